@@ -1,0 +1,3 @@
+"""bionav: biologically inspired visual navigation."""
+
+__version__ = "0.1.0"

@@ -1,0 +1,108 @@
+"""Panorama geometry and angle conventions shared by every part of bionav.
+
+Conventions (used everywhere unless a docstring says otherwise)
+-------------------------------------------------------------
+* Angles are radians. Positive rotation is counter-clockwise seen from above
+  (right-handed grid frame: +x to the right, +y up, +z towards the sky).
+* The *grid frame* is the frame of a database's capture grid: a position is
+  ``(x, y)`` in grid units (integer indices for grid cells). The home direction
+  from current view ``c`` to snapshot ``s`` is ``atan2(s_y - c_y, s_x - c_x)``.
+* A *canonical panorama* is an unfolded image of shape ``(H, W)`` (or
+  ``(H, W, C)``) in which column ``j`` looks along azimuth
+  ``2 * pi * j / W`` measured counter-clockwise from the robot's heading.
+  Databases convert their images to canonical panoramas when loading (they
+  mirror clockwise images and roll the heading column to column 0), so homing
+  methods never see on-disk conventions.
+* Rows: row 0 is the top of the image; the elevation of row ``r`` is
+  ``(horizon_row - r) * rad_per_row`` (positive above the horizon).
+* A robot with heading ``phi`` (CCW from grid +x) sees grid azimuth
+  ``phi + 2*pi*j/W`` in column ``j``. An angle returned by a homing method lives
+  in the *current view's own frame*; add the current view's heading to get the
+  grid-frame angle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+TWO_PI = 2.0 * np.pi
+
+
+def wrap_angle(angle):
+    """Wrap angles to ``[-pi, pi)``.
+
+    Parameters
+    ----------
+    angle : float or ndarray
+        Angle(s) in radians.
+
+    Returns
+    -------
+    float or ndarray
+        The same angle(s) wrapped to ``[-pi, pi)``.
+    """
+    return (np.asarray(angle) + np.pi) % TWO_PI - np.pi
+
+
+def angular_difference(a, b):
+    """Absolute angular difference ``|wrap(a - b)|`` in ``[0, pi]`` (radians)."""
+    return np.abs(wrap_angle(np.asarray(a) - np.asarray(b)))
+
+
+@dataclass(frozen=True)
+class PanoramaGeometry:
+    """Pixel geometry of a canonical unfolded panorama.
+
+    Parameters
+    ----------
+    width : int
+        Number of columns ``W``; they span 360 degrees counter-clockwise,
+        column 0 along the robot's heading.
+    height : int
+        Number of rows ``H``.
+    horizon_row : float
+        Row (may be fractional) that images the horizon (elevation 0).
+    rad_per_row : float
+        Elevation step per row in radians (rows grow downwards, elevation
+        grows upwards).
+    """
+
+    width: int
+    height: int
+    horizon_row: float
+    rad_per_row: float
+
+    @classmethod
+    def square_pixels(cls, width: int, height: int, *, horizon_row: float | None = None) -> "PanoramaGeometry":
+        """Geometry where a pixel spans the same angle vertically and horizontally.
+
+        The horizon defaults to the middle row, ``(height - 1) / 2``.
+        """
+        if horizon_row is None:
+            horizon_row = (height - 1) / 2.0
+        return cls(int(width), int(height), float(horizon_row), TWO_PI / width)
+
+    @property
+    def rad_per_column(self) -> float:
+        """Azimuth step per column in radians (counter-clockwise)."""
+        return TWO_PI / self.width
+
+    def column_azimuths(self) -> np.ndarray:
+        """Azimuth of every column, shape ``(W,)``, radians CCW from the heading."""
+        return np.arange(self.width) * self.rad_per_column
+
+    def row_elevations(self) -> np.ndarray:
+        """Elevation of every row, shape ``(H,)``, radians, positive above the horizon."""
+        return (self.horizon_row - np.arange(self.height)) * self.rad_per_row
+
+    def resized(self, width: int, height: int) -> "PanoramaGeometry":
+        """The same field of view sampled at another size (``H x W`` pixels)."""
+        sy = height / self.height
+        return PanoramaGeometry(
+            int(width),
+            int(height),
+            (self.horizon_row + 0.5) * sy - 0.5,
+            self.rad_per_row / sy,
+        )

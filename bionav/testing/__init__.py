@@ -1,0 +1,1 @@
+"""bionav.testing."""
