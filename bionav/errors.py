@@ -1,0 +1,17 @@
+"""Errors that the command line turns into one clear message (no traceback)."""
+
+
+class UserError(Exception):
+    """A problem the user can fix: bad name, missing file, bad value, unreachable device.
+
+    The message must be one paragraph that names the problem and the fix. The
+    command line prints it and exits with status 2.
+    """
+
+
+class PluginError(UserError):
+    """A plugin could not be found, loaded or instantiated."""
+
+
+class DeviceError(UserError):
+    """A serial device is missing, busy, silent or speaks garbage."""
