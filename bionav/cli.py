@@ -20,6 +20,9 @@ EXIT_INTERNAL_ERROR = 1
 
 log = logging.getLogger("bionav")
 
+#: config groups that hold YAML options only (plugin groups come from the registry)
+YAML_GROUPS = ("experiment", "db", "preprocess", "layout", "data", "mode")
+
 
 def _fail(message: str, code: int = EXIT_USER_ERROR) -> None:
     print(f"bionav: error: {message}", file=sys.stderr)
@@ -34,16 +37,20 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
         overrides = OverridesParser.create().parse_overrides([a for a in argv if not a.startswith("-")])
     except Exception:
         return  # Hydra reports syntax errors itself
+    groups = {g: list(v) for g, v in names.items()}
+    for group in YAML_GROUPS:
+        if _yaml_options(group):  # only groups that exist; otherwise `key=value` is a plain value
+            groups.setdefault(group, [])
     for override in overrides:
         key = override.key_or_group
-        if key in names and not override.is_delete():
+        if key in groups and not override.is_delete():
             values = override.value()
             candidates = values if isinstance(values, list) else [values]
             if override.is_sweep_override() and not isinstance(values, list):
                 continue
             for value in candidates:
-                if isinstance(value, str) and value not in names[key] and not _has_yaml(key, value):
-                    choices = sorted(set(names[key]) | set(_yaml_options(key)))
+                if isinstance(value, str) and value not in groups[key] and not _has_yaml(key, value):
+                    choices = sorted(set(groups[key]) | set(_yaml_options(key)))
                     raise UserError(
                         f"unknown {key} {value!r}. Available: {', '.join(choices) or '(none installed)'}. "
                         f"Run `python -m bionav.plugins` to see every installed plugin."
@@ -75,9 +82,10 @@ def _check_writable(path: Path) -> None:
     probe = path
     while not probe.exists() and probe != probe.parent:
         probe = probe.parent
-    if not os.access(probe, os.W_OK):
+    if not probe.is_dir() or not os.access(probe, os.W_OK):
+        what = "is not a directory" if not probe.is_dir() else "is not writable"
         raise UserError(
-            f"cannot write the output directory {path}: {probe} is not writable. "
+            f"cannot write the output directory {path}: {probe} {what}. "
             f"Choose another one with hydra.run.dir=... (or hydra.sweep.dir=... for -m)."
         )
 
