@@ -47,3 +47,15 @@ def make_homing(cfg: DictConfig, ctx, geometry):
     if "signature" in inspect.signature(cls.__init__).parameters and cfg.get("signature"):
         kwargs["signature"] = ctx.plugin("signature", cfg.signature)
     return ctx.plugin("homing", cfg.homing, **kwargs)
+
+
+def prepared_cache(cfg: DictConfig):
+    """The on-disk cache of per-image work for ``cfg.homing`` (None when ``bionav.cache_prepared=false``)."""
+    if not OmegaConf.select(cfg, "bionav.cache_prepared", default=True):
+        return None
+    from bionav.evaluation.prepcache import PreparedCache
+
+    name = str(cfg.homing.name)
+    if cfg.get("signature") and cfg.signature.get("name"):
+        name = f"{name}-{cfg.signature.name}"
+    return PreparedCache(Path(str(cfg.cache_dir)), name)
