@@ -20,9 +20,12 @@ class FloorPlan:
     ----------
     segments : ndarray, shape (M, 4)
         ``(x0, y0, x1, y1)`` per segment, metres.
+    is_wall : ndarray of bool, shape (M,), optional
+        True for segments of room walls (candidates for wall following).
     """
 
     segments: np.ndarray
+    is_wall: np.ndarray | None = None
 
     @classmethod
     def from_shapes(cls, *, rooms=(), boxes=(), discs=(), n_disc_sides: int = 16) -> "FloorPlan":
@@ -42,6 +45,7 @@ class FloorPlan:
         segs = []
         for lo, hi in rooms:
             segs += _polygon_segments(np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]]))
+        n_walls = len(segs)
         for (cx, cy), (hx, hy), yaw in boxes:
             c, s = np.cos(yaw), np.sin(yaw)
             corners = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
@@ -53,7 +57,9 @@ class FloorPlan:
             rr = r / np.cos(np.pi / n_disc_sides)
             segs += _polygon_segments(np.stack([cx + rr * np.cos(a), cy + rr * np.sin(a)], axis=1))
         arr = np.array(segs, dtype=np.float64).reshape(-1, 4)
-        return cls(arr)
+        is_wall = np.zeros(len(arr), dtype=bool)
+        is_wall[:n_walls] = True
+        return cls(arr, is_wall)
 
     def clearance(self, x: float, y: float) -> float:
         """Distance (m) from the point ``(x, y)`` to the nearest obstacle outline (``inf`` if none)."""
@@ -92,3 +98,50 @@ class FloorPlan:
 def _polygon_segments(pts: np.ndarray) -> list:
     n = len(pts)
     return [(pts[i, 0], pts[i, 1], pts[(i + 1) % n, 0], pts[(i + 1) % n, 1]) for i in range(n)]
+
+
+def floorplan_from_scene(scene, *, max_height: float = 0.35, min_height: float = 0.01) -> FloorPlan:
+    """Obstacle outlines of a :class:`bionav.world.scene.Scene` for a robot ``max_height`` metres tall.
+
+    Room shells (boxes rendered from inside) become walls; boxes, vertical
+    cylinders/cones and ellipsoids whose underside is below ``max_height`` and
+    whose top is above ``min_height`` (not a floor decal) become footprints:
+    rotated rectangles for boxes, discs of the larger radius for the others.
+    A table top is no obstacle, its legs are.
+
+    Parameters
+    ----------
+    scene : Scene
+        The world (its ``boxes``, ``frusta`` and ``ellipsoids`` lists).
+    max_height, min_height : float
+        Height band (m) in which parts of the world block the robot.
+    """
+    rooms, boxes, discs = [], [], []
+    wall_segments = []
+    for b in scene.boxes:
+        cx, cy, cz, hx, hy, hz, c, s, inside = (float(v) for v in b[:9])
+        yaw = float(np.arctan2(s, c))
+        if inside:
+            corners = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+            pts = corners @ np.array([[c, s], [-s, c]]) + np.array([cx, cy])
+            wall_segments += _polygon_segments(pts)
+            continue
+        if cz - hz < max_height and cz + hz > min_height:
+            boxes.append(((cx, cy), (hx, hy), yaw))
+    for f in scene.frusta:
+        cx, cy, z0, z1, r0, r1 = (float(v) for v in f[:6])
+        if z0 < max_height and z1 > min_height:
+            # the largest radius within the blocking height band
+            zt = min(z1, max_height)
+            r = max(r0, r0 + (r1 - r0) * (zt - z0) / (z1 - z0))
+            discs.append(((cx, cy), r))
+    for e in scene.ellipsoids:
+        cx, cy, cz, rx, ry, rz = (float(v) for v in e[:6])
+        if cz - rz < max_height and cz + rz > min_height:
+            discs.append(((cx, cy), max(rx, ry)))
+    inner = FloorPlan.from_shapes(boxes=boxes, discs=discs)
+    walls = np.array(wall_segments, dtype=np.float64).reshape(-1, 4)
+    segs = np.concatenate([walls, inner.segments])
+    is_wall = np.zeros(len(segs), dtype=bool)
+    is_wall[: len(walls)] = True
+    return FloorPlan(segs, is_wall)

@@ -15,10 +15,17 @@ tick), on later lanes by whatever the subclass measures (visual triangulation
 against the previous lane for ``triangulation``, nothing for ``odometry``).
 A fix replaces ``y`` and the heading by ``y + g (y_meas - y)`` (gain ``g``).
 
+Wheel bias. A static wheel-speed error makes the robot turn by ``kappa``
+radians per metre driven that the odometry does not see. With
+``bias_learning`` the controller estimates ``kappa`` from its fixes: the
+heading corrections it applied, summed over at least ``bias_window`` metres
+and divided by the distance driven, are the drift its dead reckoning missed;
+``kappa`` moves towards explaining them (gain ``bias_gain``), and the
+odometry increments are corrected by ``kappa`` times the distance driven.
+
 Lane keeping is pure pursuit of a point ``lookahead`` metres ahead on the
 desired line: desired heading ``atan2(-y, lookahead)``, turn rate
-``omega = heading_gain * wrap(desired - heading)`` (clipped), plus an optional
-integral term that learns a constant turn-rate bias (the wheel error).
+``omega = heading_gain * wrap(desired - heading)`` (clipped).
 """
 
 from __future__ import annotations
@@ -51,8 +58,12 @@ class MeanderConfig:
         Turn rate per radian of heading error, 1/s.
     max_steer_rate : float
         Largest turn rate while driving a lane, rad/s.
+    bias_learning : bool
+        Estimate the heading drift per metre (wheel error) from the fixes.
     bias_gain : float
-        Integral gain (1/s^2) of the turn-rate bias estimate; 0 disables it.
+        Fraction of the observed drift added to the estimate per window.
+    bias_window : float
+        Distance (m) over which heading corrections are summed per update.
     wall_gate_deg : float
         Wall readings whose heading disagrees with the estimate by more than
         this are ignored (a corner, an open door).
@@ -66,7 +77,9 @@ class MeanderConfig:
     lookahead: float = 0.30
     heading_gain: float = 1.5
     max_steer_rate: float = 0.5
-    bias_gain: float = 0.0
+    bias_learning: bool = False
+    bias_gain: float = 0.5
+    bias_window: float = 0.2
     wall_gate_deg: float = 20.0
     turn_tolerance_deg: float = 0.5
 
@@ -84,7 +97,10 @@ class MeanderController(Controller):
         self.phase = "lane"
         self.est = Pose(0.0, 0.0, 0.0)  # pose in the current lane frame
         self.origin_in_prev = Pose(0.0, 0.0, 0.0)  # R_k's origin in R_{k-1}
-        self.bias = 0.0  # learned turn-rate bias, rad/s
+        self.kappa = 0.0  # learned heading drift, rad per metre driven
+        self.odometry = Pose(0.0, 0.0, 0.0)  # odometry corrected by kappa (frame of the run's start)
+        self._bias_turn = 0.0  # heading corrections applied in the current window (rad)
+        self._bias_dist = 0.0  # distance driven in the current window (m)
         self._prev_odo: Pose | None = None
         self._prev_time = 0.0
         self._lane_end_x = 0.0
@@ -98,11 +114,12 @@ class MeanderController(Controller):
         return self.plan.side * (1 if lane % 2 == 0 else -1)
 
     # ------------------------------------------------------------------ hooks
-    def lane_fix(self, obs: Observation, info: dict) -> tuple[float, float] | None:
-        """Measure ``(y, heading)`` in the current lane frame on lanes after the first.
+    def lane_fix(self, obs: Observation, info: dict) -> tuple[float | None, float, float] | None:
+        """Measure ``(x, y, heading)`` in the current lane frame on lanes after the first.
 
         Called every tick while driving a lane ``k >= 1``; return ``None`` when
-        there is nothing new. Subclasses write their internals into ``info``.
+        there is nothing new, ``x = None`` when only ``y`` and the heading were
+        measured. Subclasses write their internals into ``info``.
         """
         return None
 
@@ -113,12 +130,17 @@ class MeanderController(Controller):
         """Called every tick while driving any lane, after the fix (e.g. to store a snapshot)."""
 
     # ------------------------------------------------------------------ control
-    def _apply_fix(self, y: float, heading: float, gain: float) -> None:
-        self.est = Pose(
-            self.est.x,
-            self.est.y + gain * (y - self.est.y),
-            float(wrap_angle(self.est.theta + gain * wrap_angle(heading - self.est.theta))),
-        )
+    def _apply_fix(self, y: float, heading: float, gain: float, x: float | None = None) -> None:
+        turn = gain * float(wrap_angle(heading - self.est.theta))
+        new_x = self.est.x if x is None else self.est.x + gain * (x - self.est.x)
+        self.est = Pose(new_x, self.est.y + gain * (y - self.est.y), float(wrap_angle(self.est.theta + turn)))
+        c = self.config
+        if c.bias_learning:
+            self._bias_turn += turn
+            if self._bias_dist >= c.bias_window:
+                self.kappa += c.bias_gain * self._bias_turn / self._bias_dist
+                self._bias_turn = 0.0
+                self._bias_dist = 0.0
 
     def _wall_fix(self, obs: Observation) -> None:
         if obs.wall is None:
@@ -136,9 +158,7 @@ class MeanderController(Controller):
         c = self.config
         desired = np.arctan2(-self.est.y, c.lookahead)
         err = float(wrap_angle(desired - self.est.theta))
-        if c.bias_gain > 0:
-            self.bias += c.bias_gain * err * dt
-        omega = float(np.clip(c.heading_gain * err + self.bias, -c.max_steer_rate, c.max_steer_rate))
+        omega = float(np.clip(c.heading_gain * err, -c.max_steer_rate, c.max_steer_rate))
         v = c.speed * max(0.0, float(np.cos(err)))
         return self._wheels(v, omega)
 
@@ -152,7 +172,13 @@ class MeanderController(Controller):
     def step(self, obs: Observation) -> Command:
         if self._prev_odo is None:
             self._prev_odo, self._prev_time = obs.odometry, obs.time
-        self.est = self.est.compose(obs.odometry.relative_to(self._prev_odo))
+        delta = obs.odometry.relative_to(self._prev_odo)
+        if self.kappa != 0.0:
+            delta = Pose(delta.x, delta.y, delta.theta + self.kappa * delta.x)
+        self.est = self.est.compose(delta)
+        self.odometry = self.odometry.compose(delta)
+        if self.phase == "lane":
+            self._bias_dist += abs(delta.x)
         dt = obs.time - self._prev_time
         self._prev_odo, self._prev_time = obs.odometry, obs.time
         info: dict = {}
@@ -165,7 +191,7 @@ class MeanderController(Controller):
             else:
                 fix = self.lane_fix(obs, info)
                 if fix is not None:
-                    self._apply_fix(fix[0], fix[1], getattr(self.config, "fix_gain", 1.0))
+                    self._apply_fix(fix[1], fix[2], getattr(self.config, "fix_gain", 1.0), x=fix[0])
             self.post_fix(obs, info)
             if self.est.x >= self.plan.lane_length or obs.bumper:
                 info["lane_end"] = self.lane

@@ -109,7 +109,7 @@ class SimulatedRobot:
         self.pose = self.start
         self.odometry = Pose(0.0, 0.0, 0.0)
         self.bumper = False
-        self.captures: list[tuple[np.ndarray, Pose]] = []
+        self.captures: list[tuple[np.ndarray, Pose, int]] = []
         self._n_captures = 0
 
     def _free(self, pose: Pose) -> bool:
@@ -130,9 +130,10 @@ class SimulatedRobot:
             pose = self.pose
 
             def cam() -> np.ndarray:
-                img = self.camera(pose, self._n_captures)
+                index = self._n_captures
+                img = self.camera(pose, index)
                 self._n_captures += 1
-                self.captures.append((img, pose))
+                self.captures.append((img, pose, index))
                 return img
 
         wall = None

@@ -82,6 +82,7 @@ class TriangulationConfig(MeanderConfig):
         Fixes whose ``h`` differs from the prediction by more are rejected, m.
     """
 
+    bias_learning: bool = True
     snapshot_interval: float = 0.10
     max_snapshot_distance: float = 1.0
     min_intersection_deg: float = 30.0
@@ -105,7 +106,8 @@ class MapNode:
     x, y : float
         Estimated position in its lane's frame (m).
     odometry : Pose
-        Odometry pose at capture.
+        Odometry pose at capture, corrected by the learned wheel bias
+        (:attr:`MeanderController.kappa`).
     prepared : object
         The homing method's prepared image.
     """
@@ -159,18 +161,18 @@ class TriangulationController(MeanderController):
             info["fix"] = {"accepted": False, "reason": "no well-conditioned pair"}
             return None
         n1, n2, sigma = choice
-        result = self.measure(n1, n2, obs.odometry)
+        result = self.measure(n1, n2, self.odometry)
         result["predicted_std"] = float(sigma)
         info["fix"] = result
         if not result["accepted"]:
             return None
         side_prev = self.lane_side(self.lane - 1)
-        return side_prev * self.plan.spacing - result["h"], float(wrap_angle(result["heading"] - np.pi))
+        return None, side_prev * self.plan.spacing - result["h"], float(wrap_angle(result["heading"] - np.pi))
 
     def post_fix(self, obs: Observation, info: dict) -> None:
         if self._current is None:
             return
-        node = MapNode(len(self.nodes), self.lane, self.est.x, self.est.y, obs.odometry, self._current)
+        node = MapNode(len(self.nodes), self.lane, self.est.x, self.est.y, self.odometry, self._current)
         self.nodes.append(node)
         self._lane_nodes.setdefault(self.lane, []).append(node)
         info["snapshot"] = {"id": node.id, "lane": node.lane, "x": node.x, "y": node.y}

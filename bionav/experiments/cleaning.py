@@ -1,0 +1,334 @@
+"""``experiment=cleaning``: meandering cleaning runs of a simulated robot (thesis chapter 7).
+
+Gerstmayr, Möller et al. (2009), "A vision-based trajectory controller for
+autonomous cleaning robots", Autonome Mobile Systeme 2009,
+doi:10.1007/978-3-642-10284-4_9.
+
+``python -m bionav experiment=cleaning layout=long_lanes|short_lanes runs=10
+controller=triangulation|odometry|random``
+
+A differential-drive robot with a static wheel-speed error (``+e`` left /
+``-e`` right for the first half of the runs, swapped for the second half,
+unknown to its odometry) cleans the target area of a layout (``conf/layout``:
+7 lanes of 4 m or 14 lanes of 2 m, 0.30 m apart, first lane by wall
+following). With ``experiment.vision=render`` the robot sees 335 x 40
+panoramas rendered in its own frame at its true pose in the synthetic world
+``experiment.world`` and homes with ``cfg.homing`` (min-warping by default);
+with ``experiment.vision=oracle`` the home vectors come from the true geometry
+plus Gaussian noise (no renderer needed).
+
+Writes metrics.json (``coverage``, ``overlap``, ``uncovered``: fractions of the
+target area, means over runs; their standard deviations; the same fractions
+for the ideal meander; triangulation statistics), ``cleaning_runs.csv`` (one
+row per run), run.mcap (per tick the controller's inputs and commands, the
+true pose, grabbed-image digests; controller internals h, e and the chosen
+snapshots; see :mod:`bionav.robot.recording`) and plots/ (trajectories of all
+runs and overlap maps, thesis figs. 7.3-7.4).
+"""
+
+from __future__ import annotations
+
+import csv
+import time
+from dataclasses import asdict, dataclass
+from typing import Any, Callable
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from bionav.errors import UserError
+from bionav.robot.controller import LanePlan
+from bionav.robot.kinematics import Pose
+
+#: seconds between the log times of consecutive runs' first ticks (runs are laid end to end)
+RUN_SPACING_NS = 100_000 * 1_000_000_000
+
+
+@dataclass
+class CleaningWorld:
+    """Where the runs happen.
+
+    Attributes
+    ----------
+    floor : FloorPlan
+        Obstacles (collisions, wall sensor).
+    start : Pose
+        World pose of the plan frame's origin (nominal start of the first lane).
+    camera_factory : callable
+        ``camera_factory(seed) -> camera(true_pose, capture_index) -> image``.
+    geometry : PanoramaGeometry or None
+        Geometry of the rendered images (None in oracle mode).
+    scene : object
+        The rendered scene (None in oracle mode).
+    """
+
+    floor: Any
+    start: Pose
+    camera_factory: Callable[[int], Callable]
+    geometry: Any = None
+    scene: Any = None
+
+
+def plan_from_layout(node: Any) -> LanePlan:
+    """A :class:`LanePlan` from a ``layout`` config node (``conf/layout/*.yaml``)."""
+    try:
+        return LanePlan(
+            n_lanes=int(node.n_lanes),
+            lane_length=float(node.lane_length),
+            spacing=float(node.spacing),
+            turn=str(node.turn),
+            wall_offset=float(node.wall_offset),
+            unit_width=float(node.get("unit_width", node.spacing)),
+        )
+    except (ValueError, TypeError, AttributeError) as exc:
+        raise UserError(f"bad layout settings: {exc}. Choose layout=long_lanes or layout=short_lanes, or fix "
+                        f"the layout.* overrides.") from None
+
+
+# ---------------------------------------------------------------------------- worlds
+def oracle_world(plan: LanePlan, *, margin: float = 1.0) -> CleaningWorld:
+    """An empty room for oracle runs: the plan frame is the world frame, the wall along the first lane.
+
+    The first lane's wall lies ``plan.wall_offset`` to the right of the first
+    lane; the other walls ``margin`` metres beyond the target area.
+    """
+    from bionav.robot.floorplan import FloorPlan
+    from bionav.robot.oracle import oracle_camera
+
+    (x0, y0), (x1, y1) = plan.target_rectangle()
+    if plan.side > 0:
+        lo, hi = (x0 - margin, -plan.wall_offset), (x1 + margin, y1 + margin)
+    else:
+        lo, hi = (x0 - margin, y0 - margin), (x1 + margin, plan.wall_offset)
+    floor = FloorPlan.from_shapes(rooms=[(lo, hi)])
+    return CleaningWorld(floor=floor, start=Pose(0.0, 0.0, 0.0), camera_factory=lambda seed: oracle_camera)
+
+
+def rendered_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
+    """The synthetic world ``experiment.world`` with the layout placed in it, and a rendering camera."""
+    from bionav.geometry import PanoramaGeometry
+    from bionav.robot.floorplan import floorplan_from_scene
+    from bionav.robot.worldview import load_world, place_plan, render_camera
+
+    ex = cfg.experiment
+    world = load_world(str(ex.world), seed=int(ex.world_seed))
+    cam = ex.camera
+    geometry = PanoramaGeometry.square_pixels(
+        int(cam.width), int(cam.height), horizon_row=None if cam.horizon_row is None else float(cam.horizon_row))
+    floor = floorplan_from_scene(world.scene, max_height=float(ex.robot_height))
+    start = place_plan(world, floor, plan, layout=cfg.layout, robot_radius=float(ex.robot_radius))
+    height = float(cam.height_m)
+    noise = float(cam.noise)
+
+    def factory(seed: int):
+        return render_camera(world.scene, geometry, height=height, noise=noise, seed=seed)
+
+    return CleaningWorld(floor=floor, start=start, camera_factory=factory, geometry=geometry, scene=world.scene)
+
+
+# ---------------------------------------------------------------------------- runs
+@dataclass
+class RunResult:
+    """One simulated run and its analysis."""
+
+    run: int
+    wheel_error: tuple[float, float]
+    episode: Any
+    counts: np.ndarray
+    fractions: dict
+    fixes: list
+    truth_h: np.ndarray  # true h at accepted fixes (m)
+    seconds: float
+
+
+def wheel_errors(runs: int, magnitude: float) -> list[tuple[float, float]]:
+    """``(+e, -e)`` for the first half of the runs, ``(-e, +e)`` for the rest (thesis 7.2)."""
+    half = (runs + 1) // 2
+    return [(magnitude, -magnitude) if k < half else (-magnitude, magnitude) for k in range(runs)]
+
+
+def true_lane_distances(episode, fixes: list, captures_true: dict[int, tuple]) -> np.ndarray:
+    """True signed distance ``h`` at each fix from the true positions of its two snapshots.
+
+    Parameters
+    ----------
+    episode : Episode
+        The run (true poses per tick).
+    fixes : list of (tick, dict)
+        Accepted fixes with ``snapshots`` ids.
+    captures_true : dict
+        Snapshot id -> true pose ``(x, y, theta)`` at capture.
+    """
+    out = []
+    for tick, fix in fixes:
+        a = np.asarray(captures_true[fix["snapshots"][0]][:2])
+        b = np.asarray(captures_true[fix["snapshots"][1]][:2])
+        p = episode.true_pose[tick, :2]
+        u = b - a
+        out.append(float((u[0] * (p[1] - a[1]) - u[1] * (p[0] - a[0])) / np.hypot(*u)))
+    return np.array(out)
+
+
+def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_controller, homing) -> list[RunResult]:
+    """Run ``cfg.experiment.runs`` simulated cleaning runs, logging each to ``ctx.log``."""
+    from bionav.robot.coverage import Raster, coverage_fractions, sweep_counts
+    from bionav.robot.kinematics import DriveModel
+    from bionav.robot.lanes import to_plan_frame
+    from bionav.robot.recording import RESULT_TOPIC, EpisodeRecorder
+    from bionav.robot.simulator import SimulatedRobot, run_episode
+
+    ex = cfg.experiment
+    runs = int(ex.runs)
+    if runs < 1:
+        raise UserError(f"runs must be at least 1, got {runs}; set runs=10 as in the thesis.")
+    lo, hi = plan.target_rectangle()
+    raster = Raster.around(lo, hi, cell=float(ex.raster_cell), margin=float(ex.raster_margin))
+    target = raster.rectangle_mask(lo, hi)
+    dt = float(ex.dt)
+    speed = float(getattr(make_controller().config, "speed", 0.1))
+    max_time = float(ex.time_limit_factor) * plan.ideal_path_length / speed + 600.0
+    errors = wheel_errors(runs, float(ex.wheel_error))
+    seeds = ctx.rng.integers(0, 2**31 - 1, size=(runs, 3))
+    results = []
+    for k in ctx.progress(range(runs), desc="cleaning runs", total=runs):
+        controller = make_controller()
+        controller_seed, camera_seed, sim_seed = (int(s) for s in seeds[k])
+        sim_rng = np.random.default_rng(sim_seed)
+        start = world.start.compose(Pose(
+            float(ex.start_position_std) * float(sim_rng.standard_normal()),
+            float(ex.start_position_std) * float(sim_rng.standard_normal()),
+            float(np.radians(float(ex.start_heading_std_deg)) * sim_rng.standard_normal())))
+        confine = (lo, hi, world.start) if controller.confined else None
+        camera = world.camera_factory(camera_seed) if controller.uses_camera else None
+        robot = SimulatedRobot(
+            DriveModel(track_width=float(ex.track_width), wheel_error=errors[k]), start, floor=world.floor,
+            radius=float(ex.robot_radius), confine=confine, camera=camera, rng=sim_rng)
+        controller.reset(plan, homing=homing if controller.uses_camera else None,
+                         rng=np.random.default_rng(controller_seed))
+        recorder = EpisodeRecorder(ctx.log, k, time_offset_ns=k * RUN_SPACING_NS, log_images=bool(ex.log_images))
+        recorder.start({
+            "controller": str(cfg.controller.name),
+            "controller_config": asdict(controller.config),
+            "plan": asdict(plan),
+            "controller_seed": controller_seed, "camera_seed": camera_seed,
+            "camera": camera is not None,
+            "wheel_error": list(errors[k]), "start": list(start.as_tuple()),
+            "nominal_start": list(world.start.as_tuple()),
+        })
+        captures_true: dict[int, tuple] = {}
+
+        def on_tick(tick, obs, cmd, robot, recorder=recorder, captures_true=captures_true):
+            recorder.on_tick(tick, obs, cmd, robot)
+            snap = cmd.info.get("snapshot") if cmd.info else None
+            if snap is not None:
+                captures_true[snap["id"]] = robot.pose.as_tuple()
+
+        t0 = time.perf_counter()
+        episode = run_episode(controller, robot, dt=dt, max_time=max_time, on_tick=on_tick)
+        seconds = time.perf_counter() - t0
+        counts = sweep_counts(to_plan_frame(episode.true_pose, world.start), raster, width=plan.unit_width)
+        fractions = coverage_fractions(counts, target)
+        fixes = [(t, i["fix"]) for t, i in episode.info if "fix" in i]
+        accepted = [(t, f) for t, f in fixes if f.get("accepted")]
+        truth = true_lane_distances(episode, accepted, captures_true) if accepted else np.zeros(0)
+        ctx.log.write(RESULT_TOPIC, {"run": k, "wheel_error": list(errors[k]), **fractions,
+                                     "finished": bool(episode.finished), "ticks": int(len(episode.time)),
+                                     "fixes": len(fixes), "accepted_fixes": len(accepted), "seconds": seconds},
+                      schema_name="bionav.CleaningResult", log_time_ns=recorder.last_time_ns)
+        results.append(RunResult(k, errors[k], episode, counts, fractions, fixes, truth, seconds))
+    return results
+
+
+def summarise(results: list[RunResult], plan: LanePlan, ideal: dict) -> dict[str, Any]:
+    """Flat metrics: means (and stds) over runs plus triangulation statistics."""
+    out: dict[str, Any] = {}
+    for key in ("coverage", "overlap", "uncovered"):
+        vals = np.array([r.fractions[key] for r in results])
+        out[key] = float(vals.mean())
+        out[f"{key}_std"] = float(vals.std(ddof=1)) if len(vals) > 1 else 0.0
+    for key in ("coverage", "overlap", "uncovered"):
+        out[f"ideal_{key}"] = ideal[key]
+    out["n_runs"] = len(results)
+    out["finished_runs"] = int(sum(r.episode.finished for r in results))
+    n_fix = sum(len(r.fixes) for r in results)
+    accepted = [f for r in results for _, f in r.fixes if f.get("accepted")]
+    out["fixes"] = n_fix
+    out["fix_acceptance"] = float(len(accepted) / n_fix) if n_fix else 0.0
+    if accepted:
+        h = np.array([f["h"] for f in accepted])
+        truth = np.concatenate([r.truth_h for r in results])
+        desired = np.array([abs(f["h"] - f["e"]) for f in accepted])
+        out["h_error_rms"] = float(np.sqrt(np.mean((h - truth) ** 2)))
+        out["lane_distance_error_rms"] = float(np.sqrt(np.mean((np.abs(truth) - desired) ** 2)))
+    out["seconds_per_run"] = float(np.mean([r.seconds for r in results]))
+    return out
+
+
+def write_runs_csv(path, results: list[RunResult]) -> None:
+    """``cleaning_runs.csv``: one row per run."""
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", "wheel_error_left", "wheel_error_right", "coverage", "overlap", "uncovered", "finished",
+                    "ticks", "fixes", "accepted_fixes", "h_error_rms"])
+        for r in results:
+            acc = [f for _, f in r.fixes if f.get("accepted")]
+            herr = (float(np.sqrt(np.mean((np.array([f["h"] for f in acc]) - r.truth_h) ** 2))) if acc else "")
+            w.writerow([r.run, r.wheel_error[0], r.wheel_error[1], f"{r.fractions['coverage']:.6f}",
+                        f"{r.fractions['overlap']:.6f}", f"{r.fractions['uncovered']:.6f}", int(r.episode.finished),
+                        len(r.episode.time), len(r.fixes), len(acc), herr if herr == "" else f"{herr:.6f}"])
+
+
+def make_oracle_homing(cfg: DictConfig):
+    """The oracle homing method of ``experiment.oracle`` (noisy home vectors from true geometry)."""
+    from bionav.robot.oracle import GeometricHoming, GeometricHomingConfig
+
+    node = cfg.experiment.oracle
+    return GeometricHoming(GeometricHomingConfig(angle_noise_deg=float(node.angle_noise_deg),
+                                                 compass_noise_deg=float(node.compass_noise_deg),
+                                                 seed=int(cfg.seed)))
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    from bionav.experiments.cleaning_plots import plot_overlap_maps, plot_trajectories
+    from bionav.experiments.common import make_homing
+    from bionav.robot.coverage import Raster, coverage_fractions, sweep_counts
+    from bionav.robot.lanes import ideal_meander
+
+    ex = cfg.experiment
+    if cfg.get("layout") is None:
+        raise UserError("experiment=cleaning needs a layout; choose layout=long_lanes or layout=short_lanes.")
+    if cfg.get("controller") is None or not cfg.controller.get("name"):
+        raise UserError("experiment=cleaning needs a controller; choose controller=triangulation, "
+                        "controller=odometry or controller=random.")
+    plan = plan_from_layout(cfg.layout)
+    vision = str(ex.vision)
+    if vision not in ("render", "oracle"):
+        raise UserError(f"experiment.vision must be 'render' or 'oracle', got {vision!r}.")
+    world = rendered_world(cfg, plan) if vision == "render" else oracle_world(plan)
+
+    from bionav.config import plugin_config
+
+    cls, config = plugin_config("controller", cfg.controller)
+
+    def make_controller():
+        return cls(config)
+
+    homing = None
+    if cls.uses_camera:
+        homing = make_homing(cfg, ctx, world.geometry) if vision == "render" else make_oracle_homing(cfg)
+
+    results = simulate(cfg, ctx, world, plan, make_controller, homing)
+
+    lo, hi = plan.target_rectangle()
+    raster = Raster.around(lo, hi, cell=float(ex.raster_cell), margin=float(ex.raster_margin))
+    ideal = coverage_fractions(sweep_counts(ideal_meander(plan), raster, width=plan.unit_width),
+                               raster.rectangle_mask(lo, hi))
+    metrics = summarise(results, plan, ideal)
+    metrics["layout"] = str(cfg.layout.name)
+    metrics["controller"] = str(cfg.controller.name)
+    metrics["vision"] = vision
+    write_runs_csv(ctx.dir / "cleaning_runs.csv", results)
+    plot_trajectories(ctx.plots / "trajectories.png", results, world, plan,
+                      title=f"{cfg.controller.name}, {cfg.layout.name}")
+    plot_overlap_maps(ctx.plots / "overlap_map.png", ctx.plots / "overlap_maps_all.png", results, raster, plan)
+    return metrics

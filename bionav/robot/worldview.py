@@ -1,0 +1,135 @@
+"""The simulated robot in a rendered world: loading the world, placing the lanes, the camera."""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.robot.controller import LanePlan
+from bionav.robot.floorplan import FloorPlan
+from bionav.robot.kinematics import Pose
+
+
+def load_world(name: str, *, seed: int = 0):
+    """Build the synthetic world ``name`` (a :class:`bionav.world.worlds.common.World`)."""
+    import importlib
+
+    try:
+        worlds = importlib.import_module("bionav.world.worlds")
+    except ModuleNotFoundError:
+        raise UserError("the renderer (bionav.world) is not available in this installation; run the cleaning "
+                        "experiment with experiment.vision=oracle (home vectors from true geometry).") from None
+    build = getattr(worlds, "build_world", None)
+    if build is not None:
+        return build(name, seed=seed)
+    try:
+        module = importlib.import_module(f"bionav.world.worlds.{name}")
+    except ModuleNotFoundError:
+        raise UserError(f"there is no synthetic world named {name!r}; set experiment.world=apartment.") from None
+    return getattr(module, f"build_{name}")(seed)
+
+
+def render_camera(scene, geometry, *, height: float, noise: float = 0.0, seed: int = 0) -> Callable[[Pose, int], np.ndarray]:
+    """A camera rendering grey panoramas in the robot's own frame.
+
+    Parameters
+    ----------
+    scene : Scene
+        The world.
+    geometry : PanoramaGeometry
+        Output size and elevation mapping (335 x 40 in the thesis).
+    height : float
+        Camera height above the floor, m.
+    noise : float
+        Std of Gaussian pixel noise added before 8-bit quantisation.
+    seed : int
+        Seed of the noise; capture ``k`` uses ``default_rng([seed, k])`` so a
+        capture can be re-created exactly (replay).
+
+    Returns
+    -------
+    callable
+        ``camera(true_pose, capture_index) -> ndarray (H, W) float32`` in
+        ``[0, 1]``, canonical panorama (column 0 along the robot's heading).
+    """
+    from bionav.world.render import render_panorama
+
+    def camera(pose: Pose, index: int) -> np.ndarray:
+        img = render_panorama(scene, position=(pose.x, pose.y, height), heading=pose.theta, geometry=geometry)
+        grey = img.mean(axis=2) if img.ndim == 3 else img
+        if noise > 0:
+            grey = grey + noise * np.random.default_rng([int(seed), int(index)]).standard_normal(grey.shape)
+        return (np.round(np.clip(grey, 0.0, 1.0) * 255.0) / 255.0).astype(np.float32)
+
+    return camera
+
+
+def plan_clearance(floor: FloorPlan, plan: LanePlan, start: Pose, *, step: float = 0.1,
+                   skip_first_lane: bool = False) -> float:
+    """Smallest distance (m) from the ideal meander's path to any obstacle outline.
+
+    With ``skip_first_lane`` the first lane (which runs along a wall at
+    ``plan.wall_offset`` by design) is left out.
+    """
+    from bionav.robot.lanes import ideal_meander, to_world_frame
+
+    pts = ideal_meander(plan, step=step)
+    if skip_first_lane:
+        pts = pts[int(np.ceil(plan.lane_length / step)) + 1:]
+    pts = to_world_frame(pts, start)
+    return min((floor.clearance(p[0], p[1]) for p in pts), default=np.inf)
+
+
+def place_plan(world, floor: FloorPlan, plan: LanePlan, *, layout: Any = None, robot_radius: float = 0.17) -> Pose:
+    """World pose of the plan frame (start of the first lane, heading along it).
+
+    With ``layout.start = [x, y]`` and ``layout.start_heading_deg`` given, that
+    pose is used. Otherwise the first lane is placed along a room wall (wall on
+    the robot's right at ``plan.wall_offset``) such that the ideal meander
+    keeps the largest clearance from every obstacle; candidates start every
+    0.1 m along every wall segment long enough, in both directions.
+
+    Raises
+    ------
+    UserError
+        When the given pose or every candidate brings the ideal lanes closer
+        than ``robot_radius`` to an obstacle.
+    """
+    if layout is not None and layout.get("start") is not None:
+        x, y = (float(v) for v in layout.start)
+        start = Pose(x, y, float(np.radians(float(layout.get("start_heading_deg") or 0.0))))
+        if plan_clearance(floor, plan, start) < robot_radius:
+            raise UserError(f"the layout's start pose {list(layout.start)} puts the lanes into an obstacle; "
+                            f"choose another layout.start / layout.start_heading_deg, or omit them for automatic "
+                            f"placement.")
+        return start
+    walls = floor.segments[floor.is_wall] if floor.is_wall is not None else floor.segments
+    best, best_clear = None, -np.inf
+    for x0, y0, x1, y1 in walls:
+        for a, b in (((x0, y0), (x1, y1)), ((x1, y1), (x0, y0))):
+            u = np.array(b) - np.array(a)
+            length = float(np.hypot(*u))
+            if length < plan.lane_length + 0.4:
+                continue
+            u /= length
+            heading = float(np.arctan2(u[1], u[0]))
+            left = np.array([-u[1], u[0]])
+            for s in np.arange(0.2, length - plan.lane_length - 0.2 + 1e-9, 0.1):
+                p = np.array(a) + s * u + plan.wall_offset * left
+                start = Pose(float(p[0]), float(p[1]), heading)
+                # the wall must be on the robot's right: the plan must lie on the wall's inner side
+                mid = np.array(a) + (s + plan.lane_length / 2) * u + (plan.wall_offset + 0.3) * left
+                if floor.raycast(mid[0], mid[1], heading - np.pi / 2, max_range=0.4) == np.inf:
+                    continue
+                if plan_clearance(floor, plan, start, step=0.2) < robot_radius:
+                    continue
+                c = plan_clearance(floor, plan, start, step=0.2, skip_first_lane=True)
+                if c > best_clear + 1e-9:
+                    best, best_clear = start, c
+    if best is None or best_clear < robot_radius:
+        raise UserError(f"the {plan.n_lanes} x {plan.lane_length} m layout does not fit along any wall of the world "
+                        f"(best clearance {best_clear:.2f} m < robot radius {robot_radius} m); choose a smaller "
+                        f"layout or give layout.start and layout.start_heading_deg.")
+    return best
