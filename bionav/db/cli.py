@@ -51,7 +51,12 @@ def run(argv: list[str]) -> int:
     from bionav.db.compose import available_databases, compose_database
     from bionav.db.loading import load_database
 
-    args = _parser(available_databases()).parse_args(argv)
+    parser = _parser(available_databases())
+    args, extra = parser.parse_known_args(argv)
+    unknown = [a for a in extra if a.startswith("-") or "=" not in a]
+    if unknown:
+        parser.error(f"unrecognized arguments: {' '.join(unknown)}")
+    args.overrides = list(args.overrides) + extra
     composed = compose_database(args.db, args.overrides)
     db = load_database(composed.db, data_dir=composed.data_dir, cache_dir=composed.cache_dir)
     if args.command == "show":

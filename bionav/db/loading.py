@@ -38,7 +38,10 @@ def as_database_config(cfg) -> DatabaseConfig:
         merged = OmegaConf.merge(OmegaConf.structured(DatabaseConfig), cfg)
         return OmegaConf.to_object(merged)
     except OmegaConfBaseException as exc:
-        raise UserError(f"invalid db configuration: {str(exc).splitlines()[0]}; check the db.* values.") from None
+        key = getattr(exc, "full_key", None)
+        where = f"db.{key}" if key else "a db.* value"
+        raise UserError(f"invalid db configuration, {where}: {str(exc).splitlines()[0]}; "
+                        f"fix {where} (see the DatabaseConfig fields in bionav/db/config.py).") from None
 
 
 def _missing_folder_message(cfg: DatabaseConfig, folder: Path, data_dir: Path) -> str:
