@@ -15,7 +15,7 @@ The thesis names the filters "Butterworth 1 with a 0.03 cutoff frequency" and
 "Butterworth 2 with a 0.015 cutoff frequency"; bionav reads the digit as the
 filter order (the issue asks for orders 1/2/3). Any other combination is a
 free list of steps, e.g.
-``preprocess.steps='[{op: butterworth, order: 3, cutoff: 0.1}, {op: edges}]'``.
+``preprocess.name=bw3e 'preprocess.steps=[{op:butterworth,order:3,cutoff:0.1},{op:edges}]'``.
 
 Deviation from the thesis: there, the filters were applied to the raw camera
 frame before unfolding. bionav filters the panorama at its native resolution
