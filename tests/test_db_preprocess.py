@@ -107,18 +107,16 @@ def test_chains_and_errors():
 
 
 def test_thesis_presets_compose():
-    from hydra import compose, initialize_config_dir
     from omegaconf import OmegaConf
 
-    from bionav.db.compose import config_dir
+    from bionav.config import compose
 
     expected = {"none": [], "bw1": [("butterworth", 1, 0.03)], "bw2": [("butterworth", 2, 0.015)],
                 "bw1e": [("butterworth", 1, 0.03), ("edges",)], "bw2e": [("butterworth", 2, 0.015), ("edges",)],
                 "he": [("equalize",)]}
-    with initialize_config_dir(config_dir=str(config_dir()), version_base="1.3"):
-        for name, steps in expected.items():
-            node = compose(overrides=[f"+preprocess={name}"]).preprocess
-            cfg = OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(PreprocessConfig), node))
-            assert cfg.name == name
-            got = [(s["op"], s["order"], s["cutoff"]) if s["op"] == "butterworth" else (s["op"],) for s in cfg.steps]
-            assert got == steps
+    for name, steps in expected.items():
+        node = compose([f"preprocess={name}"]).preprocess
+        cfg = OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(PreprocessConfig), node))
+        assert cfg.name == name
+        got = [(s["op"], s["order"], s["cutoff"]) if s["op"] == "butterworth" else (s["op"],) for s in cfg.steps]
+        assert got == steps

@@ -6,7 +6,6 @@ composes its configs through Hydra's own application machinery instead.
 
 from __future__ import annotations
 
-import importlib.resources
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,22 +14,11 @@ from bionav.db.config import DatabaseConfig
 from bionav.errors import UserError
 
 
-def config_dir() -> Path:
-    """bionav's config folder: the installed ``bionav.conf`` package, else ``conf/`` next to the package."""
-    try:
-        found = importlib.resources.files("bionav.conf")
-        path = Path(str(found))
-        if path.is_dir() and (path / "db").is_dir():
-            return path
-    except (ModuleNotFoundError, TypeError):
-        pass
-    return Path(__file__).resolve().parents[2] / "conf"
-
-
 def available_databases() -> list[str]:
-    """Names selectable as ``db=<name>`` (the presets in ``conf/db``)."""
-    folder = config_dir() / "db"
-    return sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
+    """Names selectable as ``db=<name>`` (the ``db`` presets of every config package)."""
+    from bionav.config import config_options
+
+    return config_options("db")
 
 
 def default_data_dir() -> Path:
@@ -74,32 +62,19 @@ def compose_database(name: str, overrides=()) -> ComposedDatabase:
         Unknown database name (the message lists the available ones), a
         malformed override or a value of the wrong type.
     """
-    from hydra import compose, initialize_config_dir
     from hydra.errors import HydraException
-    from omegaconf import OmegaConf, open_dict
+    from omegaconf import OmegaConf
     from omegaconf.errors import OmegaConfBaseException
 
+    from bionav.config import compose
     from bionav.db.loading import as_database_config
 
-    conf = config_dir()
     names = available_databases()
     if name not in names:
         raise UserError(f"unknown database {name!r}; the available databases are: {', '.join(names)}.")
-    primary = "config" if (conf / "config.yaml").is_file() else None
     overrides = list(overrides)
-    base = [f"db={name}"] if primary else [f"+db={name}"]
-    if primary is None:
-        # without the main config, add the two top-level keys the db presets refer to
-        base += [f"+{key}={value}" for key, value in
-                 (("data_dir", default_data_dir()), ("cache_dir", default_cache_dir()))]
     try:
-        with initialize_config_dir(config_dir=str(conf), version_base="1.3", job_name="bionav_db"):
-            cfg = compose(config_name=primary, overrides=base + overrides)
-        with open_dict(cfg):
-            if cfg.get("data_dir") is None:
-                cfg.data_dir = str(default_data_dir())
-            if cfg.get("cache_dir") is None:
-                cfg.cache_dir = str(default_cache_dir())
+        cfg = compose([f"db={name}", *overrides])
         data_dir = Path(str(cfg.data_dir)).expanduser()
         cache_dir = Path(str(cfg.cache_dir)).expanduser()
         node = OmegaConf.to_container(cfg.db, resolve=True)
