@@ -17,6 +17,11 @@ filter order (the issue asks for orders 1/2/3). Any other combination is a
 free list of steps, e.g.
 ``preprocess.name=bw3e 'preprocess.steps=[{op:butterworth,order:3,cutoff:0.1},{op:edges}]'``.
 
+The thesis does not name its edge detector; bionav uses the Sobel gradient
+magnitude (:func:`edge_filter`). In the thesis a cutoff of 1.0 "depicts
+unfiltered images"; bionav's Butterworth filter with cutoff 1.0 still halves the
+power at the Nyquist frequency, so use ``preprocess=none`` for unfiltered images.
+
 Deviation from the thesis: there, the filters were applied to the raw camera
 frame before unfolding. bionav filters the panorama at its native resolution
 (cyclic in azimuth) with the cutoff relative to the panorama's Nyquist
