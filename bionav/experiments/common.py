@@ -15,8 +15,11 @@ def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageD
     from bionav.db.loading import load_database
 
     preprocess = OmegaConf.select(cfg, "preprocess", default=None)
+    node = cfg.db if node is None else node
+    if isinstance(node, DictConfig):
+        node = OmegaConf.to_container(node, resolve=True)  # resolve ${data_dir} against the whole config
     return load_database(
-        cfg.db if node is None else node,
+        node,
         data_dir=Path(str(cfg.data_dir)),
         cache_dir=Path(str(cfg.cache_dir)),
         preprocess=preprocess,
