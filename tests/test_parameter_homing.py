@@ -175,8 +175,9 @@ def test_config_handling_and_errors():
     assert not h.requires_alignment
     with pytest.raises(UserError, match="homing.gradient"):
         ParameterHoming(Config(gradient="newton"), geometry=GEOM)
-    with pytest.raises(UserError, match="rings"):
-        ParameterHoming(Config(signature="fc", rings=3), geometry=GEOM)
+    # a pass-through parameter the signature does not have is ignored
+    h = ParameterHoming(Config(signature="fc", rings=3, n_coeffs=2), geometry=GEOM)
+    assert h.signature.config.n_coeffs == 2 and not hasattr(h.signature.config, "rings")
     ts = ParameterHoming(Config(signature="mean", rings=2), geometry=GEOM)
     rng = np.random.default_rng(0)
     prep = ts.prepare(rng.random((18, 72)))

@@ -157,3 +157,83 @@ def mffc_abs_home_vector(
     ax = spec_phi.real * spec_current.real + spec_phi.imag * spec_current.imag
     ay = spec_psi.real * spec_current.real + spec_psi.imag * spec_current.imag
     return -np.array([np.sum(w * ax), np.sum(w * ay)])
+
+
+# --- all pairs at once (grid evaluation) --------------------------------------------------------
+
+
+def potential_matrix(f_snapshots: np.ndarray, f_currents: np.ndarray) -> np.ndarray:
+    """Potentials (eq. 5.17) of every snapshot/current-view pair.
+
+    Parameters
+    ----------
+    f_snapshots : ndarray, shape (S, L)
+    f_currents : ndarray, shape (C, L)
+
+    Returns
+    -------
+    ndarray, shape (S, C)
+        ``P[s, c] = sum_i (f_i(S_s) - f_i(C_c))**2``.
+    """
+    from scipy.spatial.distance import cdist
+
+    return cdist(np.asarray(f_snapshots, dtype=np.float64), np.asarray(f_currents, dtype=np.float64), "sqeuclidean")
+
+
+def gradient_matrix_from_test_steps(potentials: np.ndarray, neighbours: np.ndarray) -> np.ndarray:
+    """Test-step gradients (eq. 5.19) for every pair from a potential matrix.
+
+    The same estimate as :func:`gradient_from_test_steps` for the grid's four
+    axis-aligned unit neighbours: central differences where both neighbours
+    along an axis exist, one-sided where one exists, 0 where none does, NaN for
+    a cell without any neighbour.
+
+    Parameters
+    ----------
+    potentials : ndarray, shape (S, C)
+        :func:`potential_matrix` of the snapshots against *all* current views.
+    neighbours : ndarray of int, shape (C, 4)
+        Index (into the current views) of the neighbours at offsets
+        ``(+1, 0), (-1, 0), (0, +1), (0, -1)``; -1 where missing.
+
+    Returns
+    -------
+    ndarray, shape (S, C, 2)
+        ``(dp/dx, dp/dy)`` per grid unit.
+    """
+    p = np.asarray(potentials, dtype=np.float64)
+    nb = np.asarray(neighbours, dtype=np.int64)
+    grad = np.zeros(p.shape + (2,))
+    for axis, (plus, minus) in enumerate(((0, 1), (2, 3))):
+        ip, im = nb[:, plus], nb[:, minus]
+        has_p, has_m = ip >= 0, im >= 0
+        pp = p[:, np.where(has_p, ip, 0)]
+        pm = p[:, np.where(has_m, im, 0)]
+        g = np.where(has_p & has_m, (pp - pm) / 2.0, np.where(has_p, pp - p, np.where(has_m, p - pm, 0.0)))
+        grad[..., axis] = g
+    grad[:, ~np.any(nb >= 0, axis=1)] = np.nan
+    return grad
+
+
+def matched_filter_gradient_matrix(
+    f_snapshots: np.ndarray, f_currents: np.ndarray, df_dx: np.ndarray, df_dy: np.ndarray
+) -> np.ndarray:
+    """:func:`matched_filter_gradient` for every snapshot/current-view pair.
+
+    Parameters
+    ----------
+    f_snapshots : ndarray, shape (S, L)
+    f_currents, df_dx, df_dy : ndarray, shape (C, L)
+
+    Returns
+    -------
+    ndarray, shape (S, C, 2)
+        ``sum_i (f_i(C) - f_i(S)) grad f_i(C)`` (the gradient of ``p / 2``).
+    """
+    fs = np.asarray(f_snapshots, dtype=np.float64)
+    fc = np.asarray(f_currents, dtype=np.float64)
+    out = np.empty((len(fs), len(fc), 2))
+    for axis, d in enumerate((df_dx, df_dy)):
+        d = np.asarray(d, dtype=np.float64)
+        out[..., axis] = np.einsum("cl,cl->c", fc, d)[None, :] - fs @ d.T
+    return out

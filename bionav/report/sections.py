@@ -8,4 +8,9 @@ from typing import Any
 
 def extra_sections(root: Path, rows: list[dict[str, Any]]) -> list[str]:
     """Markdown sections added to summary.md when the runs support them."""
-    return []
+    sections: list[str] = []
+    if any(r.get("experiment") == "param_sweep" for r in rows):
+        from bionav.report.ranking import write_parameter_report
+
+        sections += write_parameter_report(root)
+    return sections

@@ -35,7 +35,9 @@ class Config:
         ``auto`` = the thesis' protocol: ``matched_filter`` for the ``mffc_*``
         signatures and ``test_steps`` for all others.
     rings, n_coeffs, bins : when set, override the signature's parameter of the
-        same name (``None`` keeps the signature's own config).
+        same name (``None`` keeps the signature's own config); ignored by
+        signatures without that parameter, so one value can be given to a
+        sweep over several signatures.
     mf_step : size of the predicted move of the matched filter's finite
         differences, in units of the assumed (equal) landmark distance; used by
         signatures without a closed-form derivative.
@@ -102,16 +104,11 @@ class ParameterHoming(HomingMethod):
             )
         if not isinstance(signature, Signature):
             signature = signature_class(config.signature)(signature)
-        overrides = {k: getattr(config, k) for k in ("rings", "n_coeffs", "bins") if getattr(config, k) is not None}
+        names = {f.name for f in dataclasses.fields(signature.config)}
+        overrides = {
+            k: getattr(config, k) for k in ("rings", "n_coeffs", "bins") if getattr(config, k) is not None and k in names
+        }
         if overrides:
-            names = {f.name for f in dataclasses.fields(signature.config)}
-            unknown = sorted(set(overrides) - names)
-            if unknown:
-                raise UserError(
-                    f"homing.{unknown[0]} is set, but signature {signature.name!r} has no parameter "
-                    f"{unknown[0]!r} (its parameters: {', '.join(sorted(names)) or 'none'}). Remove "
-                    f"homing.{unknown[0]} or choose a signature that uses it."
-                )
             signature = type(signature)(dataclasses.replace(signature.config, **overrides))
         if not config.mf_step > 0:
             raise UserError(f"homing.mf_step={config.mf_step} must be positive; the default is 0.05.")

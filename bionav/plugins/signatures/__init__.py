@@ -58,13 +58,24 @@ def builtin_signature_class(name: str) -> type:
 
 
 def signature_class(name: str) -> type:
-    """Signature class for ``name``: from ``bionav.registry`` when present, else built-in."""
+    """Signature class for ``name``: from the plugin registry, else bionav's built-in table.
+
+    The built-in table is the fallback for names the registry does not know
+    (bionav used from a source tree without installed entry points).
+
+    Raises
+    ------
+    PluginError
+        If neither the registry nor the built-in table knows ``name``.
+    """
+    from bionav.registry import load_plugin
+
     try:
-        from bionav.registry import load_plugin
-    except ImportError:
+        return load_plugin("signature", name)
+    except PluginError:
+        if name not in SIGNATURE_NAMES:
+            raise
         return builtin_signature_class(name)
-    plugin = load_plugin("signature", name)
-    return plugin if isinstance(plugin, type) else type(plugin)
 
 
 def make_signature(name: str, config: Any = None):
