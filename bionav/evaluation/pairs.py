@@ -63,10 +63,16 @@ def prepare_images(
     workers: int = 1,
     progress: Progress = _no_progress,
     desc: str = "per-image work",
+    cache: Any = None,
 ) -> list[Any]:
-    """Run ``method.prepare`` once per image, on ``workers`` threads."""
+    """Run ``method.prepare`` once per image, on ``workers`` threads.
+
+    With a :class:`bionav.evaluation.prepcache.PreparedCache`, results are
+    read from / written to the on-disk cache.
+    """
+    fn = method.prepare if cache is None else (lambda image: cache.prepare(method, image))
     with ThreadPoolExecutor(max(1, workers)) as pool:
-        return list(progress(pool.map(method.prepare, images), desc=desc, total=len(images)))
+        return list(progress(pool.map(fn, images), desc=desc, total=len(images)))
 
 
 def home_vector_matrix(
@@ -78,6 +84,7 @@ def home_vector_matrix(
     workers: int = 1,
     progress: Progress = _no_progress,
     prepared: tuple[list[Any], list[Any]] | None = None,
+    cache: Any = None,
 ) -> HomeVectorMatrix:
     """Home vectors from every current view to every (selected) snapshot.
 
@@ -98,6 +105,8 @@ def home_vector_matrix(
         ``progress(iterable, desc=..., total=...)``, e.g. a tqdm wrapper.
     prepared : (list, list), optional
         Already prepared snapshot and current images (skips the per-image work).
+    cache : PreparedCache, optional
+        On-disk cache of per-image work.
 
     Returns
     -------
@@ -110,9 +119,10 @@ def home_vector_matrix(
 
     t0 = time.perf_counter()
     if prepared is None:
-        cur_prep = prepare_images(method, list(currents.images), workers=workers, progress=progress)
+        cur_prep = prepare_images(method, list(currents.images), workers=workers, progress=progress, cache=cache)
         snap_prep = cur_prep if same else prepare_images(
-            method, list(snapshots.images), workers=workers, progress=progress, desc="per-image work (snapshots)"
+            method, list(snapshots.images), workers=workers, progress=progress, cache=cache,
+            desc="per-image work (snapshots)",
         )
     else:
         snap_prep, cur_prep = prepared

@@ -17,7 +17,7 @@ from omegaconf import DictConfig
 from bionav.evaluation.agent import run_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix
-from bionav.experiments.common import load_configured_database, make_homing
+from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
 
 HOME_VECTOR_SCHEMA = {
     "type": "object",
@@ -63,7 +63,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     method = make_homing(cfg, ctx, db.geometry)
     snapshots = None if exp.get("snapshots") is None else list(exp.snapshots)
     hv = home_vector_matrix(
-        method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress
+        method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
+        cache=prepared_cache(cfg),
     )
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))

@@ -195,3 +195,19 @@ def write_parameter_report(root: Path, *, top: int = 8) -> list[str]:
         plot_per_snapshot(root / "plots" / f"ranking_{db}.png", ranked, db=db, top=top)
         sections.append(text)
     return sections
+
+
+def ranking_sections(root: Path, rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Report hook: the parameter-homing ranking sections when ``rows`` hold ``param_sweep`` runs.
+
+    Parameters
+    ----------
+    root : Path
+        The sweep (or run tree) directory; ranking files are written into it
+        (:func:`write_parameter_report`).
+    rows : sequence of mapping
+        The summary rows of the runs below ``root`` (``experiment`` per run).
+    """
+    if not any(r.get("experiment") == "param_sweep" for r in rows):
+        return []
+    return write_parameter_report(root)
