@@ -60,18 +60,9 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
 
 
 def _yaml_options(group: str) -> list[str]:
-    from importlib.resources import files
+    from bionav.config import config_options
 
-    from bionav import registry
-
-    options = []
-    for _name, package, _dist in registry.config_packages():
-        try:
-            folder = files(package) / group
-            options += [p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml")]
-        except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
-            continue
-    return options
+    return config_options(group)
 
 
 def _has_yaml(group: str, value: str) -> bool:
@@ -117,7 +108,10 @@ def _task(cfg) -> float | None:
             f"in {run_dir / 'error.log'} and the run's log in {run_dir / 'run.mcap'}.",
             EXIT_INTERNAL_ERROR,
         )
-    _print_result(metrics)
+    if multirun:
+        log.info("job %s: %s", hc.job.num, ", ".join(f"{k}={metrics[k]:.4g}" for k in ("aae", "mae", "rr") if isinstance(metrics.get(k), float)) or metrics.get("status"))
+    else:
+        _print_result(metrics)
     return None
 
 

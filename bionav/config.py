@@ -84,6 +84,20 @@ def register_configs() -> dict[str, list[str]]:
     return names
 
 
+def config_options(group: str) -> list[str]:
+    """YAML options of a config group across every ``bionav.configs`` package (sorted)."""
+    from importlib.resources import files
+
+    options: set[str] = set()
+    for _name, package, _dist in registry.config_packages():
+        try:
+            folder = files(package) / group
+            options |= {p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml")}
+        except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
+            continue
+    return sorted(options)
+
+
 def compose(overrides: Sequence[str] = (), *, config_name: str = "config") -> DictConfig:
     """Compose bionav's configuration outside the command line (tests, tools).
 

@@ -8,32 +8,22 @@ from typing import Any
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.db.database import ImageDatabase
-from bionav.errors import UserError
-
-
-def database_config(node: Any):
-    """Validate a ``db`` config node against :class:`bionav.db.config.DatabaseConfig`."""
-    from bionav.db.config import DatabaseConfig
-
-    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
-    try:
-        return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(DatabaseConfig), plain))
-    except Exception as exc:
-        raise UserError(f"bad database settings: {exc}") from None
 
 
 def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageDatabase:
     """The database the config selects (``cfg.db`` unless ``node`` given), preprocessed per ``cfg.preprocess``."""
     from bionav.db.loading import load_database
 
-    db_cfg = database_config(cfg.db if node is None else node)
-    db = load_database(db_cfg, data_dir=Path(str(cfg.data_dir)), cache_dir=Path(str(cfg.cache_dir)))
-    steps = OmegaConf.select(cfg, "preprocess.steps", default=None)
-    if steps:
-        from bionav.db.preprocess import preprocess_database
-
-        db = preprocess_database(db, OmegaConf.to_container(steps, resolve=True))
-    return db
+    preprocess = OmegaConf.select(cfg, "preprocess", default=None)
+    node = cfg.db if node is None else node
+    if isinstance(node, DictConfig):
+        node = OmegaConf.to_container(node, resolve=True)  # resolve ${data_dir} against the whole config
+    return load_database(
+        node,
+        data_dir=Path(str(cfg.data_dir)),
+        cache_dir=Path(str(cfg.cache_dir)),
+        preprocess=preprocess,
+    )
 
 
 def make_homing(cfg: DictConfig, ctx, geometry):
