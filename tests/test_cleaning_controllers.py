@@ -70,7 +70,7 @@ def test_odometry_meander_is_perfect_without_wheel_error_and_drifts_with_it():
     ep = simulate(OdometryController(OdometryConfig()), wheel_error=(0.05, -0.05))
     # the first lane follows the wall; afterwards the unknown error bends the lanes away
     p = ep.true_pose
-    assert np.max(np.abs(p[20:140, 1])) < 0.01
+    assert np.max(np.abs(p[20:140, 1])) < 0.02
     lane1 = [t for t, i in ep.info if i.get("lane_start") == 1][0]
     end1 = [t for t, i in ep.info if i.get("lane_end") == 1][0]
     assert np.max(np.abs(p[lane1:end1, 1] - 0.30)) > 0.1

@@ -60,6 +60,9 @@ class CleaningWorld:
         Geometry of the rendered images (None in oracle mode).
     scene : object
         The rendered scene (None in oracle mode).
+    guide_wall : bool
+        A straight guide wall was added for the first lane's wall following
+        (the world has no wall where the layout fits).
     """
 
     floor: Any
@@ -67,6 +70,7 @@ class CleaningWorld:
     camera_factory: Callable[[int], Callable]
     geometry: Any = None
     scene: Any = None
+    guide_wall: bool = False
 
 
 def plan_from_layout(node: Any) -> LanePlan:
@@ -116,14 +120,15 @@ def rendered_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
     geometry = PanoramaGeometry.square_pixels(
         int(cam.width), int(cam.height), horizon_row=None if cam.horizon_row is None else float(cam.horizon_row))
     floor = floorplan_from_scene(world.scene, max_height=float(ex.robot_height))
-    start = place_plan(world, floor, plan, layout=cfg.layout, robot_radius=float(ex.robot_radius))
+    placement = place_plan(world, floor, plan, layout=cfg.layout, robot_radius=float(ex.robot_radius))
     height = float(cam.height_m)
     noise = float(cam.noise)
 
     def factory(seed: int):
         return render_camera(world.scene, geometry, height=height, noise=noise, seed=seed)
 
-    return CleaningWorld(floor=floor, start=start, camera_factory=factory, geometry=geometry, scene=world.scene)
+    return CleaningWorld(floor=placement.floor, start=placement.start, camera_factory=factory, geometry=geometry,
+                         scene=world.scene, guide_wall=placement.guide_wall)
 
 
 # ---------------------------------------------------------------------------- runs
@@ -327,6 +332,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     metrics["layout"] = str(cfg.layout.name)
     metrics["controller"] = str(cfg.controller.name)
     metrics["vision"] = vision
+    metrics["guide_wall"] = bool(world.guide_wall)
     write_runs_csv(ctx.dir / "cleaning_runs.csv", results)
     plot_trajectories(ctx.plots / "trajectories.png", results, world, plan,
                       title=f"{cfg.controller.name}, {cfg.layout.name}")

@@ -95,6 +95,12 @@ class FloorPlan:
         return d if d <= max_range else float("inf")
 
 
+    def enclosed(self, x: float, y: float, *, n_rays: int = 8, max_range: float = 50.0) -> bool:
+        """True when rays from ``(x, y)`` in ``n_rays`` directions all hit an outline (inside a room)."""
+        return all(np.isfinite(self.raycast(x, y, a, max_range=max_range))
+                   for a in np.linspace(0.0, 2 * np.pi, n_rays, endpoint=False))
+
+
 def _polygon_segments(pts: np.ndarray) -> list:
     n = len(pts)
     return [(pts[i, 0], pts[i, 1], pts[(i + 1) % n, 0], pts[(i + 1) % n, 1]) for i in range(n)]

@@ -69,12 +69,19 @@ class MeanderConfig:
         this are ignored (a corner, an open door).
     turn_tolerance_deg : float
         A turn on the spot ends when the heading is this close to its target.
+    turn_reference : str
+        Heading reference of the lane change. ``"local"``: the current heading
+        estimate, i.e. relative to the previous lane's direction where the lane
+        ends (a hooked lane end tilts the next lane, and the tilt grows from
+        lane to lane). ``"lane_mean"``: relative to the lane's mean direction,
+        the average over the lane of the direction its fixes implied (in the
+        bias-corrected odometry frame).
     """
 
     speed: float = 0.10
     turn_rate: float = 0.5
     track_width: float = 0.30
-    lookahead: float = 0.30
+    lookahead: float = 0.60
     heading_gain: float = 1.5
     max_steer_rate: float = 0.5
     bias_learning: bool = False
@@ -82,6 +89,7 @@ class MeanderConfig:
     bias_window: float = 0.2
     wall_gate_deg: float = 20.0
     turn_tolerance_deg: float = 0.5
+    turn_reference: str = "lane_mean"
 
 
 class MeanderController(Controller):
@@ -101,6 +109,7 @@ class MeanderController(Controller):
         self.odometry = Pose(0.0, 0.0, 0.0)  # odometry corrected by kappa (frame of the run's start)
         self._bias_turn = 0.0  # heading corrections applied in the current window (rad)
         self._bias_dist = 0.0  # distance driven in the current window (m)
+        self._dir_sum = np.zeros(2)  # sum of (cos, sin) of the lane direction in the corrected odometry frame
         self._prev_odo: Pose | None = None
         self._prev_time = 0.0
         self._lane_end_x = 0.0
@@ -193,6 +202,8 @@ class MeanderController(Controller):
                 if fix is not None:
                     self._apply_fix(fix[1], fix[2], getattr(self.config, "fix_gain", 1.0), x=fix[0])
             self.post_fix(obs, info)
+            d = float(self.odometry.theta - self.est.theta)
+            self._dir_sum += (np.cos(d), np.sin(d))
             if self.est.x >= self.plan.lane_length or obs.bumper:
                 info["lane_end"] = self.lane
                 info["lane_end_bumper"] = bool(obs.bumper)
@@ -200,6 +211,12 @@ class MeanderController(Controller):
                     self.phase = "done"
                     return Command(0.0, 0.0, True, info)
                 self._lane_end_x = self.est.x
+                if self.config.turn_reference == "lane_mean" and self.lane > 0:
+                    mean_dir = float(np.arctan2(self._dir_sum[1], self._dir_sum[0]))
+                    heading = float(wrap_angle(self.odometry.theta - mean_dir))
+                    info["lane_heading_correction"] = float(wrap_angle(heading - self.est.theta))
+                    self.est = Pose(self.est.x, self.est.y, heading)
+                self._dir_sum = np.zeros(2)
                 self.phase = "turn1"
             else:
                 return Command(*self._lane_command(dt), False, info)

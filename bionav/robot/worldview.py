@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -82,14 +83,70 @@ def plan_clearance(floor: FloorPlan, plan: LanePlan, start: Pose, *, step: float
     return min((floor.clearance(p[0], p[1]) for p in pts), default=np.inf)
 
 
-def place_plan(world, floor: FloorPlan, plan: LanePlan, *, layout: Any = None, robot_radius: float = 0.17) -> Pose:
-    """World pose of the plan frame (start of the first lane, heading along it).
+def _inside(floor: FloorPlan, plan: LanePlan, start: Pose) -> bool:
+    from bionav.robot.lanes import to_world_frame
+
+    (x0, y0), (x1, y1) = plan.target_rectangle()
+    far = plan.side * (plan.n_lanes - 1) * plan.spacing
+    corners = to_world_frame(np.array([[x0, 0.0, 0], [x1, 0.0, 0], [x0, far, 0], [x1, far, 0]]), start)
+    return all(floor.enclosed(p[0], p[1]) for p in corners)
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the layout lies in the world.
+
+    Attributes
+    ----------
+    start : Pose
+        World pose of the plan frame (start of the first lane, heading along it).
+    floor : FloorPlan
+        The world's floor plan, plus the guide wall if one was added.
+    guide_wall : bool
+        True when no wall of the world runs along the first lane and a straight
+        guide (a low strip the side sensor and the bumper see, not rendered)
+        was added on its right for wall following.
+    """
+
+    start: Pose
+    floor: FloorPlan
+    guide_wall: bool
+
+
+def _wall_along(floor: FloorPlan, plan: LanePlan, start: Pose) -> bool:
+    u = np.array([np.cos(start.theta), np.sin(start.theta)])
+    for f in (0.0, 0.5, 1.0):
+        q = np.array([start.x, start.y]) + f * plan.lane_length * u
+        r = floor.raycast(q[0], q[1], start.theta - np.pi / 2, max_range=plan.wall_offset + 0.05)
+        if abs(r - plan.wall_offset) >= 0.01:
+            return False
+    return True
+
+
+def _with_guide(floor: FloorPlan, plan: LanePlan, start: Pose) -> FloorPlan:
+    u = np.array([np.cos(start.theta), np.sin(start.theta)])
+    right = np.array([u[1], -u[0]])
+    p = np.array([start.x, start.y]) + plan.wall_offset * right
+    a, b = p - 0.5 * u, p + (plan.lane_length + 0.5) * u
+    segs = np.vstack([floor.segments, [[a[0], a[1], b[0], b[1]]]])
+    is_wall = np.r_[floor.is_wall if floor.is_wall is not None else np.zeros(len(floor.segments), bool), True]
+    return FloorPlan(segs, is_wall)
+
+
+def place_plan(world, floor: FloorPlan, plan: LanePlan, *, layout: Any = None,
+               robot_radius: float = 0.17) -> Placement:
+    """Place the layout in the world: the plan frame's pose and the floor plan to simulate with.
 
     With ``layout.start = [x, y]`` and ``layout.start_heading_deg`` given, that
-    pose is used. Otherwise the first lane is placed along a room wall (wall on
-    the robot's right at ``plan.wall_offset``) such that the ideal meander
-    keeps the largest clearance from every obstacle; candidates start every
-    0.1 m along every wall segment long enough, in both directions.
+    pose is used. Otherwise the first lane is placed along a wall (any obstacle
+    outline at least a lane long, on the robot's right at ``plan.wall_offset``
+    along the whole first lane) such that the ideal meander keeps the largest
+    clearance from every obstacle; candidates start every 0.1 m along every
+    such segment, in both directions. If no wall qualifies and the world has a
+    ``free_area``, the layout is centred along the best edge of the free area
+    and a straight guide wall is added there for the first lane's wall
+    following (:class:`Placement`). A given start pose without a wall on the
+    right gets a guide wall as well.
 
     Raises
     ------
@@ -104,10 +161,11 @@ def place_plan(world, floor: FloorPlan, plan: LanePlan, *, layout: Any = None, r
             raise UserError(f"the layout's start pose {list(layout.start)} puts the lanes into an obstacle; "
                             f"choose another layout.start / layout.start_heading_deg, or omit them for automatic "
                             f"placement.")
-        return start
-    walls = floor.segments[floor.is_wall] if floor.is_wall is not None else floor.segments
+        if _wall_along(floor, plan, start):
+            return Placement(start, floor, False)
+        return Placement(start, _with_guide(floor, plan, start), True)
     best, best_clear = None, -np.inf
-    for x0, y0, x1, y1 in walls:
+    for x0, y0, x1, y1 in floor.segments:
         for a, b in (((x0, y0), (x1, y1)), ((x1, y1), (x0, y0))):
             u = np.array(b) - np.array(a)
             length = float(np.hypot(*u))
@@ -119,17 +177,38 @@ def place_plan(world, floor: FloorPlan, plan: LanePlan, *, layout: Any = None, r
             for s in np.arange(0.2, length - plan.lane_length - 0.2 + 1e-9, 0.1):
                 p = np.array(a) + s * u + plan.wall_offset * left
                 start = Pose(float(p[0]), float(p[1]), heading)
-                # the wall must be on the robot's right: the plan must lie on the wall's inner side
-                mid = np.array(a) + (s + plan.lane_length / 2) * u + (plan.wall_offset + 0.3) * left
-                if floor.raycast(mid[0], mid[1], heading - np.pi / 2, max_range=0.4) == np.inf:
+                if not _wall_along(floor, plan, start) or not _inside(floor, plan, start):
                     continue
                 if plan_clearance(floor, plan, start, step=0.2) < robot_radius:
                     continue
                 c = plan_clearance(floor, plan, start, step=0.2, skip_first_lane=True)
                 if c > best_clear + 1e-9:
                     best, best_clear = start, c
-    if best is None or best_clear < robot_radius:
-        raise UserError(f"the {plan.n_lanes} x {plan.lane_length} m layout does not fit along any wall of the world "
-                        f"(best clearance {best_clear:.2f} m < robot radius {robot_radius} m); choose a smaller "
-                        f"layout or give layout.start and layout.start_heading_deg.")
-    return best
+    if best is not None and best_clear >= robot_radius:
+        return Placement(best, floor, False)
+    free = getattr(world, "free_area", None)
+    if free is not None:
+        fx0, fy0, fx1, fy1 = (float(v) for v in free)
+        ring = [(fx0, fy0), (fx1, fy0), (fx1, fy1), (fx0, fy1)]  # counter-clockwise: inside on the left
+        if plan.side < 0:
+            ring = ring[::-1]
+        depth_needed = plan.wall_offset + (plan.n_lanes - 1) * plan.spacing + plan.unit_width / 2
+        for i in range(4):
+            a, b = np.array(ring[i]), np.array(ring[(i + 1) % 4])
+            length = float(np.hypot(*(b - a)))
+            u = (b - a) / length
+            other = np.array(ring[(i + 2) % 4]) - b
+            depth = abs(float(u[0] * other[1] - u[1] * other[0]))
+            if length < plan.lane_length or depth < depth_needed:
+                continue
+            left = plan.side * np.array([-u[1], u[0]])
+            p = a + 0.5 * (length - plan.lane_length) * u + plan.wall_offset * left
+            start = Pose(float(p[0]), float(p[1]), float(np.arctan2(u[1], u[0])))
+            c = plan_clearance(floor, plan, start, step=0.2)
+            if c > best_clear + 1e-9:
+                best, best_clear = start, c
+        if best is not None and best_clear >= robot_radius:
+            return Placement(best, _with_guide(floor, plan, best), True)
+    raise UserError(f"the {plan.n_lanes} x {plan.lane_length} m layout does not fit along any wall of the world "
+                    f"(best clearance {best_clear:.2f} m < robot radius {robot_radius} m); choose a smaller "
+                    f"layout or give layout.start and layout.start_heading_deg.")

@@ -80,6 +80,9 @@ class TriangulationConfig(MeanderConfig):
         Weight of a fix (1 replaces the estimate, smaller values smooth).
     max_innovation : float
         Fixes whose ``h`` differs from the prediction by more are rejected, m.
+    max_rejections : int
+        After this many consecutive innovation rejections the next fix is
+        accepted anyway (the estimate, not the measurement, is probably wrong).
     """
 
     bias_learning: bool = True
@@ -91,6 +94,7 @@ class TriangulationConfig(MeanderConfig):
     orientation: str = "compass"
     fix_gain: float = 0.5
     max_innovation: float = 0.15
+    max_rejections: int = 3
 
 
 @dataclass
@@ -139,6 +143,7 @@ class TriangulationController(MeanderController):
         self._next_capture = 0.0
         self._capture_lane = 0
         self._current = None
+        self._rejections = 0
 
     # ------------------------------------------------------------------ hooks
     def lane_tick(self, obs: Observation, info: dict) -> None:
@@ -260,9 +265,11 @@ class TriangulationController(MeanderController):
             out.update(accepted=False, reason="ill-conditioned bearings")
         elif not tri.consistent:
             out.update(accepted=False, reason="inconsistent triangle")
-        elif abs(tri.y - h_pred) > c.max_innovation:
+        elif abs(tri.y - h_pred) > c.max_innovation and self._rejections < c.max_rejections:
+            self._rejections += 1
             out.update(accepted=False, reason="innovation too large")
         else:
+            self._rejections = 0
             out.update(accepted=True, reason="")
         return out
 
