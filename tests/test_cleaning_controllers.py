@@ -110,3 +110,26 @@ def test_same_seed_same_commands():
     a = simulate(RandomController(RandomConfig()), plan=LanePlan(n_lanes=2, lane_length=1.0), seed=7)
     b = simulate(RandomController(RandomConfig()), plan=LanePlan(n_lanes=2, lane_length=1.0), seed=7)
     np.testing.assert_array_equal(a.command, b.command)
+
+
+def test_blocked_moves_and_escape_from_a_slightly_bad_start():
+    from bionav.robot.floorplan import FloorPlan
+
+    floor = FloorPlan.from_shapes(rooms=[((-1.0, -1.0), (1.0, 1.0))])
+    drive = DriveModel(wheel_error=(0.0, 0.0))
+    # 0.165 m from the wall at x = 1 with radius 0.17: driving on towards the wall is blocked
+    robot = SimulatedRobot(drive, Pose(0.835, 0.0, 0.0), floor=floor, radius=0.17)
+    robot.apply(0.1, 0.1, 0.1)
+    assert robot.bumper and robot.pose.x == 0.835 and robot.odometry.x == 0.0
+    # turning on the spot is always possible, and driving away from the wall too
+    robot.apply(-0.1, 0.1, np.pi / 2 * 0.3 / 0.2)
+    assert not robot.bumper and robot.pose.theta == pytest.approx(np.pi / 2)
+    robot.apply(-0.1, -0.1, 0.1)
+    assert not robot.bumper
+    # virtual walls: a centre 1 cm outside may move back in but not further out
+    lo, hi = (0.0, 0.0), (1.0, 1.0)
+    robot = SimulatedRobot(drive, Pose(-0.01, 0.5, np.pi), confine=(lo, hi, Pose(0, 0, 0)))
+    robot.apply(0.1, 0.1, 0.1)
+    assert robot.bumper
+    robot.apply(-0.1, -0.1, 0.1)
+    assert not robot.bumper and robot.pose.x == pytest.approx(0.0)

@@ -58,6 +58,11 @@ def test_cleaning_run_writes_everything(tmp_path, controllers, controller):
     assert len(rows) == 3
     topics = {t for t, _, _ in read_messages(tmp_path / "run.mcap")}
     assert {"/cleaning/run", "/cleaning/step", "/cleaning/true_pose", "/cleaning/result"} <= topics
+    # the logged runs replay exactly through freshly built controllers
+    from bionav.experiments.cleaning import replay_log
+
+    replayed = replay_log(tmp_path / "run.mcap")
+    assert sorted(replayed) == [0, 1]
     if controller == "triangulation":
         assert metrics["fix_acceptance"] > 0.9
         # with 5 degree bearing noise the triangulated h is off by a few centimetres

@@ -293,8 +293,68 @@ def make_oracle_homing(cfg: DictConfig):
                                                  seed=int(cfg.seed)))
 
 
+def make_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
+    """The :class:`CleaningWorld` that ``cfg.experiment.vision`` asks for."""
+    vision = str(cfg.experiment.vision)
+    if vision not in ("render", "oracle"):
+        raise UserError(f"experiment.vision must be 'render' or 'oracle', got {vision!r}.")
+    return rendered_world(cfg, plan) if vision == "render" else oracle_world(plan)
+
+
+def make_vision_homing(cfg: DictConfig, world: CleaningWorld):
+    """The homing method of a run: ``cfg.homing`` on rendered images, or the oracle."""
+    if str(cfg.experiment.vision) == "oracle":
+        return make_oracle_homing(cfg)
+    from bionav.config import plugin_config
+
+    cls, config = plugin_config("homing", cfg.homing)
+    return cls(config, geometry=world.geometry)
+
+
+def replay_log(path, *, runs: list[int] | None = None) -> dict[int, Any]:
+    """Replay the runs of a cleaning ``run.mcap`` through freshly built controllers.
+
+    The resolved config attached to the log rebuilds the layout, the world
+    (its camera re-creates images that were not logged), the homing method
+    and the controller; :func:`bionav.robot.recording.replay_episode` then
+    checks every command.
+
+    Returns
+    -------
+    dict
+        Run index -> :class:`~bionav.robot.recording.ReplayResult`.
+
+    Raises
+    ------
+    ReplayMismatch
+        At the first difference.
+    """
+    from bionav.config import plugin_config
+    from bionav.logs.reader import read_attachment, read_messages
+    from bionav.robot.recording import load_logged_runs, replay_episode
+
+    raw = read_attachment(path, "config.yaml")
+    if raw is None:
+        raise UserError(f"{path} has no attached config.yaml; it was not written by `python -m bionav`.")
+    cfg = OmegaConf.create(raw.decode())
+    if str(cfg.experiment.name) != "cleaning":
+        raise UserError(f"{path} is a log of experiment={cfg.experiment.name}, not of experiment=cleaning.")
+    plan = plan_from_layout(cfg.layout)
+    logged = load_logged_runs(read_messages(path))
+    cls, config = plugin_config("controller", cfg.controller)
+    world = make_world(cfg, plan) if cls.uses_camera else None
+    homing = make_vision_homing(cfg, world) if cls.uses_camera else None
+    out = {}
+    for k in sorted(logged) if runs is None else runs:
+        if k not in logged:
+            raise UserError(f"{path} has no run {k}; it holds runs {sorted(logged)}.")
+        camera = world.camera_factory(int(logged[k].meta["camera_seed"])) if world is not None else None
+        out[k] = replay_episode(logged[k], cls(config), plan, homing=homing, camera=camera)
+    return out
+
+
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
-    from bionav.experiments.cleaning_plots import plot_overlap_maps, plot_trajectories
+    from bionav.experiments.cleaning_plots import plot_layout, plot_overlap_maps, plot_trajectories
     from bionav.experiments.common import make_homing
     from bionav.robot.coverage import Raster, coverage_fractions, sweep_counts
     from bionav.robot.lanes import ideal_meander
@@ -307,9 +367,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                         "controller=odometry or controller=random.")
     plan = plan_from_layout(cfg.layout)
     vision = str(ex.vision)
-    if vision not in ("render", "oracle"):
-        raise UserError(f"experiment.vision must be 'render' or 'oracle', got {vision!r}.")
-    world = rendered_world(cfg, plan) if vision == "render" else oracle_world(plan)
+    world = make_world(cfg, plan)
 
     from bionav.config import plugin_config
 
@@ -337,4 +395,5 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     plot_trajectories(ctx.plots / "trajectories.png", results, world, plan,
                       title=f"{cfg.controller.name}, {cfg.layout.name}")
     plot_overlap_maps(ctx.plots / "overlap_map.png", ctx.plots / "overlap_maps_all.png", results, raster, plan)
+    plot_layout(ctx.plots / "layout.png", results, world, plan)
     return metrics

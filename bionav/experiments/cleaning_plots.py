@@ -102,3 +102,32 @@ def plot_overlap_maps(path_one: Path, path_all: Path, results, raster, plan) -> 
     fig.tight_layout()
     fig.savefig(path_all, dpi=100)
     plt.close(fig)
+
+
+def plot_layout(path: Path, results, world, plan) -> None:
+    """The layout in the world (fig. 7.2): obstacle outlines, target area, ideal meander, the median run."""
+    from bionav.robot.lanes import ideal_meander, to_world_frame
+
+    plt = _plt()
+    segs = world.floor.segments
+    fig, ax = plt.subplots(figsize=(7, 8))
+    walls = world.floor.is_wall if world.floor.is_wall is not None else np.zeros(len(segs), bool)
+    for (x0, y0, x1, y1), wall in zip(segs, walls):
+        ax.plot([x0, x1], [y0, y1], color="0.1" if wall else "0.45", lw=1.6 if wall else 1.0)
+    (x0, y0), (x1, y1) = plan.target_rectangle()
+    rect = to_world_frame(np.array([[x0, y0, 0], [x1, y0, 0], [x1, y1, 0], [x0, y1, 0], [x0, y0, 0]]), world.start)
+    ax.fill(rect[:, 0], rect[:, 1], color="0.9", zorder=0, label="target area")
+    ideal = to_world_frame(ideal_meander(plan), world.start)
+    ax.plot(ideal[:, 0], ideal[:, 1], color="0.6", lw=2.5, label="ideal meander")
+    cov = np.array([r.fractions["coverage"] for r in results])
+    r = results[int(np.argsort(cov)[len(cov) // 2])]
+    ax.plot(r.episode.true_pose[:, 0], r.episode.true_pose[:, 1], color="C0", lw=0.8, label=f"run {r.run}")
+    ax.plot([world.start.x], [world.start.y], "k>", ms=7, label="start")
+    ax.set_aspect("equal")
+    ax.set_xlabel("world x (m)")
+    ax.set_ylabel("world y (m)")
+    ax.set_title("Layout in the world" + (" (guide wall for the first lane)" if world.guide_wall else ""))
+    ax.legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

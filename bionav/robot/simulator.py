@@ -112,15 +112,24 @@ class SimulatedRobot:
         self.captures: list[tuple[np.ndarray, Pose, int]] = []
         self._n_captures = 0
 
-    def _free(self, pose: Pose) -> bool:
-        if self.floor is not None and self.floor.clearance(pose.x, pose.y) < self.radius:
-            return False
+    def _violation(self, pose: Pose) -> tuple[float, float]:
+        """How far a pose intrudes into obstacles and beyond the virtual walls (m, 0 when free)."""
+        inside = 0.0
+        if self.floor is not None:
+            inside = max(0.0, self.radius - self.floor.clearance(pose.x, pose.y))
+        outside = 0.0
         if self.confine is not None:
             lo, hi, frame = self.confine
             p = pose.relative_to(frame)
-            if not (lo[0] <= p.x <= hi[0] and lo[1] <= p.y <= hi[1]):
-                return False
-        return True
+            outside = max(lo[0] - p.x, p.x - hi[0], lo[1] - p.y, p.y - hi[1], 0.0)
+        return inside, outside
+
+    def _free(self, new: Pose) -> bool:
+        # a move is blocked when it intrudes (further) into an obstacle or beyond a virtual wall;
+        # a robot that starts slightly inside may still move out
+        now = self._violation(self.pose)
+        after = self._violation(new)
+        return all(a <= 0.0 or a < n - 1e-12 for a, n in zip(after, now))
 
     def observe(self, time: float) -> Observation:
         """The observation a controller gets now (camera grabs at the current true pose)."""
