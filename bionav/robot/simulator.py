@@ -129,7 +129,7 @@ class SimulatedRobot:
         # a robot that starts slightly inside may still move out
         now = self._violation(self.pose)
         after = self._violation(new)
-        return all(a <= 0.0 or a < n - 1e-12 for a, n in zip(after, now))
+        return all(a <= 0.0 or a <= n + 1e-12 for a, n in zip(after, now))
 
     def observe(self, time: float) -> Observation:
         """The observation a controller gets now (camera grabs at the current true pose)."""
