@@ -111,7 +111,6 @@ class MeanderController(Controller):
         self._bias_dist = 0.0  # distance driven in the current window (m)
         self._dir_sum = np.zeros(2)  # sum of (cos, sin) of the lane direction in the corrected odometry frame
         self._prev_odo: Pose | None = None
-        self._prev_time = 0.0
         self._lane_end_x = 0.0
 
     def lane_side(self, lane: int) -> int:
@@ -163,7 +162,7 @@ class MeanderController(Controller):
     def _wheels(self, v: float, omega: float) -> tuple[float, float]:
         return wheel_speeds(v, omega, track_width=self.config.track_width)
 
-    def _lane_command(self, dt: float) -> tuple[float, float]:
+    def _lane_command(self) -> tuple[float, float]:
         c = self.config
         desired = np.arctan2(-self.est.y, c.lookahead)
         err = float(wrap_angle(desired - self.est.theta))
@@ -180,7 +179,7 @@ class MeanderController(Controller):
 
     def step(self, obs: Observation) -> Command:
         if self._prev_odo is None:
-            self._prev_odo, self._prev_time = obs.odometry, obs.time
+            self._prev_odo = obs.odometry
         delta = obs.odometry.relative_to(self._prev_odo)
         if self.kappa != 0.0:
             delta = Pose(delta.x, delta.y, delta.theta + self.kappa * delta.x)
@@ -188,8 +187,7 @@ class MeanderController(Controller):
         self.odometry = self.odometry.compose(delta)
         if self.phase == "lane":
             self._bias_dist += abs(delta.x)
-        dt = obs.time - self._prev_time
-        self._prev_odo, self._prev_time = obs.odometry, obs.time
+        self._prev_odo = obs.odometry
         info: dict = {}
         side = self.lane_side(self.lane)
 
@@ -219,7 +217,7 @@ class MeanderController(Controller):
                 self._dir_sum = np.zeros(2)
                 self.phase = "turn1"
             else:
-                return Command(*self._lane_command(dt), False, info)
+                return Command(*self._lane_command(), False, info)
 
         if self.phase == "turn1":
             cmd = self._turn_command(side * np.pi / 2)
@@ -246,6 +244,6 @@ class MeanderController(Controller):
             self.lane += 1
             self.phase = "lane"
             info["lane_start"] = self.lane
-            return Command(*self._lane_command(dt), False, info)
+            return Command(*self._lane_command(), False, info)
 
         return Command(0.0, 0.0, True, info)
