@@ -78,7 +78,7 @@ def plot_evector_field(path: Path, pans, tilts, angle, degree, model_angle, mode
     radius the absolute tilt in degrees; each bar is turned by the e-vector
     angle (sensor frame, relative to the pan direction) and scaled by the degree.
     """
-    plt, fig, axes = _figure(1, 2, figsize=(11, 5.5))
+    plt, fig, axes = _figure(1, 2, figsize=(11, 6.2))
     theta = np.asarray(pans) + np.where(np.asarray(tilts) < 0, np.pi, 0.0)
     radius = np.degrees(np.abs(tilts))
     x, y = radius * np.cos(theta), radius * np.sin(theta)
@@ -95,7 +95,7 @@ def plot_evector_field(path: Path, pans, tilts, angle, degree, model_angle, mode
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
         ax.set_aspect("equal")
-        ax.set_title(f"e-vectors, {title} (bar length ~ degree)")
+        ax.set_title(f"e-vectors, {title} (bar length ~ degree)", fontsize=10)
         ax.set_xlabel("tilt (deg) along pan 0")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
