@@ -507,6 +507,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                 devices[role] = None
                 continue
             plugin = ctx.plugin("sensor", node)
+            if role == "reference":
+                plugin.config_prefix = "experiment.reference"
             if getattr(plugin, "simulated", False):
                 plugin.attach_simulation(scene, streams[role])
             plugin.open()
