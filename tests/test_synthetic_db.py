@@ -196,3 +196,45 @@ def test_apartment_free_area_is_free():
         for y in np.linspace(y0, y1, 21):
             for z in (0.05, 0.3, 0.6):
                 assert not _inside_any_solid(w.scene, (x, y, z))
+
+
+def test_campus_renders_five_bands_with_caller_albedos_and_sky():
+    from bionav.geometry import PanoramaGeometry
+    from bionav.world.sky import BAND_ALBEDO
+    from bionav.world.worlds.outdoor import build_campus
+
+    bands = ("UV", "B", "G", "R", "IR")
+    albedos = {k: [BAND_ALBEDO[b][k] for b in bands] for k in BAND_ALBEDO["grey"]}
+    albedos["foliage"] = [0.0, 0.0, 0.0, 0.0, 0.9]  # leaves visible in IR only
+    seen = []
+
+    def sky(d):
+        seen.append(len(d))
+        return np.tile([0.5, 0.4, 0.3, 0.2, 0.1], (len(d), 1))
+
+    w = build_campus(0, channels=bands, albedos=albedos, sky=sky)
+    geo = get_spec("sim_uni").geometry(96, 14)
+    img = render_panorama(w.scene, position=w.cell_position(4, 8), geometry=geo, clip=False)
+    assert img.shape == (14, 96, 5) and seen and sum(seen) > 0
+    depth, kind, idx = render_depth(w.scene, position=w.cell_position(4, 8), geometry=geo)
+    sky_px = np.isinf(depth)
+    np.testing.assert_allclose(img[sky_px] / w.scene.exposure, np.tile([0.5, 0.4, 0.3, 0.2, 0.1], (sky_px.sum(), 1)),
+                               rtol=1e-6)
+    # tree crowns (ellipsoids with the foliage albedo) are black in UV..R and bright in IR
+    crown = kind == 2
+    if crown.any():
+        assert np.all(img[crown][:, :4] < 0.2 * img[crown][:, 4].max() + 1e-6)
+    with pytest.raises(ValueError):
+        build_campus(0, channels=bands, albedos={"concrete": [0.1] * 5})
+
+
+def test_concurrent_workers_share_the_cache(tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+
+    kw = dict(image_size=(24, 4), cache_dir=tmp_path)
+    with ThreadPoolExecutor(2) as pool:
+        a, b = pool.map(lambda _: synthetic_database("sim_winlit", **kw), range(2))
+    np.testing.assert_array_equal(a.images, b.images)
+    assert len(list(tmp_path.glob("*.npz"))) == 1
+    assert not list(tmp_path.glob("*.tmp"))
+    assert synthetic_database("sim_winlit", **kw).meta["from_cache"]

@@ -12,7 +12,7 @@ from bionav.world.kernels import depth_kernel, render_kernel
 from bionav.world.scene import CompiledScene, Scene
 
 #: Bump whenever a change to the renderer or a world builder changes pixels (invalidates caches).
-RENDERER_VERSION = 1
+RENDERER_VERSION = 2
 
 
 def _run_threads(threads: int | None, kernel, *args) -> None:
