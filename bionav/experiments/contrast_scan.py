@@ -167,7 +167,6 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     """Contrast images, separation, stability series, plots and metrics of a set of scans."""
     import csv
 
-    from bionav.experiments import spectral_plots as sp
     from bionav.spectral.bands import CHANNELS, dual_contrasts
     from bionav.spectral.scan import separation_images, stability_series
     from bionav.spectral.stability import MEASURES
@@ -186,8 +185,36 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
         for r in rows:
             w.writerow({**r, "time": times[r["scan"]].isoformat()})
     hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
+    if bool(_get(exp, "plots", True)):
+        _plots(scans, times, hours, rows, disc, names, ctx.plots)
+    metrics: dict = {"n_scans": int(len(scans)), "n_readings": int(scans.shape[0] * scans.shape[1] * scans.shape[2])}
+    if len(scans) > 1:
+        for sep, key in ((False, "logMSEvar"), (True, "logMSEvar_separated")):
+            per = {n: float(np.mean([r["logMSEvar"] for r in rows if r["feature"] == n and r["separated"] == sep]))
+                   for n in names}
+            metrics[key] = per
+            metrics[f"{key}_single_mean"] = _finite_mean([per[n] for n in CHANNELS])
+            metrics[f"{key}_dual_mean"] = _finite_mean([per[n] for n in dual_contrasts()])
+    if truths is not None:
+        acc = {}
+        for n in names:
+            acc[n] = float(np.mean([np.mean(separation_images(s[..., :5], {n: disc[n]})[n] == tr)
+                                    for s, tr in zip(scans, truths)]))
+        metrics["sky_accuracy"] = acc
+        metrics["best_sky_accuracy_feature"] = max(acc, key=acc.get)
+    return metrics
+
+
+def _finite_mean(values) -> float:
+    finite = [v for v in values if np.isfinite(v)]
+    return float(np.mean(finite)) if finite else float("nan")
+
+
+def _plots(scans, times, hours, rows, disc, names, plots):
+    from bionav.experiments import spectral_plots as sp
+    from bionav.spectral.scan import separation_images
+
     labels = [t.strftime("%H:%M") for t in times]
-    plots = ctx.plots
     (plots / "scans").mkdir(exist_ok=True)
     for k in range(len(scans)):
         sp.plot_channel_images(scans[k], plots / "scans" / f"channels_{k:02d}.png", title=f"scan {k}: {labels[k]}")
@@ -199,23 +226,5 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
         sp.plot_separated_scatter(scans[k], seps["UV-IR"], disc["UV-IR"], plots / f"separated_uv_ir_{tag}.png",
                                   title=f"UV-IR pixels classified, {labels[k]}")
     if len(scans) > 1:
-        for m in MEASURES:
-            sp.plot_stability(rows, hours[1:], m, plots / f"stability_{m}.png", separated=False)
-            sp.plot_stability(rows, hours[1:], m, plots / f"stability_{m}_separated.png", separated=True)
-    metrics: dict = {"n_scans": int(len(scans)), "n_readings": int(scans.shape[0] * scans.shape[1] * scans.shape[2])}
-    if len(scans) > 1:
-        for sep, key in ((False, "logMSEvar"), (True, "logMSEvar_separated")):
-            per = {n: float(np.mean([r["logMSEvar"] for r in rows if r["feature"] == n and r["separated"] == sep]))
-                   for n in names}
-            metrics[key] = per
-            fin = lambda vals: float(np.mean([v for v in vals if np.isfinite(v)])) if any(np.isfinite(v) for v in vals) else float("nan")  # noqa: E731
-            metrics[f"{key}_single_mean"] = fin([per[n] for n in CHANNELS])
-            metrics[f"{key}_dual_mean"] = fin([per[n] for n in dual_contrasts()])
-    if truths is not None:
-        acc = {}
-        for n in names:
-            acc[n] = float(np.mean([np.mean(separation_images(s[..., :5], {n: disc[n]})[n] == tr)
-                                    for s, tr in zip(scans, truths)]))
-        metrics["sky_accuracy"] = acc
-        metrics["best_sky_accuracy_feature"] = max(acc, key=acc.get)
-    return metrics
+        sp.plot_stability(rows, hours[1:], plots / "stability.png", separated=False)
+        sp.plot_stability(rows, hours[1:], plots / "stability_separated.png", separated=True)

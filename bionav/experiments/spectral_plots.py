@@ -190,22 +190,32 @@ def plot_separated_scatter(counts, is_sky, lda, path, *, title="", channels=(0, 
     return Path(path)
 
 
-def plot_stability(rows, hours, measure, path, *, separated: bool) -> Path:
-    """One stability measure over the day for every channel and dual contrast (figs. 6.10-6.15, D.3-D.6)."""
+def plot_stability(rows, hours, path, *, separated: bool, measures=None) -> Path:
+    """The stability measures over the day for every channel and dual contrast (figs. 6.10-6.15, D.3-D.6).
+
+    One row of panels per measure: single channels left, dual-channel contrasts right.
+    """
     from bionav.spectral.bands import CHANNELS, dual_contrasts
+    from bionav.spectral.stability import MEASURES
 
     plt = _plt()
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+    measures = list(measures or MEASURES)
+    fig, axes = plt.subplots(len(measures), 2, figsize=(11, 2.6 * len(measures)), squeeze=False)
     groups = (("single channels", list(CHANNELS)), ("dual-channel contrasts", list(dual_contrasts())))
-    for ax, (label, names) in zip(axes, groups):
-        for n in names:
-            vals = [r[measure] for r in rows if r["feature"] == n and r["separated"] == separated]
-            ax.plot(hours[: len(vals)], vals, marker="o", ms=3, label=n, ls="-" if n.startswith("UV") or "-" not in n else "--")
-        ax.set_title(label)
+    for row, measure in enumerate(measures):
+        for ax, (label, names) in zip(axes[row], groups):
+            for n in names:
+                vals = [r[measure] for r in rows if r["feature"] == n and r["separated"] == separated]
+                ls = "-" if n.startswith("UV") or "-" not in n else "--"
+                ax.plot(hours[: len(vals)], vals, marker="o", ms=3, label=n, ls=ls)
+            ax.set_ylabel(measure)
+            if row == 0:
+                ax.set_title(label + (" (after sky/object separation)" if separated else ""))
+                ax.legend(fontsize=6, ncol=2)
+        axes[row, 1].sharey(axes[row, 0])
+    for ax in axes[-1]:
         ax.set_xlabel("hours after the first scan")
-        ax.legend(fontsize=7, ncol=2)
-    axes[0].set_ylabel(measure + (" (separated)" if separated else ""))
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    fig.savefig(path, dpi=90)
     plt.close(fig)
     return Path(path)

@@ -26,6 +26,7 @@ from typing import Callable
 import numpy as np
 
 from bionav.errors import DeviceError
+from bionav.plugins.sensors.base import SensorPlugin
 
 #: MCAP topic of raw readings (the convention of ``sensor=replay``: one message per ``read()``).
 RAW_TOPIC = "/sensor/raw"
@@ -58,7 +59,7 @@ class BadReply(DeviceError):
     """A garbage, short, incomplete or missing reply (worth retrying the command)."""
 
 
-class _Spectral5Base:
+class _Spectral5Base(SensorPlugin):
     """What both spectral5 plugins share: schema of raw readings, life cycle, ``read()``."""
 
     config_group = "sensor"
@@ -66,22 +67,12 @@ class _Spectral5Base:
     schema_name = RAW_SCHEMA_NAME
     schema = RAW_SCHEMA
 
-    def attach_simulation(self, scene, rng) -> None:
-        """Receive the simulated world (only the simulator uses it)."""
-
     def measure(self, n: int | None = None) -> np.ndarray:  # pragma: no cover - overridden
         raise NotImplementedError
 
     def read(self) -> dict:
         """One raw reading: the reply to ``M<readings_per_point>`` as ``{"counts": [[uv, b, g, r, ir, ref], ...]}``."""
         return reading_message(self.measure())
-
-    def __enter__(self):
-        self.open()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
 
 class Spectral5Serial(_Spectral5Base):
