@@ -416,3 +416,65 @@ def backyard_scene(sky: SkyState, *, seed: int = 0) -> OutdoorScene:
     patches = [GroundPatch(-0.6, 0.6, -10.0, 6.4, "concrete"), GroundPatch(1.5, 5.0, -3.0, -1.0, "soil")]
     return OutdoorScene(sky=sky, boxes=boxes, ellipsoids=ellipsoids, cylinders=cylinders, patches=patches,
                         tree_line=TreeLine(seed=seed), ground="grass", pan_zero_azimuth=np.pi / 4, seed=seed)
+
+
+def garden_scene(sky: SkyState, *, seed: int = 0, grid_extent: float = 4.0) -> OutdoorScene:
+    """An outdoor garden around a free square ``[0, grid_extent]^2`` (metres) for homing on a grid.
+
+    Shrubs at 3-9 m, trees at 9-30 m, a summer house, a garage, a hedge, a shed
+    and a distant tree line, on a lawn with a paved path; nothing stands inside
+    the square (plus a 1.5 m margin). The sensor (camera) is 0.8 m above the ground.
+    """
+    r = np.random.default_rng([seed, 17])
+    c = grid_extent / 2
+
+    def around(dmin, dmax):
+        while True:
+            az = r.uniform(0, 2 * np.pi)
+            dist = r.uniform(dmin, dmax)
+            x, y = c + dist * np.cos(az), c + dist * np.sin(az)
+            if not (-1.5 < x < grid_extent + 1.5 and -1.5 < y < grid_extent + 1.5):
+                return x, y
+
+    ellipsoids, cylinders = [], []
+    for _ in range(10):
+        x, y = around(3.5, 9.0)
+        rad = r.uniform(0.5, 1.1)
+        ellipsoids.append(Ellipsoid((x, y, rad * r.uniform(0.6, 1.0)), (rad, rad * r.uniform(0.8, 1.2),
+                                                                          rad * r.uniform(0.8, 1.5)), "shrub"))
+    for _ in range(9):
+        x, y = around(9.0, 30.0)
+        h = r.uniform(5.0, 13.0)
+        rad = r.uniform(1.8, 3.8)
+        cylinders.append(Cylinder((x, y), 0.22, 0.0, h - rad, "dead_wood"))
+        ellipsoids.append(Ellipsoid((x, y, h - 0.3 * rad), (rad, rad, rad * 1.25),
+                                    "tree" if r.random() < 0.7 else "conifer"))
+    boxes = [
+        Box((c + 1.0, c + 9.5), (4.0, 3.0), 0.0, 2.4, "wood_painted", "roof_tile", yaw=0.15),   # summer house (N)
+        Box((c + 1.0, c + 9.5), (4.4, 3.4), 2.4, 2.8, "roof_tile", "roof_tile", yaw=0.15),
+        Box((c + 11.0, c - 3.0), (6.0, 4.0), 0.0, 3.0, "brick", "roof_tile", yaw=0.5),         # garage (E)
+        Box((c - 8.5, c + 1.0), (0.9, 12.0), 0.0, 1.9, "shrub", "shrub", yaw=-0.1),           # hedge (W)
+        Box((c - 3.0, c - 8.0), (2.5, 2.0), 0.0, 2.1, "paint_green", "roof_tile", yaw=0.3),    # shed (S)
+    ]
+    patches = [GroundPatch(c - 0.5, c + 0.5, c - 20.0, c + 8.0, "concrete"),
+               GroundPatch(c + 3.0, c + 6.0, c - 6.0, c - 4.0, "soil")]
+    return OutdoorScene(sky=sky, boxes=boxes, ellipsoids=ellipsoids, cylinders=cylinders, patches=patches,
+                        tree_line=TreeLine(radius=120.0, seed=seed), ground="grass", sensor_height=0.8,
+                        position=(c, c), pan_zero_azimuth=0.0, seed=seed)
+
+
+def render_spectral_panorama(scene: OutdoorScene, geometry, *, position, heading: float = 0.0):
+    """Band radiance of a canonical panorama seen from ``position`` (see :mod:`bionav.geometry`).
+
+    Column ``j`` looks at world azimuth ``heading + 2 pi j / W`` (radians CCW
+    from east), row ``r`` at elevation ``(horizon_row - r) * rad_per_row``.
+
+    Returns
+    -------
+    radiance : ndarray, shape (H, W, 5)
+    is_sky : ndarray of bool, shape (H, W)
+    """
+    az = heading + geometry.column_azimuths()
+    el = geometry.row_elevations()
+    ee, aa = np.meshgrid(el, az, indexing="ij")
+    return scene.render(direction(ee, aa), position=position)
