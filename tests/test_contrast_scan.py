@@ -164,3 +164,31 @@ def test_recorded_scan_replays_to_identical_metrics(tmp_path):
     assert m1 == m2 and "sky_accuracy" in m2
     np.testing.assert_array_equal(np.load(tmp_path / "live" / "scans.npz")["counts"],
                                   np.load(tmp_path / "replay" / "scans.npz")["counts"])
+
+
+def test_scan_with_the_simulated_ptu46_quantisation(scene):
+    """pantilt=sim quantises poses to 185.1428 arc-seconds; prefetched columns still serve the reads."""
+    from bionav.plugins.sensors.pantilt_sim import PanTiltSim, PanTiltSimConfig
+
+    grid = ScanGrid.from_steps(n_pan=4, pan_step=np.deg2rad(2.0), n_tilt=3, tilt_step=np.deg2rad(3.0),
+                               tilt_start=np.deg2rad(-3.0))
+    sensor = Spectral5Sim(Spectral5Sim.Config(noise_counts=0.0))
+    ptu = PanTiltSim(PanTiltSimConfig())
+    for dev in (sensor, ptu):
+        dev.attach_simulation(scene, np.random.default_rng(0))
+    moves = []
+    direct = run_scan(sensor, ptu, grid, on_move=moves.append)
+    res = np.deg2rad(185.1428 / 3600)
+    assert all(abs(m["pan"] / res - round(m["pan"] / res)) < 1e-9 for m in moves)
+    from bionav.experiments.contrast_scan import _reached
+
+    calls = []
+    original = scene.render
+    scene.render = lambda *a, **k: (calls.append(1), original(*a, **k))[1]
+    try:
+        prefetched = run_scan(sensor, ptu, grid, before_column=lambda j: scene.prefetch(
+            *_reached(ptu, np.full(3, grid.pans[j]), grid.tilts)))
+    finally:
+        del scene.render
+    np.testing.assert_array_equal(prefetched, direct)
+    assert len(calls) == 4  # one render per column: every read was served from the prefetch

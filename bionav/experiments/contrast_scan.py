@@ -146,7 +146,7 @@ def run(cfg, ctx) -> dict:
             def before_column(j, k=k, t=t):
                 if scene is not None:
                     scene.sky = sky_at(k, t + _dt.timedelta(seconds=scan_s * j / grid.shape[1]))
-                    scene.prefetch(np.full(grid.shape[0], grid.pans[j]), grid.tilts)
+                    scene.prefetch(*_reached(pantilt, np.full(grid.shape[0], grid.pans[j]), grid.tilts))
 
             scans.append(run_scan(sensor, pantilt, grid, before_column=before_column, on_move=record_move,
                                   on_reading=record_reading, progress=ctx.progress))
@@ -203,6 +203,15 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
         metrics["sky_accuracy"] = acc
         metrics["best_sky_accuracy_feature"] = max(acc, key=acc.get)
     return metrics
+
+
+def _reached(pantilt, pans, tilts):
+    """The poses a pan-tilt unit reaches for commanded ones (its quantisation, if it has one)."""
+    try:
+        res_pan, res_tilt = pantilt.resolution()
+    except (AttributeError, NotImplementedError, UserError):
+        return pans, tilts
+    return np.round(pans / res_pan) * res_pan, np.round(tilts / res_tilt) * res_tilt
 
 
 def _finite_mean(values) -> float:

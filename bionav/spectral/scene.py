@@ -356,10 +356,10 @@ class OutdoorScene:
     def prefetch(self, pans, tilts, *, aperture: float = np.deg2rad(1.0)) -> None:
         """Render the sensor's view for many poses at once under the current sky (a speed-up only).
 
-        Later :meth:`band_radiance` calls for a pose within 0.002 rad (0.11
-        degrees, more than a pan-tilt unit's quantisation) of a prefetched one,
-        under the same sky, return the prefetched value instead of casting rays
-        again.
+        Later :meth:`band_radiance` calls for a prefetched pose (within 1e-7
+        rad) under the same sky return the prefetched value instead of casting
+        the same rays again; other poses are rendered as usual. Prefetch the
+        poses a pan-tilt unit will actually reach (after its quantisation).
         """
         pans = np.asarray(pans, dtype=float).ravel()
         tilts = np.asarray(tilts, dtype=float).ravel()
@@ -378,7 +378,7 @@ class OutdoorScene:
         if pf is not None and pf[0] == self.sky and pf[1] == aperture:
             dist = np.hypot(np.abs(pf[2] - pan) * np.cos(tilt), np.abs(pf[3] - tilt))
             k = int(np.argmin(dist))
-            if dist[k] < 0.002:
+            if dist[k] < 1e-7:
                 return pf[4][k].copy()
         rad, _ = self.render(self._bundle(pan, tilt, aperture))
         return rad.reshape(9, 5).mean(axis=0)
