@@ -192,3 +192,44 @@ def test_scan_with_the_simulated_ptu46_quantisation(scene):
         del scene.render
     np.testing.assert_array_equal(prefetched, direct)
     assert len(calls) == 4  # one render per column: every read was served from the prefetch
+
+
+def test_contrast_scan_over_the_serial_drivers_and_fakes(tmp_path, scene):
+    """experiment=contrast_scan with sensor=spectral5_serial and pantilt=ptu46 against fakes on ptys."""
+    from bionav.experiments import contrast_scan
+    from bionav.plugins.sensors.fakes.ptu46 import FakePTU46
+    from bionav.plugins.sensors.ptu46 import PTU46, PTU46Config
+
+    sim = Spectral5Sim(Spectral5Sim.Config(noise_counts=0.0))
+    sim.attach_simulation(scene, None)
+    ptu_fake = FakePTU46(scene.set_pose)
+    ptu_fake.start()
+    board = FakeSpectral5(source=sim.measure)
+    try:
+        cfg = _small_scan_cfg()
+        cfg.experiment.n_pan, cfg.experiment.n_tilt = 4, 3
+        cfg.experiment.times = cfg.experiment.times[:1]
+        cfg.experiment.cloud_cover, cfg.experiment.cloud_optical_depth = 0.8, 30.0
+        cfg.sensor = {"name": "spectral5_serial", "port": board.port}
+        cfg.pantilt = {"name": "ptu46", "port": ptu_fake.port}
+
+        class Ctx(FakeContext):
+            def plugin(self, kind, node, **kw):
+                if node.name == "ptu46":
+                    return PTU46(PTU46Config(port=node.port, settle_s=0.02))
+                return Spectral5Serial(Spectral5Serial.Config(port=node.port, timeout_s=1.0))
+
+        ctx = Ctx(tmp_path)
+        m = contrast_scan.run(cfg, ctx)
+    finally:
+        board.close()
+        ptu_fake.stop()
+    assert m["n_scans"] == 1 and m["n_readings"] == 12 and "sky_accuracy" not in m
+    assert board.commands.count(b"M1") == 12
+    counts = np.load(tmp_path / "scans.npz")["counts"][0]
+    # the pixels are what the simulated sensor sees at the PTU's reached poses
+    states = [msg for topic, msg, _ in ctx.log.messages if topic == "/pantilt/state"]
+    model = LogSensorModel(noise_counts=0.0)
+    last = states[2]  # first column, highest tilt -> row 0
+    want = np.clip(np.rint(model.ideal_counts(scene.band_radiance(last["pan"], last["tilt"]))), 0, 4095)
+    np.testing.assert_array_equal(counts[0, 0, :5], want)

@@ -46,7 +46,7 @@ _TRUTH_SCHEMA = {
 
 
 def _per_scan(value, k, n, what):
-    v = list(value) if isinstance(value, (list, tuple)) or hasattr(value, "__len__") and not isinstance(value, str) else [value]
+    v = [value] if isinstance(value, (int, float, str)) else list(value)
     if len(v) == 1:
         return float(v[0])
     if len(v) != n:
@@ -97,7 +97,7 @@ def run(cfg, ctx) -> dict:
                         "sensor=spectral5_serial sensor.port=... (hardware) or sensor=replay sensor.path=run.mcap.")
     sensor = ctx.plugin("sensor", sensor_node)
     pantilt_node = _get(cfg, "pantilt")
-    pantilt = ctx.plugin("pantilt", pantilt_node) if pantilt_node else DirectPanTilt()
+    pantilt = ctx.plugin("sensor", pantilt_node) if pantilt_node else DirectPanTilt()
     simulated = bool(getattr(sensor, "simulated", False) or getattr(pantilt, "simulated", False))
     if not pantilt_node and not simulated and not hasattr(sensor, "recorded"):
         raise UserError("A real sensor needs a real pan-tilt unit for experiment=contrast_scan: add pantilt=ptu46 "
