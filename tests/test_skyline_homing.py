@@ -71,3 +71,21 @@ def test_skyline_homing_tiny(tmp_path):
     assert sum(t == "/skyline_homing/cell" for t, _, _ in ctx.log.messages) == 12
     data = np.load(tmp_path / "panoramas.npz")
     assert data["counts"].shape == (2, 9, 8, 48, 5) and data["sky"].any()
+
+
+def test_campus_world_in_five_bands():
+    """The world renderer's outdoor campus with bionav.spectral albedos and sky (when the campus exists)."""
+    pytest.importorskip("bionav.world.worlds.outdoor")
+    from bionav.experiments.skyline_homing import campus_world, render_campus_counts
+    from bionav.geometry import PanoramaGeometry
+    from bionav.spectral.sensor_model import LogSensorModel
+    from bionav.spectral.sky import CloudField, SkyState
+
+    sky = SkyState.from_time("2009-06-17T16:00:00+02:00", clouds=CloudField(cover=0.3, optical_depth=20, seed=1))
+    world = campus_world(sky, seed=0)
+    g = PanoramaGeometry(60, 10, 7.5, 2 * np.pi / 60)
+    counts, is_sky = render_campus_counts(world, g, np.array([[2, 3]]), sensor_model=LogSensorModel(noise_counts=0.0),
+                                          rng=np.random.default_rng(0))
+    assert counts.shape == (1, 10, 60, 5) and 0.05 < is_sky.mean() < 0.95
+    uv_ir = counts[0, ..., 0] - counts[0, ..., 4]
+    assert uv_ir[is_sky[0]].mean() > uv_ir[~is_sky[0]].mean() + 300  # sky is UV-rich, the world is not

@@ -62,6 +62,57 @@ def render_condition_counts(scene, geometry, world_positions, *, sensor_model, r
     return np.stack(counts), np.stack(skies)
 
 
+#: bionav.spectral material used for each material kind of the campus world (bionav.world.worlds.outdoor).
+CAMPUS_MATERIALS = {
+    "concrete": "concrete", "brick": "brick", "glass": "glass", "foliage": "tree", "bark": "dead_wood",
+    "grass": "grass", "paving": "concrete", "asphalt": "tar", "metal": "metal_bare", "paint": "lacquered_metal",
+    "wood": "dead_wood", "soil": "soil",
+}
+
+
+def campus_world(sky, *, seed: int):
+    """The outdoor campus of :mod:`bionav.world.worlds.outdoor` in five bands under a spectral sky.
+
+    Per-kind albedos come from :data:`bionav.spectral.materials.MATERIALS` (via
+    :data:`CAMPUS_MATERIALS`), the sun and the hemispherical ambient light from
+    :func:`bionav.spectral.sky.illumination` (``E/pi``, so that pixel values are
+    band radiances in the unit of the sensor model), rays that hit nothing from
+    :func:`bionav.spectral.sky.band_sky_radiance`.
+    """
+    try:
+        from bionav.world.worlds.outdoor import build_campus
+    except ImportError:
+        raise UserError("experiment.world=campus needs bionav's outdoor campus world (bionav.world.worlds.outdoor), "
+                        "which this installation lacks; use experiment.world=garden.") from None
+    from bionav.spectral.bands import CHANNELS, band_integrate
+    from bionav.spectral.materials import MATERIALS
+    from bionav.spectral.sky import band_sky_radiance, illumination
+
+    ill = illumination(sky)
+    e_dir = band_integrate(ill.direct_normal) / np.pi
+    e_dif = band_integrate(ill.diffuse_horizontal) / np.pi
+    albedos = {k: np.asarray(MATERIALS[m].reflectance) for k, m in CAMPUS_MATERIALS.items()}
+    world = build_campus(seed, channels=CHANNELS, albedos=albedos, sky=lambda d: band_sky_radiance(sky, d),
+                         sun_elevation=float(sky.sun_elevation), sun_azimuth=float(sky.sun_azimuth),
+                         sun_irradiance=e_dir, sky_irradiance=e_dif, exposure=1.0)
+    return world
+
+
+def render_campus_counts(world, geometry, cells, *, sensor_model, rng, progress=None):
+    """Counts ``(N, H, W, 5)`` and true sky masks of the campus at grid cells ``(N, 2)`` (may be fractional)."""
+    from bionav.world.render import render_depth, render_panorama
+
+    counts, skies = [], []
+    it = cells if progress is None else progress(cells, desc="render", total=len(cells))
+    for i, j in it:
+        pos = world.cell_position(float(i), float(j))
+        rad = render_panorama(world.scene, position=pos, geometry=geometry, clip=False, exposure=1.0)
+        depth, _, _ = render_depth(world.scene, position=pos, geometry=geometry)
+        counts.append(sensor_model.read(np.asarray(rad, float), rng=rng)[0, ..., :5].astype(np.float32))
+        skies.append(~np.isfinite(depth))
+    return np.stack(counts), np.stack(skies)
+
+
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
     from bionav.db.database import ImageDatabase
@@ -83,11 +134,15 @@ def run(cfg, ctx) -> dict:
             check_representation(r)
         except ValueError as exc:
             raise UserError(f"experiment.representations: {exc}.") from None
-    world = str(_get(exp, "world", "garden"))
-    if world != "garden":
-        raise UserError(f"experiment.world={world!r} is not available; use experiment.world=garden.")
+    world_name = str(_get(exp, "world", "garden"))
+    if world_name not in ("garden", "campus"):
+        raise UserError(f"experiment.world={world_name!r} is unknown; choose garden or campus.")
     nx, ny = (int(v) for v in _get(exp, "grid", [9, 9]))
     spacing = float(_get(exp, "spacing_m", 0.5))
+    if world_name == "campus":
+        from bionav.world.worlds.outdoor import GRID_SHAPE, SPACING
+
+        (nx, ny), spacing = GRID_SHAPE, SPACING
     width, height = int(_get(exp, "image_width", 120)), int(_get(exp, "image_height", 20))
     top = np.deg2rad(float(_get(exp, "elevation_top_deg", 45.0)))
     rad_per_row = 2 * np.pi / width
@@ -103,21 +158,30 @@ def run(cfg, ctx) -> dict:
     world_pos = positions * spacing
     side = float(_get(exp, "square_side_m", 2.0))
     square_cells = np.array([[0, 0], [1, 0], [0, 1], [1, 1]])
-    square_pos = extent / 2 - side / 2 + square_cells * side
+    centre = np.array([nx - 1, ny - 1]) * spacing / 2
+    square_pos = centre - side / 2 + square_cells * side
     do_square = bool(_get(exp, "square_test", True))
 
     counts, squares, truths = [], [], []
     for k, (name, t, cover, tau) in enumerate(conditions):
         sky = SkyState.from_time(t, clouds=CloudField(cover=cover, optical_depth=tau, seed=seed + 1),
                                  turbidity=float(_get(exp, "turbidity", 0.1)))
-        scene = garden_scene(sky, seed=seed, grid_extent=extent)
-        c, truth = render_condition_counts(scene, geometry, world_pos, sensor_model=sensor_model, rng=ctx.rng,
-                                           progress=ctx.progress)
+        if world_name == "campus":
+            world = campus_world(sky, seed=seed)
+            c, truth = render_campus_counts(world, geometry, positions, sensor_model=sensor_model, rng=ctx.rng,
+                                            progress=ctx.progress)
+            if do_square:
+                squares.append(render_campus_counts(world, geometry, square_pos / spacing,
+                                                    sensor_model=sensor_model, rng=ctx.rng)[0])
+        else:
+            scene = garden_scene(sky, seed=seed, grid_extent=extent)
+            c, truth = render_condition_counts(scene, geometry, world_pos, sensor_model=sensor_model, rng=ctx.rng,
+                                               progress=ctx.progress)
+            if do_square:
+                squares.append(render_condition_counts(scene, geometry, square_pos, sensor_model=sensor_model,
+                                                       rng=ctx.rng)[0])
         counts.append(c)
         truths.append(truth)
-        if do_square:
-            squares.append(render_condition_counts(scene, geometry, square_pos, sensor_model=sensor_model,
-                                                   rng=ctx.rng)[0])
     np.savez_compressed(ctx.dir / "panoramas.npz", counts=np.stack(counts), sky=np.stack(truths),
                         positions=positions, conditions=np.array([c[0] for c in conditions]))
 
