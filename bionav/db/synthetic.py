@@ -41,7 +41,7 @@ import numpy as np
 
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
-from bionav.geometry import TWO_PI, PanoramaGeometry, wrap_angle
+from bionav.geometry import PanoramaGeometry
 
 #: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
 NATIVE_SIZE = (561, 81)
@@ -335,12 +335,6 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     images = images_u8.astype(np.float32) / np.float32(255.0)
     if images.shape[-1] == 1:
         images = images[..., 0]
-    headings = np.zeros(len(positions))
-    if rotate_current:
-        rrng = np.random.default_rng(int(rotation_seed))
-        shifts = rrng.integers(0, w, size=len(positions))
-        images = np.stack([np.roll(img, -int(k), axis=1) for img, k in zip(images, shifts)])
-        headings = wrap_angle(TWO_PI * shifts / w)
     meta = {
         "source": "synthetic",
         "world": spec.description,
@@ -355,9 +349,14 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "rotate_current": bool(rotate_current),
         "rotation_seed": int(rotation_seed),
     }
-    return ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
-                         geometry=geometry, spacing_m=float(spec.spacing_m), headings=np.asarray(headings, float),
+    db = ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
+                         geometry=geometry, spacing_m=float(spec.spacing_m),
                          meta=meta)
+    if rotate_current:
+        from bionav.db.rotation import rotate_views
+
+        db = rotate_views(db, seed=rotation_seed)
+    return db
 
 
 def synthetic_database_from_config(cfg, *, cache_dir: str | Path | None = None,

@@ -66,6 +66,51 @@ class DevicePlugin:
         self.close()
 
 
+class SerialDeviceMixin:
+    """Open/close of a device behind one serial link (pyserial, timeouts, reconnect).
+
+    The using class sets ``device_name`` (for messages), has a ``config`` with
+    ``port``, ``baudrate``, ``timeout_s``, ``reconnect_attempts`` and
+    ``reconnect_delay_s``, and implements ``_init_device()``, which is run
+    after every (re)connection.
+    """
+
+    device_name: ClassVar[str] = "serial device"
+    _link: Any = None
+
+    def open(self) -> None:
+        from bionav.errors import DeviceError
+        from bionav.serialio import SerialLink
+
+        if self._link is not None:
+            return
+        link = SerialLink(
+            self.config.port,
+            baudrate=self.config.baudrate,
+            timeout=self.config.timeout_s,
+            device=self.device_name,
+            config_key=self.config_key("port"),
+            reconnect_attempts=self.config.reconnect_attempts,
+            reconnect_delay=self.config.reconnect_delay_s,
+        )
+        link.open()
+        link.on_reconnect = self._init_device
+        self._link = link
+        try:
+            self._init_device()
+        except DeviceError:
+            self.close()
+            raise
+
+    def _init_device(self) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        link, self._link = self._link, None
+        if link is not None:
+            link.close()
+
+
 class SensorPlugin(DevicePlugin):
     """A sensor: :meth:`read` returns one raw reading as a JSON-ready dict."""
 
