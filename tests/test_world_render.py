@@ -174,3 +174,34 @@ def test_result_does_not_depend_on_the_number_of_threads():
     one = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=1)
     two = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=2)
     np.testing.assert_array_equal(one, two)
+
+
+def test_binned_shadow_rays_equal_brute_force():
+    from bionav.world import kernels as K
+
+    rng = np.random.default_rng(11)
+    s = _random_scene(rng)
+    s.add_light(PointLight((0.5, -0.5, 2.8), 1.0))
+    s.add_light(PointLight((-2.0, 2.0, 2.5), 1.0, downward=False))
+    s.add_light(DirectionalLight((0.3, -0.4, 0.8), 1.0))
+    cs = s.compile()
+    casters_only = [cs.boxes[cs.boxes[:, 9] > 0.5], cs.frusta[cs.frusta[:, 6] > 0.5],
+                    cs.ellipsoids[cs.ellipsoids[:, 6] > 0.5]]
+    n_blocked = 0
+    for k in range(len(cs.light_params)):
+        lp = cs.light_params[k]
+        for _ in range(300):
+            p = rng.uniform([-5, -5, 0], [5, 5, 2.5])
+            if lp[0] < 0.5:
+                v = lp[1:4] - p
+                tmax = np.linalg.norm(v) - 1e-3
+                d = v / np.linalg.norm(v)
+            else:
+                d, tmax = lp[1:4], K.INF
+            binned = K._occluded(k, *p, *d, tmax, cs.light_params, cs.shadow_grids, cs.shadow_starts,
+                                 cs.shadow_items, cs.prim_kind, cs.prim_idx, cs.spheres, cs.boxes, cs.frusta,
+                                 cs.ellipsoids)
+            brute = trace_depth_reference(p, d[None], *casters_only)[0] < tmax
+            assert binned == brute
+            n_blocked += brute
+    assert n_blocked > 20

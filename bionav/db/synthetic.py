@@ -258,8 +258,9 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         Standard deviation of the camera noise before 8-bit quantisation.
     rotate_current : bool
         Roll every image by a random whole number of columns ``k`` (Vardy's
-        protocol); ``headings[i] = wrap(2*pi*k_i/W)`` records the rotation
-        (radians CCW from grid +x).
+        protocol, :func:`bionav.db.rotation.rotate_views`);
+        ``headings[i] = 2*pi*k_i/W`` records the rotation (radians CCW from
+        grid +x).
     rotation_seed : int
         Seed of the random rotations.
     cache_dir : path, optional
@@ -350,8 +351,7 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "rotation_seed": int(rotation_seed),
     }
     db = ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
-                         geometry=geometry, spacing_m=float(spec.spacing_m),
-                         meta=meta)
+                       geometry=geometry, spacing_m=float(spec.spacing_m), meta=meta)
     if rotate_current:
         from bionav.db.rotation import rotate_views
 

@@ -61,7 +61,7 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
     scene = Scene(name="hall")
 
     r = stream(seed, "hall/shell")
-    floor = scene.material(texture=tx.tiles(r, n=2, lo=0.3, hi=0.55, grout_level=0.25), albedo=0.6, scale=2.4)
+    floor = scene.material(texture=tx.tiles(r, n=4, lo=0.25, hi=0.65, grout_level=0.2), albedo=0.6, scale=2.4)
     wall = scene.material(texture=tx.value_noise(r, lo=0.45, hi=0.7, base_cells=2), albedo=0.6, scale=4.0)
     ceiling = scene.material(texture=tx.tiles(r, n=3, lo=0.15, hi=0.35, grout_level=0.05), albedo=0.5,
                              scale=3.0)
