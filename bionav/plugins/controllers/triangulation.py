@@ -81,8 +81,9 @@ class TriangulationConfig(MeanderConfig):
     max_innovation : float
         Fixes whose ``h`` differs from the prediction by more are rejected, m.
     max_rejections : int
-        After this many consecutive innovation rejections the next fix is
-        accepted anyway (the estimate, not the measurement, is probably wrong).
+        When this many consecutive fixes were rejected for their innovation
+        but agree with each other (their ``h`` within ``max_innovation``), the
+        estimate rather than the measurements is wrong: the latest is accepted.
     """
 
     bias_learning: bool = True
@@ -143,7 +144,7 @@ class TriangulationController(MeanderController):
         self._next_capture = 0.0
         self._capture_lane = 0
         self._current = None
-        self._rejections = 0
+        self._rejected_h: list[float] = []
 
     # ------------------------------------------------------------------ hooks
     def lane_tick(self, obs: Observation, info: dict) -> None:
@@ -265,13 +266,19 @@ class TriangulationController(MeanderController):
             out.update(accepted=False, reason="ill-conditioned bearings")
         elif not tri.consistent:
             out.update(accepted=False, reason="inconsistent triangle")
-        elif abs(tri.y - h_pred) > c.max_innovation and self._rejections < c.max_rejections:
-            self._rejections += 1
+        elif abs(tri.y - h_pred) > c.max_innovation and not self._consistent_rejections(tri.y):
             out.update(accepted=False, reason="innovation too large")
         else:
-            self._rejections = 0
+            self._rejected_h = []
             out.update(accepted=True, reason="")
         return out
+
+    def _consistent_rejections(self, h: float) -> bool:
+        """Record an innovation rejection; True when the last ``max_rejections`` ones agree."""
+        c = self.config
+        self._rejected_h = (self._rejected_h + [float(h)])[-c.max_rejections:]
+        recent = self._rejected_h
+        return len(recent) >= c.max_rejections and max(recent) - min(recent) <= c.max_innovation
 
 
 def _circmean(a: float, b: float) -> float:
