@@ -13,7 +13,8 @@ unknown to its odometry) cleans the target area of a layout (``conf/layout``:
 7 lanes of 4 m or 14 lanes of 2 m, 0.30 m apart, first lane by wall
 following). With ``experiment.vision=render`` the robot sees 335 x 40
 panoramas rendered in its own frame at its true pose in the synthetic world
-``experiment.world`` and homes with ``cfg.homing`` (min-warping by default);
+``experiment.world`` and homes with ``cfg.homing`` (``minwarping_cleaning``: min-warping with
+compass acceleration, by default);
 with ``experiment.vision=oracle`` the home vectors come from the true geometry
 plus Gaussian noise (no renderer needed).
 
