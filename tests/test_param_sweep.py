@@ -91,7 +91,7 @@ def test_sweep_levels_and_thesis_grid_size():
     for grid in ("full", "ci"):
         cfg.experiment.grid = grid
         params = OmegaConf.to_container(cfg.hydra.sweeper.params, resolve=True)
-        assert set(params) == {"signature", "db.image_size", "preprocess"}
+        assert set(params) == {"signature", "++db.image_size", "preprocess"}
         assert list(cfg.experiment.rings) == list(exp.grids[grid].rings)
 
 
