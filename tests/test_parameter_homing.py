@@ -69,6 +69,21 @@ def test_mffc_phase_with_all_coefficients_equals_mfdid_parseval():
         np.testing.assert_allclose(ph.mffc_phase_home_vector(*spec), GEOM.width * mfdid, rtol=1e-9)
 
 
+def test_mffc_phase_all_coefficients_matches_bionav_mfdid_on_the_horizon():
+    """bionav.homing.mfdid uses horizontal flow only; on horizon rows (elevation 0) the
+    equal-distance templates coincide with it, so [mffc_phase] with K = W points the same way."""
+    from bionav.homing.mfdid import mfdid_home_vector
+
+    geom = PanoramaGeometry(width=64, height=1, horizon_row=0.0, rad_per_row=2 * np.pi / 64)
+    homing = ParameterHoming(Config(gradient="matched_filter", n_coeffs=64), geometry=geom)
+    rng = np.random.default_rng(12)
+    for _ in range(5):
+        s, c = (smooth_random_image(rng, shape=(1, 64)) for _ in range(2))
+        ref = mfdid_home_vector(s, c, geometry=geom)
+        hv = homing.home_vector(homing.prepare(s), homing.prepare(c))
+        assert angular_difference(hv.angle, math.atan2(ref[1], ref[0])) < 1e-9
+
+
 def test_closed_forms_c9_c11_equal_plugin_path_and_finite_differences():
     rng = np.random.default_rng(5)
     s, c = smooth_random_image(rng), smooth_random_image(rng)
