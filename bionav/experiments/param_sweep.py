@@ -96,11 +96,15 @@ def neighbour_table(db: ImageDatabase) -> np.ndarray:
 def parameter_home_vector_matrix(homing, db: ImageDatabase, prepared: Sequence[dict]) -> HomeVectorMatrix:
     """Home vectors of all pairs of a database for a :class:`ParameterHoming` (vectorised).
 
-    The same angles as the all-pairs runner
-    (:func:`bionav.evaluation.pairs.home_vector_matrix`) calling
-    ``homing.home_vector`` pair by pair -- grid-frame angles (own angle plus the
-    current view's heading), NaN on the snapshot's own cell and where the
-    gradient vanishes -- computed with matrix operations on the prepared signatures.
+    The same angles as calling ``homing.home_vector`` pair by pair (as
+    :func:`bionav.evaluation.pairs.home_vector_matrix` does) -- grid-frame
+    angles, NaN on the snapshot's own cell and where the gradient vanishes --
+    computed with matrix operations on the prepared signatures. The test steps
+    are the four grid neighbours, so their gradient is in the grid frame; the
+    matched filter's gradient is in the current view's frame and is turned by
+    the current view's heading. (For rotated current views this equals the
+    per-pair call with the neighbour offsets expressed in the current view's
+    frame, as :meth:`HomingMethod.home_vector` specifies.)
 
     Parameters
     ----------
@@ -130,7 +134,11 @@ def parameter_home_vector_matrix(homing, db: ImageDatabase, prepared: Sequence[d
         angles = np.arctan2(hy, hx)
     angles[(hx == 0) & (hy == 0)] = np.nan
     angles[~(np.isfinite(hx) & np.isfinite(hy))] = np.nan
-    angles = wrap_angle(angles + db.headings[None, :])
+    if homing.gradient != "test_steps":
+        # flow templates live in the current view's own frame; test steps are taken along the
+        # grid axes, so their gradient is already in the grid frame
+        angles = angles + db.headings[None, :]
+    angles = wrap_angle(angles)
     same = np.all(db.positions[:, None, :] == db.positions[None, :, :], axis=2)
     angles[same] = np.nan
     return HomeVectorMatrix(
