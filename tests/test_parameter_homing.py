@@ -198,3 +198,36 @@ def test_config_handling_and_errors():
     prep = ts.prepare(rng.random((18, 72)))
     assert np.isnan(ts.home_vector(prep, prep).angle)  # no test steps available
     assert np.isnan(ts.home_vector(prep, prep, neighbours={(1, 0): prep}).angle)  # flat potential
+
+
+def test_duck_typed_third_party_signature():
+    """A plugin signature that only has Config, rotation_invariant and compute works with both gradients."""
+    from dataclasses import dataclass
+
+    class RowMeans:
+        @dataclass
+        class Config:
+            scale: float = 1.0
+
+        rotation_invariant = True
+
+        def __init__(self, config=None):
+            self.config = config or self.Config()
+
+        def compute(self, image, *, raw=None):
+            return self.config.scale * np.asarray(image, dtype=np.float64).mean(axis=1)
+
+    rng = np.random.default_rng(2)
+    s, c = smooth_random_image(rng), smooth_random_image(rng)
+    mf = ParameterHoming(Config(gradient="matched_filter"), geometry=GEOM, signature=RowMeans())
+    assert mf.signature_name == "RowMeans" and mf.gradient == "matched_filter"
+    assert ParameterHoming(Config(), geometry=GEOM, signature=RowMeans()).gradient == "test_steps"  # auto
+    assert not mf.requires_alignment
+    hv = mf.home_vector(mf.prepare(s), mf.prepare(c))
+    # row means are linear: the finite difference equals the row means of the flow derivatives
+    phi, psi = translation_derivatives(c, geometry=GEOM)
+    d = c.mean(axis=1) - s.mean(axis=1)
+    want = -np.array([d @ phi.mean(axis=1), d @ psi.mean(axis=1)])
+    assert angular_difference(hv.angle, math.atan2(want[1], want[0])) < 1e-6
+    ts = ParameterHoming(Config(gradient="test_steps"), geometry=GEOM, signature=RowMeans())
+    assert ts.uses_test_steps and np.isfinite(ts.home_vector(ts.prepare(s), ts.prepare(c), neighbours={(1, 0): ts.prepare(s)}).angle)
