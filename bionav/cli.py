@@ -108,7 +108,10 @@ def _task(cfg) -> float | None:
             f"in {run_dir / 'error.log'} and the run's log in {run_dir / 'run.mcap'}.",
             EXIT_INTERNAL_ERROR,
         )
-    _print_result(metrics)
+    if multirun:
+        log.info("job %s: %s", hc.job.num, ", ".join(f"{k}={metrics[k]:.4g}" for k in ("aae", "mae", "rr") if isinstance(metrics.get(k), float)) or metrics.get("status"))
+    else:
+        _print_result(metrics)
     return None
 
 

@@ -124,19 +124,10 @@ def test_ranking_table_best_configuration_per_signature():
     assert ranking.ranking_table(rows, db="b")[0]["rr"] == 0.10
 
 
-def test_run_writes_rows_and_report_builds_ranking(small_db, tmp_path, monkeypatch, fake_distributions):
+def test_run_writes_rows_and_report_builds_ranking(small_db, tmp_path, monkeypatch):
     from bionav.experiments.context import RunContext
     from bionav.logs.writer import McapLog
 
-    # register bionav's own plugins (this worktree is not installed) and use the rendered grid
-    fake_distributions(
-        "bionav-under-test",
-        {
-            "bionav.homing": {"parameter": "bionav.plugins.homing.parameter:ParameterHoming"},
-            "bionav.signatures": {"mffc_phase": "bionav.plugins.signatures.fourier:MffcPhase",
-                                  "mean": "bionav.plugins.signatures.statistics:Mean"},
-        },
-    )  # fmt: skip
     import bionav.experiments.common as common
 
     monkeypatch.setattr(common, "load_configured_database", lambda cfg, node=None: small_db)

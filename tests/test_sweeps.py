@@ -98,3 +98,14 @@ def test_missing_real_database_says_where_it_looked(tmp_path):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     for needle in ("nowhere", "BIONAV_DATA", "sim_original"):
         assert needle in proc.stderr
+
+
+@pytest.mark.parametrize("launcher", ["joblib", "submitit_local"])
+def test_parallel_and_cluster_launchers(tmp_path, tiny_folder, launcher):
+    sweep = tmp_path / "sweep"
+    proc = run_bionav("-m", "homing=mfdid,sift", "db=folder", f"db.path={tiny_folder},{tmp_path / 'missing'}",
+                      f"hydra/launcher={launcher}", f"hydra.sweep.dir={sweep}", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    rows = _rows(sweep / "summary.csv")
+    assert len(rows) == 4
+    assert sorted(r["status"] for r in rows) == ["completed", "completed", "failed", "failed"]

@@ -62,6 +62,12 @@ def _sample_columns(images: np.ndarray, source_columns: np.ndarray) -> np.ndarra
     frac = (source_columns - base).astype(np.float32)
     i0 = base.astype(np.int64) % width
     if not np.any(frac > 1e-9):
+        step = (i0[1] - i0[0]) % width if width > 1 else 1
+        if width > 1 and step in (1, width - 1) and np.array_equal(i0, (i0[0] + step * np.arange(width)) % width):
+            # a pure roll, or a mirror followed by a roll: slicing is much faster than fancy indexing
+            if step == 1:
+                return np.roll(images, -int(i0[0]), axis=-1)
+            return np.roll(images[..., ::-1], -(width - 1 - int(i0[0])), axis=-1)
         return np.ascontiguousarray(images[..., i0])
     i1 = (i0 + 1) % width
     out = images[..., i0] * (1.0 - frac) + images[..., i1] * frac

@@ -35,6 +35,8 @@ def as_database_config(cfg) -> DatabaseConfig:
     from omegaconf.errors import OmegaConfBaseException
 
     try:
+        if OmegaConf.is_config(cfg):  # resolve ${data_dir} etc. against the full config first
+            cfg = OmegaConf.to_container(cfg, resolve=True)
         merged = OmegaConf.merge(OmegaConf.structured(DatabaseConfig), cfg)
         return OmegaConf.to_object(merged)
     except OmegaConfBaseException as exc:

@@ -15,7 +15,12 @@ The thesis names the filters "Butterworth 1 with a 0.03 cutoff frequency" and
 "Butterworth 2 with a 0.015 cutoff frequency"; bionav reads the digit as the
 filter order (the issue asks for orders 1/2/3). Any other combination is a
 free list of steps, e.g.
-``preprocess.steps='[{op: butterworth, order: 3, cutoff: 0.1}, {op: edges}]'``.
+``preprocess.name=bw3e 'preprocess.steps=[{op:butterworth,order:3,cutoff:0.1},{op:edges}]'``.
+
+The thesis does not name its edge detector; bionav uses the Sobel gradient
+magnitude (:func:`edge_filter`). In the thesis a cutoff of 1.0 "depicts
+unfiltered images"; bionav's Butterworth filter with cutoff 1.0 still halves the
+power at the Nyquist frequency, so use ``preprocess=none`` for unfiltered images.
 
 Deviation from the thesis: there, the filters were applied to the raw camera
 frame before unfolding. bionav filters the panorama at its native resolution
@@ -102,11 +107,17 @@ def butterworth_lowpass(images: np.ndarray, *, order: int = 1, cutoff: float) ->
         raise UserError(f"butterworth needs order >= 1 and cutoff > 0 (got order={order}, cutoff={cutoff}).")
     images = np.asarray(images, dtype=np.float32)
     height, width = images.shape[-2:]
-    ext = np.concatenate([images, images[..., ::-1, :]], axis=-2)
-    spec = np.fft.rfft2(ext, axes=(-2, -1))
     gain = butterworth_response(np.fft.rfftfreq(width)[None, :], np.fft.fftfreq(2 * height)[:, None],
-                                order=int(order), cutoff=float(cutoff))
-    out = np.fft.irfft2(spec * gain, s=(2 * height, width), axes=(-2, -1))[..., :height, :]
+                                order=int(order), cutoff=float(cutoff)).astype(np.float32)
+    stack = images.reshape(-1, height, width)
+    out = np.empty_like(stack)
+    chunk = 32  # bounds the memory of the complex spectra
+    for start in range(0, stack.shape[0], chunk):
+        block = stack[start:start + chunk]
+        ext = np.concatenate([block, block[:, ::-1, :]], axis=1)
+        spec = np.fft.rfft2(ext, axes=(-2, -1))
+        out[start:start + chunk] = np.fft.irfft2(spec * gain, s=(2 * height, width), axes=(-2, -1))[:, :height]
+    out = out.reshape(images.shape)
     return np.clip(out, 0.0, 1.0).astype(np.float32)
 
 
@@ -199,12 +210,11 @@ def resize_images(images: np.ndarray, size) -> np.ndarray:
         return cv2.resize(images, (width, height), interpolation=cv2.INTER_AREA)
     if images.shape[-2:] == (height, width):
         return images.copy()
-    out = np.empty((images.shape[0], height, width), dtype=np.float32)
-    chunk = 256  # OpenCV handles up to 512 channels per call
-    for start in range(0, images.shape[0], chunk):
-        block = np.ascontiguousarray(np.moveaxis(images[start:start + chunk], 0, -1))
-        res = cv2.resize(block, (width, height), interpolation=cv2.INTER_AREA)
-        out[start:start + chunk] = np.moveaxis(res.reshape(height, width, -1), -1, 0)
+    out = np.empty((*images.shape[:-2], height, width), dtype=np.float32)
+    flat_in = images.reshape(-1, *images.shape[-2:])
+    flat_out = out.reshape(-1, height, width)
+    for i, image in enumerate(flat_in):  # OpenCV 5 resizes at most 4 channels per call
+        flat_out[i] = cv2.resize(image, (width, height), interpolation=cv2.INTER_AREA)
     return out
 
 

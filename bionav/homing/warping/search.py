@@ -1,0 +1,370 @@
+"""Min-warping and 2D-warping: the per-pair search over movement direction and rotation.
+
+Conventions
+-----------
+* ``alpha``: direction of the movement from the snapshot position to the
+  current position, in the snapshot's frame (radians CCW from the snapshot's
+  column 0).
+* ``psi``: rotation of the current view relative to the snapshot,
+  ``heading(current) - heading(snapshot)`` (radians CCW). A current view that
+  is the snapshot rolled by ``-n`` columns (``np.roll(snapshot, -n, axis=1)``)
+  has ``psi = 2 pi n / W``.
+* The home direction in the current view's own frame is
+  ``alpha + pi - psi`` (wrapped to ``[-pi, pi)``).
+
+Angles are searched on the grids ``alpha = 2 pi a / n_alpha`` and
+``psi = 2 pi p / n_psi``, each rounded to whole columns of the panorama (the
+search shifts columns, it does not interpolate between them). When ``W`` is a
+multiple of ``n_alpha`` the fast kernels compute all alpha steps of one template
+entry as one vector; otherwise they search every column and keep the grid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import get_num_threads
+
+from bionav.geometry import wrap_angle
+from bionav.homing.warping.distance import diagonal_distances
+from bionav.homing.warping.kernels import (
+    compass_measure,
+    minwarp_scores,
+    minwarp_scores_at,
+    warp2d_scores,
+    warp2d_scores_at,
+)
+from bionav.homing.warping.scaleplanes import check_scales
+from bionav.homing.warping.templates import minwarp_template, warp2d_template
+
+
+@dataclass(frozen=True)
+class WarpingResult:
+    """Outcome of a warping search.
+
+    Attributes
+    ----------
+    home_angle : float
+        Home direction (current position towards snapshot position) in the
+        current view's own frame, radians CCW in ``[-pi, pi)``.
+    psi : float
+        Estimated rotation ``heading(current) - heading(snapshot)``, radians CCW
+        in ``[-pi, pi)`` (the visual compass).
+    alpha : float
+        Estimated movement direction snapshot -> current in the snapshot's
+        frame, radians in ``[0, 2 pi)``.
+    rho : float
+        Distance ratio ``d / r`` of the best match (equal-distance methods);
+        NaN for min-warping.
+    score : float
+        Match value of the best parameters (lower is better).
+    extras : dict
+        Diagnostics (``n_psi_searched``, ...).
+    """
+
+    home_angle: float
+    psi: float
+    alpha: float
+    rho: float
+    score: float
+    extras: dict = field(default_factory=dict)
+
+
+def _column_grid(n_steps: int, width: int) -> np.ndarray:
+    if n_steps < 1:
+        raise ValueError(f"the number of search steps must be >= 1, got {n_steps}")
+    if n_steps > width:
+        raise ValueError(
+            f"{n_steps} search steps exceed the image width {width}: the search shifts whole "
+            "columns, so use at most one step per column"
+        )
+    return np.rint(np.arange(n_steps) * width / n_steps).astype(np.int64) % width
+
+
+def _layout_step(width: int, n_alpha: int, p_cols, double_search: bool) -> int:
+    if width % n_alpha:
+        return 1
+    step = width // n_alpha
+    if double_search and ((width // 2) % step or np.any(np.asarray(p_cols) % step)):
+        return 1
+    return step
+
+
+def _select_psi(dist, p_cols, compass_fraction):
+    if compass_fraction is None or compass_fraction >= 1.0:
+        return p_cols
+    if not (0.0 < compass_fraction <= 1.0):
+        raise ValueError(f"compass_fraction must lie in (0, 1], got {compass_fraction}")
+    measure = compass_measure(dist, p_cols)
+    n_sel = max(1, int(np.ceil(compass_fraction * p_cols.size)))
+    keep = np.sort(np.argsort(measure, kind="stable")[:n_sel])
+    return p_cols[keep]
+
+
+def _check_pair(snapshot, current):
+    s1 = np.asarray(snapshot["scales"], dtype=np.float64)
+    s2 = np.asarray(current["scales"], dtype=np.float64)
+    if s1.shape != s2.shape or not np.allclose(s1, s2):
+        raise ValueError("snapshot and current view were prepared with different scale factors")
+    if np.shape(snapshot["snap"]) != np.shape(current["cur"]):
+        raise ValueError(
+            f"snapshot and current view stacks differ in shape: {np.shape(snapshot['snap'])} "
+            f"vs {np.shape(current['cur'])}; prepare both at the same image size"
+        )
+    return s1
+
+
+def minwarping_scores(snapshot, current, *, n_alpha=96, n_psi=96, thresholds=None, psi_cols=None):
+    """Min-warping match values on the full (psi, alpha) grid (fast kernels).
+
+    Parameters
+    ----------
+    snapshot, current : dict
+        Scale-plane stacks (:func:`~bionav.homing.warping.scaleplanes.scale_plane_stack`).
+    n_alpha, n_psi : int
+        Search steps over 360 degrees.
+    thresholds : array_like, shape (K,), optional
+        Scale thresholds; default geometric midpoints.
+    psi_cols : array_like of int, optional
+        Rotations (columns) to search instead of the ``n_psi`` grid.
+
+    Returns
+    -------
+    a_cols : ndarray, shape (n_alpha,), int64
+        Movement directions in columns.
+    p_cols : ndarray, shape (P,), int64
+        Rotations in columns.
+    scores : ndarray, shape (P, n_alpha), float32
+        ``scores[p, a] = sum over snapshot columns of the minimum NSAD over the
+        reachable current columns and allowed planes``.
+    """
+    scales = _check_pair(snapshot, current)
+    scales, tau = check_scales(scales, thresholds)
+    width = int(np.shape(snapshot["snap"])[-1])
+    a_cols = _column_grid(n_alpha, width)
+    p_cols = _column_grid(n_psi, width) if psi_cols is None else np.asarray(psi_cols, np.int64) % width
+    step = _layout_step(width, n_alpha, p_cols, False)
+    dist = diagonal_distances(snapshot, current, step=step)
+    tmpl = minwarp_template(width, scales, tau)
+    scores = minwarp_scores(dist, width // step, p_cols, *tmpl, get_num_threads())
+    return a_cols, p_cols, scores[:, a_cols // step]
+
+
+def minwarping(
+    snapshot,
+    current,
+    *,
+    n_alpha: int = 96,
+    n_psi: int = 96,
+    thresholds=None,
+    compass_fraction: float | None = None,
+    fine_search: bool = False,
+    double_search: bool = False,
+    template=None,
+) -> WarpingResult:
+    """Min-warping home direction and visual compass of one image pair.
+
+    Implements min-warping (Möller, Krzykawski & Gerstmayr 2010, "Three
+    2D-warping schemes for visual robot navigation", Autonomous Robots 29,
+    doi:10.1007/s10514-010-9195-y), the extension of 2D-warping (Möller 2009,
+    doi:10.1016/j.robot.2008.05.005) that drops the equal-distance assumption:
+    for every movement hypothesis ``(alpha, psi)`` each snapshot column is
+    matched with its best current-view column among those it can reach, with
+    the scale plane their positions imply (:func:`~bionav.homing.warping.
+    templates.minwarp_template`); the hypothesis with the smallest sum of these
+    minima wins.
+
+    Parameters
+    ----------
+    snapshot, current : dict
+        Scale-plane stacks of the snapshot and the current view
+        (:func:`~bionav.homing.warping.scaleplanes.scale_plane_stack`, same
+        scales and size).
+    n_alpha, n_psi : int
+        Search steps over 360 degrees for the movement direction and the
+        rotation (96 x 96 at width 288 is the fast default).
+    thresholds : array_like, shape (K,), optional
+        Scale thresholds ``tau_k``; default geometric midpoints.
+    compass_fraction : float, optional
+        Compass acceleration: search only this fraction of the ``n_psi``
+        rotations, those with the smallest compass measure
+        (:func:`~bionav.homing.warping.kernels.compass_measure`: the column
+        distances along each rotation, best plane per column, summed).
+        ``None`` or 1 searches all.
+    fine_search : bool
+        Afterwards search alpha and psi at one-column resolution around the
+        best grid point (within one grid step).
+    double_search : bool
+        Also search with the roles of snapshot and current view exchanged and
+        add the match values of corresponding hypotheses (``alpha' = alpha +
+        pi - psi``, ``psi' = -psi``).
+    template : tuple, optional
+        Precomputed ``minwarp_template(W, scales, thresholds)`` (saves about a
+        millisecond per call when many pairs share it).
+
+    Returns
+    -------
+    WarpingResult
+    """
+    scales = _check_pair(snapshot, current)
+    scales, tau = check_scales(scales, thresholds)
+    width = int(np.shape(snapshot["snap"])[-1])
+    if double_search and width % 2:
+        raise ValueError(f"double search needs an even image width, got {width}")
+    a_cols = _column_grid(n_alpha, width)
+    p_all = _column_grid(n_psi, width)
+    step = _layout_step(width, n_alpha, p_all, double_search)
+    n_a_eff = width // step
+    tmpl = minwarp_template(width, scales, tau) if template is None else template
+    dist = diagonal_distances(snapshot, current, step=step)
+    p_cols = _select_psi(dist, p_all, compass_fraction)
+    scores = minwarp_scores(dist, n_a_eff, p_cols, *tmpl, get_num_threads()).astype(np.float64)
+    dist2 = None
+    if double_search:
+        dist2 = diagonal_distances(current, snapshot, step=step)
+        scores2 = minwarp_scores(dist2, n_a_eff, (-p_cols) % width, *tmpl, get_num_threads())
+        # hypothesis (a, p) of the pair corresponds to (a + W/2 - p, -p) of the swapped pair
+        a_eff = np.arange(n_a_eff) * step
+        idx = ((a_eff[None, :] + width // 2 - p_cols[:, None]) % width) // step
+        scores = scores + np.take_along_axis(scores2, idx, axis=1)
+    scores = scores[:, a_cols // step]
+    ip, ia = np.unravel_index(int(np.argmin(scores)), scores.shape)
+    best_a, best_p, best = int(a_cols[ia]), int(p_cols[ip]), float(scores[ip, ia])
+    if fine_search:
+        best_a, best_p, best = _fine(
+            lambda ac, pc: _minwarp_at(dist, dist2, ac, pc, tmpl, width),
+            best_a, best_p, best, width, n_alpha, n_psi,
+        )
+    return _result(best_a, best_p, np.nan, best, width, n_psi_searched=int(p_cols.size))
+
+
+def _minwarp_at(dist, dist2, a_cols, p_cols, tmpl, width):
+    out = minwarp_scores_at(dist, a_cols, p_cols, *tmpl)
+    if dist2 is not None:
+        out = out + minwarp_scores_at(dist2, (a_cols + width // 2 - p_cols) % width, (-p_cols) % width, *tmpl)
+    return out
+
+
+def _fine(score_at, best_a, best_p, best, width, n_alpha, n_psi):
+    ra = max(1, int(np.ceil(width / n_alpha)) - 1)
+    rp = max(1, int(np.ceil(width / n_psi)) - 1)
+    da, dp = np.meshgrid(np.arange(-ra, ra + 1), np.arange(-rp, rp + 1), indexing="ij")
+    ac = (best_a + da.ravel()) % width
+    pc = (best_p + dp.ravel()) % width
+    vals = score_at(ac.astype(np.int64), pc.astype(np.int64))
+    t = int(np.argmin(vals))
+    if vals[t] < best:
+        return int(ac[t]), int(pc[t]), float(vals[t])
+    return best_a, best_p, best
+
+
+def _result(a_col, p_col, rho, score, width, **extras):
+    alpha = 2.0 * np.pi * a_col / width
+    psi = float(wrap_angle(2.0 * np.pi * p_col / width))
+    home = float(wrap_angle(alpha + np.pi - psi))
+    return WarpingResult(home, psi, float(alpha), float(rho), float(score), dict(extras))
+
+
+def rho_grid(n_rho: int, rho_max: float) -> np.ndarray:
+    """Distance ratios ``rho_l = rho_max * l / (n_rho - 1)``, ``l = 0..n_rho-1``."""
+    if n_rho < 1:
+        raise ValueError(f"n_rho must be >= 1, got {n_rho}")
+    if not (0.0 <= rho_max < 1.0):
+        raise ValueError(f"rho_max must lie in [0, 1), got {rho_max}")
+    if n_rho == 1:
+        return np.zeros(1)
+    return rho_max * np.arange(n_rho) / (n_rho - 1)
+
+
+def warping2d_scores(
+    snapshot, current, *, n_alpha=96, n_psi=96, n_rho=20, rho_max=0.95, thresholds=None, psi_cols=None
+):
+    """2D-warping match values on the full (rho, psi, alpha) grid (fast kernels).
+
+    Returns
+    -------
+    a_cols, p_cols : ndarray of int64
+        Movement directions and rotations in columns.
+    rhos : ndarray, shape (R,)
+    scores : ndarray, shape (R, P, n_alpha), float32
+    """
+    scales = _check_pair(snapshot, current)
+    scales, tau = check_scales(scales, thresholds)
+    width = int(np.shape(snapshot["snap"])[-1])
+    a_cols = _column_grid(n_alpha, width)
+    p_cols = _column_grid(n_psi, width) if psi_cols is None else np.asarray(psi_cols, np.int64) % width
+    step = _layout_step(width, n_alpha, p_cols, False)
+    rhos = rho_grid(n_rho, rho_max)
+    v_tab, k_tab = warp2d_template(width, rhos, tau)
+    dist = diagonal_distances(snapshot, current, step=step)
+    scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)
+    return a_cols, p_cols, rhos, scores[:, :, a_cols // step]
+
+
+def warping2d(
+    snapshot,
+    current,
+    *,
+    n_alpha: int = 96,
+    n_psi: int = 96,
+    n_rho: int = 20,
+    rho_max: float = 0.95,
+    thresholds=None,
+    compass_fraction: float | None = None,
+    fine_search: bool = False,
+    template=None,
+) -> WarpingResult:
+    """2D-warping home direction and visual compass of one image pair.
+
+    Implements 2D-warping (Möller 2009, "Local visual homing by warping of
+    two-dimensional images", Robotics and Autonomous Systems 57,
+    doi:10.1016/j.robot.2008.05.005): under the equal-distance assumption a
+    movement hypothesis ``(alpha, psi, rho)`` predicts for every snapshot column
+    its current-view column and its vertical scale
+    (:func:`~bionav.homing.warping.templates.warp2d_template`); the hypothesis
+    with the smallest sum of column distances wins.
+
+    Parameters
+    ----------
+    snapshot, current : dict
+        Scale-plane stacks (same scales and size).
+    n_alpha, n_psi : int
+        Search steps over 360 degrees.
+    n_rho : int
+        Distance-ratio steps ``rho = d / r`` over ``[0, rho_max]``.
+    rho_max : float
+        Largest distance ratio (< 1).
+    thresholds : array_like, shape (K,), optional
+        Scale thresholds; scales beyond the last threshold use the last plane.
+    compass_fraction : float, optional
+        Compass acceleration (see :func:`minwarping`).
+    fine_search : bool
+        Refine alpha and psi at one-column resolution around the best grid
+        point (``rho`` kept).
+    template : tuple, optional
+        Precomputed ``warp2d_template(W, rho_grid(n_rho, rho_max), thresholds)``.
+
+    Returns
+    -------
+    WarpingResult
+    """
+    scales = _check_pair(snapshot, current)
+    scales, tau = check_scales(scales, thresholds)
+    width = int(np.shape(snapshot["snap"])[-1])
+    a_cols = _column_grid(n_alpha, width)
+    p_all = _column_grid(n_psi, width)
+    step = _layout_step(width, n_alpha, p_all, False)
+    rhos = rho_grid(n_rho, rho_max)
+    v_tab, k_tab = warp2d_template(width, rhos, tau) if template is None else template
+    dist = diagonal_distances(snapshot, current, step=step)
+    p_cols = _select_psi(dist, p_all, compass_fraction)
+    scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)[:, :, a_cols // step]
+    il, ip, ia = np.unravel_index(int(np.argmin(scores)), scores.shape)
+    best_a, best_p, best = int(a_cols[ia]), int(p_cols[ip]), float(scores[il, ip, ia])
+    if fine_search:
+        def at(ac, pc):
+            return warp2d_scores_at(dist, ac, pc, np.full(ac.size, il, np.int64), v_tab, k_tab)
+
+        best_a, best_p, best = _fine(at, best_a, best_p, best, width, n_alpha, n_psi)
+    return _result(best_a, best_p, rhos[il], best, width, n_psi_searched=int(p_cols.size))

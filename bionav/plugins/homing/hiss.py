@@ -1,0 +1,93 @@
+"""Homing in Scale Space as a homing plugin: ``hiss``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.homing.base import HomeVector, HomingMethod
+
+
+class HissHoming(HomingMethod):
+    """Homing in Scale Space (Churchill & Vardy 2008), SIFT-based, no compass needed.
+
+    SIFT matches whose keypoints shrank pull the home vector towards them,
+    those that grew push it away (:func:`bionav.homing.hiss.hiss`). Only
+    azimuths within the current view are used, so the views need not be
+    aligned.
+    """
+
+    name = "hiss"
+    requires_alignment = False
+
+    @dataclass
+    class Config:
+        """Parameters of HiSS.
+
+        image_size: [W, H] the panorama is resized to (area averaging); null keeps it.
+        wrap_pad: columns copied from the other end on each side before SIFT, as a
+            fraction of the width (keypoints across the 0/360 degree seam).
+        ratio: Lowe ratio of the descriptor matching.
+        scale_threshold: matches with size ratio within [1/(1+t), 1+t] are ignored.
+        n_features, contrast_threshold, edge_threshold, sigma: OpenCV SIFT parameters.
+        """
+
+        image_size: list[int] | None = None
+        wrap_pad: float = 0.1
+        ratio: float = 0.8
+        scale_threshold: float = 0.0
+        n_features: int = 0
+        contrast_threshold: float = 0.04
+        edge_threshold: float = 10.0
+        sigma: float = 1.6
+
+    def __init__(self, config: Any, *, geometry) -> None:
+        super().__init__(config, geometry=geometry)
+        cfg = self.config
+        if cfg.image_size is not None and (len(cfg.image_size) != 2 or min(cfg.image_size) < 8):
+            raise UserError(
+                f"homing.image_size={list(cfg.image_size)} is not a usable [W, H] size for SIFT; "
+                "give two integers of at least 8, or null to keep the database's size"
+            )
+        if not (0.0 <= cfg.wrap_pad <= 1.0):
+            raise UserError(f"homing.wrap_pad={cfg.wrap_pad} must lie in [0, 1] (a fraction of the width)")
+        if not (0.0 < cfg.ratio <= 1.0):
+            raise UserError(f"homing.ratio={cfg.ratio} must lie in (0, 1] (Lowe's ratio test; 0.8 is usual)")
+        if cfg.scale_threshold < 0:
+            raise UserError(f"homing.scale_threshold={cfg.scale_threshold} must be >= 0")
+
+    def prepare(self, image):
+        """SIFT features of the (resized) panorama: dict of arrays (see :func:`bionav.homing.hiss.sift_features`)."""
+        from bionav.homing.hiss import sift_features
+        from bionav.homing.warping.preprocess import resize_panorama
+
+        img = np.asarray(image, dtype=np.float32)
+        if img.ndim == 3:
+            img = img.mean(axis=2, dtype=np.float32)
+        geometry = self.geometry
+        if img.shape != (geometry.height, geometry.width):
+            geometry = geometry.resized(img.shape[1], img.shape[0])
+        img, _ = resize_panorama(img, geometry=geometry, size=self.config.image_size)
+        cfg = self.config
+        return sift_features(
+            img,
+            wrap_pad=cfg.wrap_pad,
+            n_features=cfg.n_features,
+            contrast_threshold=cfg.contrast_threshold,
+            edge_threshold=cfg.edge_threshold,
+            sigma=cfg.sigma,
+        )
+
+    def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
+        """HiSS home direction in the current view's frame (NaN when no match changed scale)."""
+        from bionav.homing.hiss import hiss
+
+        r = hiss(snapshot, current, ratio=self.config.ratio, scale_threshold=self.config.scale_threshold)
+        return HomeVector(
+            angle=r.home_angle,
+            compass=None,
+            extras={"n_matches": r.n_matches, "n_contracted": r.n_contracted, "n_expanded": r.n_expanded},
+        )

@@ -1,0 +1,336 @@
+"""The warping family as homing plugins: ``minwarping``, ``warping2d``, ``warping1d``.
+
+Each plugin resizes the canonical panorama itself (``image_size``, area
+averaging), optionally low-pass filters it first (Butterworth, thesis 5.1.4),
+does the per-image work in :meth:`prepare` (scale-plane stack or horizon strip)
+and the per-pair search in :meth:`home_vector`. All three estimate the rotation
+between the views (visual compass, ``HomeVector.compass = psi``), so they need
+no aligned images. The algorithms live in :mod:`bionav.homing.warping`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.homing.base import HomeVector, HomingMethod
+
+
+def _grey(image) -> np.ndarray:
+    img = np.asarray(image, dtype=np.float32)
+    if img.ndim == 3:
+        img = img.mean(axis=2, dtype=np.float32)
+    if img.ndim != 2:
+        raise UserError(
+            f"the warping methods need panoramas of shape (H, W) or (H, W, C), got shape {img.shape}; "
+            "check the database's images"
+        )
+    return img
+
+
+def _check_common(name: str, cfg) -> None:
+    if cfg.image_size is not None:
+        if len(cfg.image_size) != 2 or min(cfg.image_size) < 3:
+            raise UserError(
+                f"homing.image_size={list(cfg.image_size)} is not a valid [W, H] size for {name}; "
+                "give two positive integers such as homing.image_size=[288,50]"
+            )
+    if cfg.butterworth_cutoff is not None and not (0.0 < cfg.butterworth_cutoff <= 1.0):
+        raise UserError(
+            f"homing.butterworth_cutoff={cfg.butterworth_cutoff} is outside (0, 1]; give the cutoff "
+            "relative to the Nyquist frequency (the thesis uses 0.1) or null to switch the filter off"
+        )
+    if cfg.butterworth_order < 1:
+        raise UserError(f"homing.butterworth_order={cfg.butterworth_order} must be >= 1 (the thesis uses 3)")
+
+
+def _prepare_image(method: HomingMethod, image):
+    from bionav.homing.warping import butterworth_lowpass, resize_panorama
+
+    cfg = method.config
+    img = _grey(image)
+    if cfg.butterworth_cutoff is not None:
+        img = butterworth_lowpass(img, cutoff=cfg.butterworth_cutoff, order=cfg.butterworth_order)
+    geometry = method.geometry
+    if img.shape != (geometry.height, geometry.width):
+        geometry = geometry.resized(img.shape[1], img.shape[0])
+    return resize_panorama(img, geometry=geometry, size=cfg.image_size)
+
+
+class _PlaneWarping(HomingMethod):
+    """Shared parts of min-warping and 2D-warping (scale-plane stack per image)."""
+
+    requires_alignment = False
+
+    def __init__(self, config: Any, *, geometry) -> None:
+        super().__init__(config, geometry=geometry)
+        self._check()
+        self._template = None
+        self._template_width = None
+
+    def _scales(self):
+        from bionav.homing.warping.scaleplanes import check_scales, default_scales
+
+        cfg = self.config
+        scales = default_scales() if cfg.scales is None else [float(x) for x in cfg.scales]
+        thresholds = None if cfg.thresholds is None else [float(x) for x in cfg.thresholds]
+        return check_scales(scales, thresholds)
+
+    def _check(self) -> None:
+        cfg = self.config
+        name = self.name
+        _check_common(name, cfg)
+        try:
+            self._scales()
+        except ValueError as exc:
+            raise UserError(
+                f"bad homing.scales / homing.thresholds for {name}: {exc}. Give increasing scale "
+                "factors and one threshold per factor with sigma_k < tau_k <= sigma_(k+1), or null "
+                "for the defaults"
+            ) from None
+        width = cfg.image_size[0] if cfg.image_size is not None else self.geometry.width
+        for key in ("n_alpha", "n_psi"):
+            n = getattr(cfg, key)
+            if not (1 <= n <= width):
+                raise UserError(
+                    f"homing.{key}={n} must lie between 1 and the image width {width} (the search "
+                    f"shifts whole columns); e.g. homing.{key}={max(1, width // 3)}"
+                )
+        if not (0.0 < cfg.compass_fraction <= 1.0):
+            raise UserError(
+                f"homing.compass_fraction={cfg.compass_fraction} must lie in (0, 1] (the fraction of "
+                "rotations searched with compass acceleration)"
+            )
+
+    def prepare(self, image):
+        """Resize (and low-pass) the panorama and build its scale-plane stack.
+
+        Returns the dict of :func:`~bionav.homing.warping.scaleplanes.scale_plane_stack`.
+        """
+        from bionav.homing.warping import scale_plane_stack
+
+        img, geometry = _prepare_image(self, image)
+        scales, _ = self._scales()
+        return scale_plane_stack(img, geometry=geometry, scales=scales)
+
+    def _compass_fraction(self):
+        cfg = self.config
+        return cfg.compass_fraction if cfg.compass_acceleration else None
+
+    def _cached_template(self, width: int, build):
+        if self._template is None or self._template_width != width:
+            self._template = build()
+            self._template_width = width
+        return self._template
+
+    @staticmethod
+    def _to_home_vector(result) -> HomeVector:
+        extras = {"alpha": result.alpha, "score": result.score}
+        if np.isfinite(result.rho):
+            extras["rho"] = result.rho
+        extras.update(result.extras)
+        return HomeVector(angle=result.home_angle, compass=result.psi, extras=extras)
+
+
+class MinWarping(_PlaneWarping):
+    """Min-warping (Möller, Krzykawski & Gerstmayr 2010, doi:10.1007/s10514-010-9195-y).
+
+    The holistic 2D-warping method without the equal-distance assumption, with
+    visual compass. Defaults are the fast settings (288 x 50 pixels, 96 x 96
+    search steps, 9 scale planes ``2 ** ((k - 4) / 4)``); the preset
+    ``homing=minwarping_thesis`` holds the thesis' tables 5.1 and 5.2.
+    """
+
+    name = "minwarping"
+
+    @dataclass
+    class Config:
+        """Parameters of min-warping.
+
+        image_size: [W, H] the panorama is resized to (area averaging); null keeps it.
+        butterworth_cutoff: relative cutoff of a Butterworth low-pass applied before
+            resizing; null switches it off (thesis: 0.1, order 3).
+        butterworth_order: order of that filter.
+        n_alpha, n_psi: search steps over 360 degrees for movement direction and rotation.
+        scales: scale factors of the planes; null = 2 ** ((k - 4) / 4), k = 0..8.
+        thresholds: upper scale thresholds per plane; null = geometric midpoints.
+        compass_acceleration: search only compass_fraction of the rotations, those the
+            visual compass measure ranks best.
+        compass_fraction: fraction of rotations searched with compass acceleration.
+        fine_search: refine alpha and psi at one-column resolution.
+        double_search: also search with snapshot and current view exchanged.
+        """
+
+        image_size: list[int] | None = field(default_factory=lambda: [288, 50])
+        butterworth_cutoff: float | None = None
+        butterworth_order: int = 3
+        n_alpha: int = 96
+        n_psi: int = 96
+        scales: list[float] | None = None
+        thresholds: list[float] | None = None
+        compass_acceleration: bool = False
+        compass_fraction: float = 0.25
+        fine_search: bool = False
+        double_search: bool = False
+
+    def _check(self) -> None:
+        super()._check()
+        cfg = self.config
+        width = cfg.image_size[0] if cfg.image_size is not None else self.geometry.width
+        if cfg.double_search and width % 2:
+            raise UserError(
+                f"homing.double_search needs an even image width, got {width}; "
+                "change homing.image_size"
+            )
+
+    def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
+        """Min-warping search; ``angle`` in the current view's frame, ``compass = psi``."""
+        from bionav.homing.warping import minwarping
+        from bionav.homing.warping.templates import minwarp_template
+
+        cfg = self.config
+        width = int(np.shape(snapshot["snap"])[-1])
+
+        def build():
+            scales, tau = self._scales()
+            return minwarp_template(width, scales, tau)
+
+        result = minwarping(
+            snapshot,
+            current,
+            n_alpha=cfg.n_alpha,
+            n_psi=cfg.n_psi,
+            thresholds=self._scales()[1],
+            compass_fraction=self._compass_fraction(),
+            fine_search=cfg.fine_search,
+            double_search=cfg.double_search,
+            template=self._cached_template(width, build),
+        )
+        return self._to_home_vector(result)
+
+
+class Warping2D(_PlaneWarping):
+    """2D-warping with the equal-distance assumption (Möller 2009, doi:10.1016/j.robot.2008.05.005).
+
+    Searches movement direction, rotation and distance ratio ``rho``; visual
+    compass included. Defaults as :class:`MinWarping` plus ``rho`` in
+    ``0 .. 0.95`` in 20 steps (table 5.1).
+    """
+
+    name = "warping2d"
+
+    @dataclass
+    class Config:
+        """Parameters of 2D-warping (see :class:`MinWarping.Config`; plus ``n_rho``, ``rho_max``)."""
+
+        image_size: list[int] | None = field(default_factory=lambda: [288, 50])
+        butterworth_cutoff: float | None = None
+        butterworth_order: int = 3
+        n_alpha: int = 96
+        n_psi: int = 96
+        n_rho: int = 20
+        rho_max: float = 0.95
+        scales: list[float] | None = None
+        thresholds: list[float] | None = None
+        compass_acceleration: bool = False
+        compass_fraction: float = 0.25
+        fine_search: bool = False
+
+    def _check(self) -> None:
+        super()._check()
+        cfg = self.config
+        if cfg.n_rho < 1 or not (0.0 <= cfg.rho_max < 1.0):
+            raise UserError(
+                f"homing.n_rho={cfg.n_rho} / homing.rho_max={cfg.rho_max} are invalid: need n_rho >= 1 "
+                "and 0 <= rho_max < 1 (the thesis uses 20 steps up to 0.95)"
+            )
+
+    def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
+        """2D-warping search; ``angle`` in the current view's frame, ``compass = psi``."""
+        from bionav.homing.warping import warping2d
+        from bionav.homing.warping.search import rho_grid
+        from bionav.homing.warping.templates import warp2d_template
+
+        cfg = self.config
+        width = int(np.shape(snapshot["snap"])[-1])
+
+        def build():
+            return warp2d_template(width, rho_grid(cfg.n_rho, cfg.rho_max), self._scales()[1])
+
+        result = warping2d(
+            snapshot,
+            current,
+            n_alpha=cfg.n_alpha,
+            n_psi=cfg.n_psi,
+            n_rho=cfg.n_rho,
+            rho_max=cfg.rho_max,
+            thresholds=self._scales()[1],
+            compass_fraction=self._compass_fraction(),
+            fine_search=cfg.fine_search,
+            template=self._cached_template(width, build),
+        )
+        return self._to_home_vector(result)
+
+
+class Warping1D(HomingMethod):
+    """1D warping of the horizon strip (Franz et al. 1998), with visual compass.
+
+    Defaults are Vardy's settings: 36 steps each for alpha, psi and rho, rho up to 0.95.
+    """
+
+    name = "warping1d"
+    requires_alignment = False
+
+    @dataclass
+    class Config:
+        """Parameters of 1D warping.
+
+        image_size: [W, H] the panorama is resized to before the strip is taken.
+        butterworth_cutoff, butterworth_order: optional low-pass before resizing.
+        strip_rows: rows around the horizon averaged into the strip.
+        n_alpha, n_psi, n_rho: search steps; rho_max: largest distance ratio.
+        """
+
+        image_size: list[int] | None = field(default_factory=lambda: [288, 50])
+        butterworth_cutoff: float | None = None
+        butterworth_order: int = 3
+        strip_rows: int = 5
+        n_alpha: int = 36
+        n_psi: int = 36
+        n_rho: int = 36
+        rho_max: float = 0.95
+
+    def __init__(self, config: Any, *, geometry) -> None:
+        super().__init__(config, geometry=geometry)
+        cfg = self.config
+        _check_common(self.name, cfg)
+        if cfg.strip_rows < 1:
+            raise UserError(f"homing.strip_rows={cfg.strip_rows} must be >= 1")
+        if min(cfg.n_alpha, cfg.n_psi, cfg.n_rho) < 1 or not (0.0 <= cfg.rho_max < 1.0):
+            raise UserError(
+                f"1D warping needs n_alpha, n_psi, n_rho >= 1 and 0 <= rho_max < 1; got "
+                f"{cfg.n_alpha}, {cfg.n_psi}, {cfg.n_rho} and {cfg.rho_max}"
+            )
+
+    def prepare(self, image):
+        """Resize (and low-pass) the panorama and average its horizon rows; shape (W,)."""
+        from bionav.homing.warping import horizon_strip
+
+        img, geometry = _prepare_image(self, image)
+        rows = min(self.config.strip_rows, img.shape[0])
+        return horizon_strip(img, geometry=geometry, rows=rows)
+
+    def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
+        """1D-warping search; ``angle`` in the current view's frame, ``compass = psi``."""
+        from bionav.homing.warping import warping1d
+
+        cfg = self.config
+        r = warping1d(
+            snapshot, current, n_alpha=cfg.n_alpha, n_psi=cfg.n_psi, n_rho=cfg.n_rho, rho_max=cfg.rho_max
+        )
+        return HomeVector(
+            angle=r.home_angle, compass=r.psi, extras={"alpha": r.alpha, "rho": r.rho, "score": r.score}
+        )
