@@ -1,8 +1,9 @@
 """Histogram signatures [hist] and [ent] (thesis 3.5.2, eqs. 3.53-3.54).
 
 Both rotation invariant. [hist] holds relative frequencies and [ent] the
-Shannon entropy of them; the bins span each image's own intensity range by
-default (see :mod:`bionav.homing.signatures.histogram` for these documented choices).
+Shannon entropy of them; the bins span the fixed range ``[0, 1]`` by default,
+or each image's own range (see :mod:`bionav.homing.signatures.histogram` for
+these documented choices).
 """
 
 from __future__ import annotations
@@ -21,14 +22,17 @@ class HistogramConfig:
     rings : number of rings ``R`` (thesis sweep: 1, 5, 10, 15, 20, 25).
     bins : number of histogram bins ``B`` (the thesis does not state ``B``;
         16 is bionav's choice).
-    bin_range : ``image`` -- the bins span each image's own ``[min, max]``
-        (informative after edge filtering, which compresses the range);
-        ``unit`` -- the fixed range ``[0, 1]`` shared by all images.
+    bin_range : ``unit`` -- the fixed range ``[0, 1]`` shared by all images
+        (like the fixed grey levels of 8-bit images); ``image`` -- each image's
+        own ``[min, max]``, which keeps the histogram informative after
+        preprocessing that compresses the range (a low-passed, edge-filtered
+        panorama may lie within ``[0, 0.02]`` and fill only the first bin),
+        at the price of depending on two extreme pixels.
     """
 
     rings: int = 20
     bins: int = 16
-    bin_range: str = "image"
+    bin_range: str = "unit"
 
 
 def _value_range(signature):
