@@ -197,3 +197,17 @@ def test_rotated_current_views_give_grid_frame_angles(small_db):
                     offsets[own] = prep[j]
             hv = homing.home_vector(prep[s], prep[c], neighbours=offsets)
             assert abs(np.angle(np.exp(1j * (hv.angle + headings[c] - turned.angles[s, c])))) < 1e-9
+
+
+def test_thesis_tables_attached_to_thesis_databases():
+    for db, table in ranking.THESIS_RANKINGS.items():
+        assert sorted(table) == sorted(SIGNATURE_NAMES), db
+        by_rank = sorted(table.values())
+        assert [r for r, _, _ in by_rank] == list(range(1, 20))
+        assert all(a[1] >= b[1] for a, b in zip(by_rank, by_rank[1:])), db  # ranked by RR*
+    rows = [_row("sim_original", "fc", 0.5, 0.9, k=4), _row("sim_original", "mean", 0.6, 0.8, rings=5)]
+    table = ranking.ranking_table(rows)
+    assert (table[1]["thesis_rank"], table[1]["thesis_rr"], table[1]["thesis_aae"]) == (2, 0.9460, 0.4437)
+    assert table[0]["thesis_rank"] == 10
+    assert "thesis_rr" in ranking.ranking_markdown(table, db="sim_original")
+    assert "thesis_rank" not in ranking.ranking_table([_row("scene", "fc", 0.5, 0.9, k=4)])[0]
