@@ -149,6 +149,13 @@ def test_statistics_plugins_match_functions():
     np.testing.assert_allclose(make_signature("mean", r2).compute(TINY), [0.5, P])
     np.testing.assert_allclose(make_signature("std", r2).compute(TINY), [math.sqrt(0.125), math.sqrt(P * (1 - P))])
     np.testing.assert_allclose(make_signature("hist", r2).compute(TINY), [0.25, 0.75, 11 / 16, 5 / 16])
+    q = P * (1 - P)
+    np.testing.assert_allclose(make_signature("skew", r2).compute(TINY), [0.0, (1 - 2 * P) / math.sqrt(q)], atol=1e-12)
+    np.testing.assert_allclose(make_signature("kurt", r2).compute(TINY), [-1.0, (1 - 6 * q) / q])
+    np.testing.assert_allclose(
+        make_signature("ent", r2).compute(TINY),
+        [-(0.25 * math.log(0.25) + 0.75 * math.log(0.75)), -(11 / 16 * math.log(11 / 16) + P * math.log(P))],
+    )
     unit = {"rings": 1, "bins": 2, "bin_range": "unit"}
     np.testing.assert_allclose(make_signature("hist", unit).compute(0.1 * TINY), [1.0, 0.0])
     np.testing.assert_allclose(make_signature("hist", {**unit, "bin_range": "image"}).compute(0.1 * TINY),
