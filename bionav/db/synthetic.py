@@ -41,7 +41,7 @@ import numpy as np
 
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
-from bionav.geometry import TWO_PI, PanoramaGeometry, wrap_angle
+from bionav.geometry import PanoramaGeometry
 
 #: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
 NATIVE_SIZE = (561, 81)
@@ -217,7 +217,7 @@ def quantise(images: np.ndarray, *, noise: float, rng: np.random.Generator) -> n
 
 
 def render_world_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *,
-                        progress: Callable[[Iterable], Iterable] | None = None) -> np.ndarray:
+                        progress: Callable[[Iterable], Iterable] | None = None, threads: int | None = 1) -> np.ndarray:
     """Render the canonical panoramas (heading 0) at the given grid cells.
 
     Returns
@@ -232,14 +232,16 @@ def render_world_images(world, positions: np.ndarray, geometry: PanoramaGeometry
         it = progress(it)
     for k in it:
         i, j = positions[k]
-        out[k] = render_panorama(world.scene, position=world.cell_position(i, j), heading=0.0, geometry=geometry)
+        out[k] = render_panorama(world.scene, position=world.cell_position(i, j), heading=0.0, geometry=geometry,
+                                 threads=threads)
     return out
 
 
 def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | None = None, seed: int = 0,
                        noise: float = 0.01, rotate_current: bool = False, rotation_seed: int = 0,
                        cache_dir: str | Path | None = None,
-                       progress: Callable[[Iterable], Iterable] | None = None) -> ImageDatabase:
+                       progress: Callable[[Iterable], Iterable] | None = None,
+                       threads: int | None = 1) -> ImageDatabase:
     """Render (or load from cache) one synthetic stand-in database.
 
     Parameters
@@ -265,6 +267,9 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         every world and render parameter); default :func:`default_cache_dir`.
     progress : callable, optional
         Wraps the render loop (e.g. ``ctx.progress``), called only on a cache miss.
+    threads : int or None
+        Render threads (see :func:`bionav.world.render.render_panorama`);
+        the images do not depend on it.
 
     Returns
     -------
@@ -319,7 +324,7 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
             images_u8 = None  # unreadable cache file: render again and overwrite
     cached = images_u8 is not None
     if not cached:
-        imgs = render_world_images(world, positions, geometry, progress=progress)
+        imgs = render_world_images(world, positions, geometry, progress=progress, threads=threads)
         rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x6E6F6973]))
         images_u8 = quantise(imgs, noise=noise, rng=rng)
         try:
@@ -330,12 +335,6 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     images = images_u8.astype(np.float32) / np.float32(255.0)
     if images.shape[-1] == 1:
         images = images[..., 0]
-    headings = np.zeros(len(positions))
-    if rotate_current:
-        rrng = np.random.default_rng(int(rotation_seed))
-        shifts = rrng.integers(0, w, size=len(positions))
-        images = np.stack([np.roll(img, -int(k), axis=1) for img, k in zip(images, shifts)])
-        headings = wrap_angle(TWO_PI * shifts / w)
     meta = {
         "source": "synthetic",
         "world": spec.description,
@@ -350,9 +349,14 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "rotate_current": bool(rotate_current),
         "rotation_seed": int(rotation_seed),
     }
-    return ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
-                         geometry=geometry, spacing_m=float(spec.spacing_m), headings=np.asarray(headings, float),
+    db = ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
+                         geometry=geometry, spacing_m=float(spec.spacing_m),
                          meta=meta)
+    if rotate_current:
+        from bionav.db.rotation import rotate_views
+
+        db = rotate_views(db, seed=rotation_seed)
+    return db
 
 
 def synthetic_database_from_config(cfg, *, cache_dir: str | Path | None = None,

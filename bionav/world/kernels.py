@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 EPS = 1e-6
 INF = 1e30
@@ -446,7 +446,7 @@ def build_shadow_bins(light_params, spheres, casters):
                     counts[k, i] = acc
                     acc += c
                 total = max(total, acc)
-            items = np.empty((nl, max(total, 1)), np.int64)
+            items = np.full((nl, max(total, 1)), -1, np.int64)
             fill = counts.copy()
         for k in range(nl):
             for q in range(casters.shape[0]):
@@ -633,7 +633,7 @@ def _sample_texture(tex, tex_id, size, uu, vv, lod):
     return v0 * (1.0 - fr) + v1 * fr
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def render_kernel(ox, oy, oz, az, el, pix_angle,
                   boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
                   prim_kind, prim_idx, spheres, shadow_grids, shadow_starts, shadow_items,
@@ -649,11 +649,11 @@ def render_kernel(ox, oy, oz, az, el, pix_angle,
     W = az.shape[0]
     C = out.shape[2]
     nl = light_params.shape[0]
-    E = np.empty(C)
-    Eg = np.empty(C)
     cands, counts, el_lo, el_hi, rho_min = _candidates(ox, oy, oz, az, 2.0 * pix_angle, prim_kind, prim_idx,
                                                        boxes, frusta, ells)
-    for r in range(H):
+    for r in prange(H):  # rows are independent: the result does not depend on the number of threads
+        E = np.empty(C)
+        Eg = np.empty(C)
         ce = math.cos(el[r])
         se = math.sin(el[r])
         for j in range(W):
@@ -747,13 +747,13 @@ def render_kernel(ox, oy, oz, az, el, pix_angle,
                 out[r, j, c] = tv * (mat_albedo[m, c] * E[c] + mat_emission[m, c])
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def depth_kernel(ox, oy, oz, az, el, pix_angle, prim_kind, prim_idx, spheres, boxes, frusta, ells,
                  depth, kind_out, index_out):
     """Hit distance (inf for misses), primitive kind and index for every ray of the grid."""
     cands, counts, el_lo, el_hi, rho_min = _candidates(ox, oy, oz, az, 2.0 * pix_angle, prim_kind, prim_idx,
                                                        boxes, frusta, ells)
-    for r in range(el.shape[0]):
+    for r in prange(el.shape[0]):
         ce = math.cos(el[r])
         se = math.sin(el[r])
         for j in range(az.shape[0]):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Sequence
 
+import numba
 import numpy as np
 
 from bionav.geometry import TWO_PI, PanoramaGeometry
@@ -11,7 +12,19 @@ from bionav.world.kernels import depth_kernel, render_kernel
 from bionav.world.scene import CompiledScene, Scene
 
 #: Bump whenever a change to the renderer or a world builder changes pixels (invalidates caches).
-RENDERER_VERSION = 1
+RENDERER_VERSION = 2
+
+
+def _run_threads(threads: int | None, kernel, *args) -> None:
+    """Run a parallel kernel on ``threads`` threads (None = numba's default); the result does not depend on it."""
+    n = numba.config.NUMBA_NUM_THREADS if threads is None else max(1, min(int(threads),
+                                                                          numba.config.NUMBA_NUM_THREADS))
+    prev = numba.get_num_threads()
+    numba.set_num_threads(n)
+    try:
+        kernel(*args)
+    finally:
+        numba.set_num_threads(prev)
 
 
 def _compiled(scene: Scene | CompiledScene) -> CompiledScene:
@@ -54,7 +67,8 @@ def ray_grid(geometry: PanoramaGeometry, heading: float = 0.0, *, supersample: i
 
 def render_panorama(scene: Scene | CompiledScene, *, position: Sequence[float], heading: float = 0.0,
                     geometry: PanoramaGeometry, supersample: int = 1, shadows: bool = True,
-                    exposure: float | None = None, sky=None, clip: bool = True) -> np.ndarray:
+                    exposure: float | None = None, sky=None, clip: bool = True,
+                    threads: int | None = 1) -> np.ndarray:
     """Render the canonical unfolded panorama seen from a pose.
 
     Ray casting with analytic intersections, Lambertian shading with a
@@ -87,6 +101,11 @@ def render_panorama(scene: Scene | CompiledScene, *, position: Sequence[float], 
         defaults to ``scene.sky`` (black if None).
     clip : bool
         Clip the result to ``[0, 1]``.
+    threads : int or None
+        Threads for the row-parallel kernel (``None``: numba's default, all
+        cores). One thread by default: on a shared machine the thread pool
+        costs more than it gains for small images. Results are identical for
+        any number of threads.
 
     Returns
     -------
@@ -108,7 +127,7 @@ def render_panorama(scene: Scene | CompiledScene, *, position: Sequence[float], 
     depth = np.empty((el.size, az.size))
     sky_mask = np.zeros((el.size, az.size), np.bool_)
     pix = max(geometry.rad_per_column, geometry.rad_per_row) / ss
-    render_kernel(ox, oy, oz, az, el, pix,
+    _run_threads(threads, render_kernel, ox, oy, oz, az, el, pix,
                   cs.boxes, cs.box_mats, cs.frusta, cs.frustum_mats, cs.ellipsoids, cs.ellipsoid_mats,
                   cs.prim_kind, cs.prim_idx, cs.spheres, cs.shadow_grids, cs.shadow_starts, cs.shadow_items,
                   cs.mat_tex, cs.mat_fit, cs.mat_scale, cs.mat_albedo, cs.mat_emission, cs.tex_data,
@@ -129,12 +148,12 @@ def render_panorama(scene: Scene | CompiledScene, *, position: Sequence[float], 
 
 
 def render_depth(scene: Scene | CompiledScene, *, position: Sequence[float], heading: float = 0.0,
-                 geometry: PanoramaGeometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                 geometry: PanoramaGeometry, threads: int | None = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Distance to the nearest surface for every pixel of a canonical panorama.
 
     Parameters
     ----------
-    scene, position, heading, geometry
+    scene, position, heading, geometry, threads
         As in :func:`render_panorama`.
 
     Returns
@@ -153,6 +172,6 @@ def render_depth(scene: Scene | CompiledScene, *, position: Sequence[float], hea
     index = np.empty((el.size, az.size), np.int64)
     ox, oy, oz = (float(v) for v in position)
     pix = max(geometry.rad_per_column, geometry.rad_per_row)
-    depth_kernel(ox, oy, oz, az, el, pix, cs.prim_kind, cs.prim_idx, cs.spheres, cs.boxes, cs.frusta, cs.ellipsoids,
+    _run_threads(threads, depth_kernel, ox, oy, oz, az, el, pix, cs.prim_kind, cs.prim_idx, cs.spheres, cs.boxes, cs.frusta, cs.ellipsoids,
                  depth, kind, index)
     return depth, kind, index

@@ -36,8 +36,18 @@ class DevicePlugin:
     schema_name: ClassVar[str] = "bionav.Reading"
     schema: ClassVar[dict] = {"type": "object"}
 
+    #: where the user sets this plugin's parameters (``sensor``, ``pantilt``, or e.g.
+    #: ``experiment.reference`` when an experiment uses a sensor under another role);
+    #: the experiment may overwrite it so error messages name the right key
+    config_prefix: str | None = None
+
     def __init__(self, config: Any) -> None:
         self.config = config
+
+    def config_key(self, field: str) -> str:
+        """The full config key of one parameter, for messages (``sensor.port``)."""
+        group = self.config_group if isinstance(self.config_group, str) else self.config_group[0]
+        return f"{self.config_prefix or group}.{field}"
 
     def attach_simulation(self, scene: Any, rng: Any) -> None:
         """Receive the simulated world (simulated plugins only; others ignore it)."""

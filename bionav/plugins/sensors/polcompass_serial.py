@@ -68,7 +68,7 @@ class PolCompassSerial(SensorPlugin):
             baudrate=self.config.baudrate,
             timeout=self.config.timeout_s,
             device="DLP-IO8-G (polarized-light compass)",
-            config_key="sensor.port",
+            config_key=self.config_key("port"),
             reconnect_attempts=self.config.reconnect_attempts,
             reconnect_delay=self.config.reconnect_delay_s,
         )

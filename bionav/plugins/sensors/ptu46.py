@@ -61,7 +61,7 @@ class PTU46(PanTiltPlugin):
             baudrate=self.config.baudrate,
             timeout=self.config.timeout_s,
             device="PTU-46 pan-tilt unit",
-            config_key="pantilt.port",
+            config_key=self.config_key("port"),
             reconnect_attempts=self.config.reconnect_attempts,
             reconnect_delay=self.config.reconnect_delay_s,
         )

@@ -71,7 +71,7 @@ class TCM2(SensorPlugin):
             baudrate=self.config.baudrate,
             timeout=self.config.timeout_s,
             device="TCM2 compass",
-            config_key="sensor.port",
+            config_key=self.config_key("port"),
             reconnect_attempts=self.config.reconnect_attempts,
             reconnect_delay=self.config.reconnect_delay_s,
         )

@@ -114,18 +114,20 @@ def potted_plant(scene: Scene, rng: np.random.Generator, *, x: float, y: float, 
     """An arboreal plant: pot, stem and clumps of foliage (none below ``min_leaf_z``)."""
     pot = scene.material(texture=tx.value_noise(rng, lo=0.35, hi=0.6), albedo=0.6, scale=0.3)
     soil = scene.material(texture=tx.carpet(rng, lo=0.05, hi=0.2), albedo=0.5, scale=0.2)
-    leaves = scene.material(texture=tx.foliage(rng), albedo=0.45, scale=0.25, kind="foliage")
+    leaves = scene.material(texture=tx.foliage(rng), albedo=0.8, emission=0.12, scale=0.25,  # leaves are translucent
+                            kind="foliage")
     stem = scene.material(texture=tx.bark(rng), albedo=0.4, scale=0.2, kind="bark")
     scene.frustum((x, y), 0.0, 0.35, 0.12, 0.16, material=pot, top=soil)
     scene.cylinder((x, y), 0.35, height * 0.8, 0.02, material=stem)
-    n = 7
+    n = 14
     for k in range(n):
-        z = min_leaf_z + crown * 0.6 + (height - min_leaf_z - crown) * k / (n - 1)
+        rad = crown * rng.uniform(0.35, 0.6)
+        rz = rad * rng.uniform(0.6, 0.9)
+        lo = min_leaf_z + rz
+        z = lo + (height - rz - lo) * (k + rng.uniform(0.0, 1.0)) / n
         a = rng.uniform(0, 2 * np.pi)
-        r = rng.uniform(0.05, 0.2)
-        rad = crown * rng.uniform(0.45, 0.8)
-        rz = min(rad * 0.7, z - min_leaf_z)
-        scene.ellipsoid((x + r * np.cos(a), y + r * np.sin(a), z), (rad, rad, max(rz, 0.05)), material=leaves)
+        r = crown * rng.uniform(0.1, 0.8) * (1.0 - 0.5 * (z - lo) / max(height - lo, 1e-6))
+        scene.ellipsoid((x + r * np.cos(a), y + r * np.sin(a), z), (rad, rad, rz), material=leaves)
 
 
 def tree(scene: Scene, rng: np.random.Generator, *, x: float, y: float, height: float, crown: float,

@@ -197,10 +197,10 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
             scene.add_light(light_band((bx_, 1.2, lz - 0.07), (bx_, ly - 1.2, lz - 0.07), n=4,
                                        intensity=band_intensity))
     n_on = int(door_band) + int(window_band)
-    scene.ambient = Ambient(up=0.22 * n_on + 0.5 * daylight, down=0.14 * n_on + 0.35 * daylight)
+    scene.ambient = Ambient(up=0.22 * n_on + 0.25 * daylight, down=0.14 * n_on + 0.15 * daylight)
     if daylight > 0 and curtains_open:
         for c in win_centres:  # diffuse daylight entering through each window
-            scene.add_light(PointLight((lx - 0.3, c, 2.0), 2.0 * daylight, downward=False))
+            scene.add_light(PointLight((lx - 0.3, c, 2.0), 1.0 * daylight, downward=False))
 
     # ---------------------------------------------------------------- variants
     if plant:
