@@ -1,1 +1,1 @@
-"""bionav.evaluation."""
+"""Evaluation of homing methods: quality measures, the return agent, all-pairs runs."""

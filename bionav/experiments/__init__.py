@@ -1,1 +1,1 @@
-"""bionav.experiments."""
+"""Experiments: one module per experiment, each exposing ``run(cfg, ctx) -> metrics``."""

@@ -1,1 +1,1 @@
-"""bionav.report."""
+"""Tables and statistics across runs and sweeps."""

@@ -1,0 +1,140 @@
+"""``python -m bionav [hydra overrides]``: the one entry point.
+
+This is the one place where user errors become clean messages: one
+paragraph naming the problem and the fix, a non-zero exit status, no
+traceback (the traceback of an unexpected error goes to ``error.log`` in the
+run directory).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+from pathlib import Path
+
+from bionav.errors import UserError
+
+EXIT_USER_ERROR = 2
+EXIT_INTERNAL_ERROR = 1
+
+log = logging.getLogger("bionav")
+
+#: config groups that hold YAML options only (plugin groups come from the registry)
+YAML_GROUPS = ("experiment", "db", "preprocess", "layout", "data", "mode")
+
+
+def _fail(message: str, code: int = EXIT_USER_ERROR) -> None:
+    print(f"bionav: error: {message}", file=sys.stderr)
+    sys.exit(code)
+
+
+def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
+    """Catch unknown plugin names and unwritable output dirs before Hydra starts."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    try:
+        overrides = OverridesParser.create().parse_overrides([a for a in argv if not a.startswith("-")])
+    except Exception:
+        return  # Hydra reports syntax errors itself
+    groups = {g: list(v) for g, v in names.items()}
+    for group in YAML_GROUPS:
+        if _yaml_options(group):  # only groups that exist; otherwise `key=value` is a plain value
+            groups.setdefault(group, [])
+    for override in overrides:
+        key = override.key_or_group
+        if key in groups and not override.is_delete():
+            values = override.value()
+            candidates = values if isinstance(values, list) else [values]
+            if override.is_sweep_override() and not isinstance(values, list):
+                continue
+            for value in candidates:
+                if isinstance(value, str) and value not in groups[key] and not _has_yaml(key, value):
+                    choices = sorted(set(groups[key]) | set(_yaml_options(key)))
+                    raise UserError(
+                        f"unknown {key} {value!r}. Available: {', '.join(choices) or '(none installed)'}. "
+                        f"Run `python -m bionav.plugins` to see every installed plugin."
+                    )
+        if key in ("hydra.run.dir", "hydra.sweep.dir"):
+            _check_writable(Path(str(override.value())))
+
+
+def _yaml_options(group: str) -> list[str]:
+    from bionav.config import config_options
+
+    return config_options(group)
+
+
+def _has_yaml(group: str, value: str) -> bool:
+    return value in _yaml_options(group)
+
+
+def _check_writable(path: Path) -> None:
+    probe = path
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    if not probe.is_dir() or not os.access(probe, os.W_OK):
+        what = "is not a directory" if not probe.is_dir() else "is not writable"
+        raise UserError(
+            f"cannot write the output directory {path}: {probe} {what}. "
+            f"Choose another one with hydra.run.dir=... (or hydra.sweep.dir=... for -m)."
+        )
+
+
+def _task(cfg) -> float | None:
+    from hydra.core.hydra_config import HydraConfig
+    from hydra.types import RunMode
+
+    from bionav.experiments.runner import run_experiment
+
+    hc = HydraConfig.get()
+    run_dir = Path(hc.runtime.output_dir)
+    multirun = hc.mode == RunMode.MULTIRUN
+    try:
+        metrics = run_experiment(cfg, run_dir, show_progress=sys.stderr.isatty() or not multirun)
+    except UserError as exc:
+        if multirun:
+            log.error("job %s failed: %s", hc.job.num, exc)
+            return None
+        _fail(f"{exc} (run directory: {run_dir})")
+    except KeyboardInterrupt:
+        _fail(f"interrupted; what was recorded so far is in {run_dir} (metrics.json says failed).", 130)
+    except Exception as exc:
+        if multirun:
+            log.error("job %s failed with an internal error: %s (see %s/error.log)", hc.job.num, exc, run_dir)
+            return None
+        _fail(
+            f"internal error: {type(exc).__name__}: {exc}. This is a bug in bionav or a plugin; the traceback is "
+            f"in {run_dir / 'error.log'} and the run's log in {run_dir / 'run.mcap'}.",
+            EXIT_INTERNAL_ERROR,
+        )
+    if multirun:
+        log.info("job %s: %s", hc.job.num, ", ".join(f"{k}={metrics[k]:.4g}" for k in ("aae", "mae", "rr") if isinstance(metrics.get(k), float)) or metrics.get("status"))
+    else:
+        _print_result(metrics)
+    return None
+
+
+def _print_result(metrics: dict) -> None:
+    from bionav.report.table import format_metrics
+
+    print(format_metrics(metrics))
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        from bionav.config import register_configs
+
+        names = register_configs()
+        if not any(a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv):
+            _precheck(argv, names)
+    except UserError as exc:
+        _fail(str(exc))
+
+    import hydra
+
+    hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
+    sys.argv = [sys.argv[0] or "bionav", *argv]
+    hydra_main()

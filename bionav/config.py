@@ -1,0 +1,146 @@
+"""Hydra wiring: bionav's config search path and the typed configs of plugins.
+
+* Config folders come from the ``bionav.configs`` entry-point group (bionav's
+  own ``conf/`` is registered there too); a small Hydra ``SearchPathPlugin``
+  registered at start-up adds them, so editable installs work (no reliance on
+  Hydra's ``hydra_plugins`` namespace scanning).
+* Every plugin's ``Config`` dataclass is stored in Hydra's ConfigStore under
+  its group (``homing/<name>``, ``signature/<name>``, ...), so
+  ``homing=<name> homing.<param>=<value>`` is validated by Hydra with no YAML.
+  The stored node adds a ``name`` field holding the registry name.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import warnings
+from typing import Any, Sequence
+
+from hydra.core.config_search_path import ConfigSearchPath
+from hydra.core.config_store import ConfigStore
+from hydra.core.plugins import Plugins
+from hydra.plugins.search_path_plugin import SearchPathPlugin
+from omegaconf import DictConfig, OmegaConf
+
+from bionav import registry
+
+#: config groups users select plugins in
+PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller")
+
+
+class BionavSearchPathPlugin(SearchPathPlugin):
+    """Adds every ``bionav.configs`` package to Hydra's config search path."""
+
+    def manipulate_search_path(self, search_path: ConfigSearchPath) -> None:
+        for name, package, _dist in registry.config_packages():
+            search_path.append(provider=f"bionav-{name}", path=f"pkg://{package}")
+
+
+def plugin_node_class(name: str, config_cls: type) -> type:
+    """A dataclass extending a plugin's ``Config`` with its registry ``name``."""
+    fields = {f.name for f in dataclasses.fields(config_cls)}
+    if "name" in fields:
+        return config_cls
+    return dataclasses.make_dataclass(
+        f"{config_cls.__name__}Node",
+        [("name", str, dataclasses.field(default=name))],
+        bases=(config_cls,),
+    )
+
+
+@dataclasses.dataclass
+class BrokenPluginNode:
+    """Placeholder for a plugin that failed to load: selecting it gives a clear error later."""
+
+    name: str = ""
+    broken: bool = True
+
+
+@functools.cache
+def register_configs() -> dict[str, list[str]]:
+    """Register the search-path plugin and all plugin configs (once per process).
+
+    Returns
+    -------
+    dict
+        Config group -> names of the plugins stored in it (broken ones included).
+    """
+    Plugins.instance().register(BionavSearchPathPlugin)
+    store = ConfigStore.instance()
+    names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
+    for kind in registry.GROUPS:
+        with warnings.catch_warnings():
+            warnings.simplefilter("default", registry.PluginWarning)
+            loaded = registry.plugins_of(kind)
+        for name, plugin in loaded.items():
+            group = plugin.config_group
+            names.setdefault(group, []).append(name)
+            if plugin.cls is None:
+                store.store(group=group, name=name, node=BrokenPluginNode(name=name), provider="bionav")
+                continue
+            node_cls = plugin_node_class(name, plugin.cls.Config)
+            store.store(group=group, name=name, node=node_cls, provider=plugin.entry.distribution)
+    return names
+
+
+def config_options(group: str) -> list[str]:
+    """YAML options of a config group across every ``bionav.configs`` package (sorted)."""
+    from importlib.resources import files
+
+    options: set[str] = set()
+    for _name, package, _dist in registry.config_packages():
+        try:
+            folder = files(package) / group
+            options |= {p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml")}
+        except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
+            continue
+    return sorted(options)
+
+
+def compose(overrides: Sequence[str] = (), *, config_name: str = "config") -> DictConfig:
+    """Compose bionav's configuration outside the command line (tests, tools).
+
+    Parameters
+    ----------
+    overrides : sequence of str
+        Hydra overrides such as ``["homing=mfdid", "db.seed=3"]``.
+    """
+    from hydra import compose as hydra_compose
+    from hydra import initialize_config_module
+    from hydra.core.global_hydra import GlobalHydra
+
+    register_configs()
+    GlobalHydra.instance().clear()
+    with initialize_config_module(config_module="bionav.conf", version_base="1.3"):
+        return hydra_compose(config_name=config_name, overrides=list(overrides))
+
+
+def plugin_config(kind: str, node: Any) -> Any:
+    """Validate a config node against its plugin's ``Config`` and return the dataclass instance.
+
+    Parameters
+    ----------
+    kind : str
+        Plugin kind (``homing``, ``signature``, ``sensor``, ``controller``).
+    node : DictConfig or Mapping
+        Config node with a ``name`` key and the plugin's parameters.
+    """
+    from bionav.errors import UserError
+
+    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
+    name = plain.pop("name", None)
+    plain.pop("broken", None)
+    cls = registry.load_plugin(kind, name)
+    valid = {f.name for f in dataclasses.fields(cls.Config)}
+    unknown = sorted(set(plain) - valid)
+    if unknown:
+        raise UserError(
+            f"the {kind} plugin {name!r} has no parameter(s) {', '.join(unknown)}; "
+            f"its parameters are {', '.join(sorted(valid)) or '(none)'}."
+        )
+    try:
+        merged = OmegaConf.merge(OmegaConf.structured(cls.Config), plain)
+        return cls, OmegaConf.to_object(merged)
+    except Exception as exc:  # omegaconf validation errors
+        raise UserError(f"bad value for the {kind} plugin {name!r}: {exc}") from None

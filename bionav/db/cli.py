@@ -1,0 +1,94 @@
+"""``python -m bionav.db``: look at a database, or export it as a folder.
+
+    python -m bionav.db show <db> [--out DIR] [overrides ...]
+    python -m bionav.db export <db> DIR [--bits 8|16] [--force] [overrides ...]
+
+Overrides are Hydra overrides of the composed config, e.g. ``db.seed=1``,
+``db.image_size=[288,50]``, ``data_dir=/data/panoramas``, ``db.path=DIR``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from pathlib import Path
+
+from bionav.errors import UserError
+
+
+def _parser(names: list[str]) -> argparse.ArgumentParser:
+    listing = ", ".join(names) if names else "(none found)"
+    parser = argparse.ArgumentParser(
+        prog="python -m bionav.db",
+        description="Inspect or export a bionav image database.",
+        epilog=f"databases: {listing}. Real databases are read from data_dir/<name> "
+               "(data_dir= or BIONAV_DATA); db=folder reads db.path=DIR.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="{show,export}")
+    show = sub.add_parser("show", help="write a contact sheet and a grid map PNG",
+                          description="Write <db>_contact.png (thumbnails laid out like the grid) and "
+                                      "<db>_grid.png (which cells exist).",
+                          epilog=f"databases: {listing}")
+    show.add_argument("db", help="database name")
+    show.add_argument("--out", type=Path, default=None, help="output folder (default: outputs/db/<db>)")
+    show.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. db.seed=1 data_dir=DIR")
+    export = sub.add_parser("export", help="write the database as <x>_<y>.png files (Vardy naming)",
+                            description="Write every image as <x>_<y>.png in the Bielefeld convention, "
+                                        "readable with db=folder db.path=DIR.",
+                            epilog=f"databases: {listing}")
+    export.add_argument("db", help="database name")
+    export.add_argument("dir", type=Path, help="output folder")
+    export.add_argument("--bits", type=int, choices=(8, 16), default=None,
+                        help="PNG bit depth (default: 8 if lossless, else 16)")
+    export.add_argument("--force", action="store_true", help="overwrite images already in DIR")
+    export.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. db.seed=1")
+    return parser
+
+
+def run(argv: list[str]) -> int:
+    """Run the command line (raises UserError for problems the user can fix)."""
+    from bionav.db.compose import available_databases, compose_database
+    from bionav.db.loading import load_database
+
+    parser = _parser(available_databases())
+    args, extra = parser.parse_known_args(argv)
+    unknown = [a for a in extra if a.startswith("-") or "=" not in a]
+    if unknown:
+        parser.error(f"unrecognized arguments: {' '.join(unknown)}")
+    args.overrides = list(args.overrides) + extra
+    composed = compose_database(args.db, args.overrides)
+    db = load_database(composed.db, data_dir=composed.data_dir, cache_dir=composed.cache_dir)
+    if args.command == "show":
+        from bionav.db.sheets import write_show
+
+        out = args.out if args.out is not None else Path("outputs") / "db" / args.db
+        try:
+            paths = write_show(db, out)
+        except OSError as exc:
+            raise UserError(f"cannot write to {out}: {exc}; choose a writable folder with --out DIR.") from None
+        nx, ny = db.grid_shape
+        print(f"{db.name}: {len(db)} images of {db.images.shape[2]} x {db.images.shape[1]} pixels "
+              f"on a {nx} x {ny} grid ({db.spacing_m:g} m spacing)")
+        for path in paths:
+            print(f"wrote {path}")
+    else:
+        from bionav.db.export import export_database
+
+        overrides = export_database(db, args.dir, bits=args.bits, overwrite=args.force)
+        print(f"wrote {len(db)} images of {db.name} to {args.dir}")
+        print("read back with: python -m bionav " + " ".join(overrides))
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point: user errors become one message on stderr and exit status 2."""
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s: %(message)s")
+    try:
+        return run(sys.argv[1:] if argv is None else list(argv))
+    except UserError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,107 @@
+"""Writing any database as a folder in Vardy naming (Bielefeld convention)."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from bionav.db.conventions import from_canonical
+from bionav.db.database import ImageDatabase
+from bionav.db.imageio import write_image
+from bionav.db.naming import VARDY_PATTERN
+from bionav.errors import UserError
+
+log = logging.getLogger(__name__)
+
+SIDECAR = "bionav-export.yaml"
+
+
+def exact_in_8bit(images: np.ndarray) -> bool:
+    """True if every value is (within float32 rounding) a multiple of 1/255."""
+    scaled = np.asarray(images, dtype=np.float64) * 255.0
+    return bool(np.all(np.abs(scaled - np.rint(scaled)) < 1e-3))
+
+
+def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None,
+                    overwrite: bool = False) -> list[str]:
+    """Write ``db`` as ``<x>_<y>.png`` files that ``db=folder`` reads back.
+
+    The images are written in the Bielefeld convention (azimuth clockwise with
+    the column index, column 0 along the grid's +x axis), i.e. the canonical
+    columns mirrored: ``disk[:, c] = canonical[:, (-c) mod W]``. Geometry that
+    the folder loader cannot infer from the files (grid shape, spacing, horizon
+    row, vertical angle per row) goes into the overrides returned and into the
+    sidecar ``bionav-export.yaml``.
+
+    Parameters
+    ----------
+    db : ImageDatabase
+    out_dir : Path
+        Created if needed.
+    bits : {8, 16}, optional
+        PNG bit depth; by default 8 when that is lossless (every value a
+        multiple of 1/255, e.g. synthetic databases with 8-bit quantisation)
+        and 16 otherwise.
+    overwrite : bool
+        Allow writing into a folder that already holds ``<x>_<y>.*`` images.
+
+    Returns
+    -------
+    list of str
+        The overrides that load the export back as the same database:
+        ``db=folder db.path=... db.grid_shape=... db.spacing_m=...
+        db.horizon_row=... db.rad_per_row=...``.
+    """
+    out_dir = Path(out_dir)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot create the export folder {out_dir}: {exc.strerror or exc}; "
+                        "choose a writable directory.") from None
+    existing = [p.name for p in out_dir.iterdir() if VARDY_PATTERN.match(p.name)]
+    if existing and not overwrite:
+        raise UserError(
+            f"{out_dir} already holds database images ({', '.join(existing[:3])}"
+            f"{' ...' if len(existing) > 3 else ''}); export into an empty folder or pass --force to overwrite."
+        )
+    for name in existing:
+        (out_dir / name).unlink()
+    if np.any(np.asarray(db.headings) != 0):
+        log.warning("database %s has rotated views; the export writes them as they are and "
+                    "reads back with heading 0", db.name)
+    if bits is None:
+        bits = 8 if exact_in_8bit(db.images) else 16
+    disk = from_canonical(db.images, azimuth="clockwise", x_axis_column=0.0)
+    try:
+        for (x, y), image in zip(db.positions, disk):
+            write_image(out_dir / f"{int(x)}_{int(y)}.png", image, bits=bits)
+    except OSError as exc:
+        raise UserError(f"cannot write the exported images to {out_dir}: {exc}; check the folder's "
+                        "permissions and free space.") from None
+    g = db.geometry
+    overrides = [
+        "db=folder",
+        f"db.path={out_dir.resolve()}",
+        "db.naming=vardy",
+        f"db.grid_shape=[{db.grid_shape[0]},{db.grid_shape[1]}]",
+        f"db.spacing_m={float(db.spacing_m)!r}",
+        f"db.horizon_row={float(g.horizon_row)!r}",
+        f"db.rad_per_row={float(g.rad_per_row)!r}",
+    ]
+    sidecar = [
+        f"# {len(db)} images of database {db.name!r} exported by python -m bionav.db export",
+        "# Vardy naming <x>_<y>.png, Bielefeld convention (azimuth clockwise, column 0 along +x).",
+        "# Load with: python -m bionav " + " ".join(overrides),
+        f"name: {db.name}",
+        f"bits: {bits}",
+        f"grid_shape: [{db.grid_shape[0]}, {db.grid_shape[1]}]",
+        f"spacing_m: {float(db.spacing_m)!r}",
+        f"width: {g.width}",
+        f"height: {g.height}",
+        f"horizon_row: {float(g.horizon_row)!r}",
+        f"rad_per_row: {float(g.rad_per_row)!r}",
+    ]
+    (out_dir / SIDECAR).write_text("\n".join(sidecar) + "\n")
+    return overrides

@@ -1,0 +1,216 @@
+"""Loading a real image database from a folder (``source: folder``).
+
+The loader reads the files of one naming scheme (:mod:`bionav.db.naming`),
+validates them, optionally unfolds raw mirror frames
+(:mod:`bionav.db.unfold`), and converts the on-disk convention into canonical
+panoramas (:mod:`bionav.db.conventions`).
+
+Validation (each a :class:`~bionav.errors.UserError` naming the file and the
+fix): an unreadable, truncated or undecodable file that matches the naming
+scheme; images of different sizes (the most common size wins); a cell outside
+the declared grid; two files for one cell; an empty folder. With
+``db.on_bad_image=skip`` undecodable files, odd-sized images and cells outside
+the grid are skipped with a logged warning instead. Files that do not match the
+naming scheme are ignored with one warning.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from bionav.db.config import DatabaseConfig
+from bionav.db.conventions import azimuth_sign, to_canonical
+from bionav.db.database import ImageDatabase
+from bionav.db.imageio import ImageReadError, read_image
+from bionav.db.naming import Entry, scan_folder
+from bionav.db.unfold import unfold_panorama
+from bionav.errors import UserError
+from bionav.geometry import TWO_PI, PanoramaGeometry
+
+log = logging.getLogger(__name__)
+
+_SKIP_HINT = "or pass db.on_bad_image=skip to skip such files with a warning"
+
+
+class RawFrames:
+    """Lazy access to the raw camera frames of a folder database: ``raw(i)`` reads file ``i`` again.
+
+    Returns the raw frame as float32 grey in ``[0, 1]``, shape ``(h, w)``,
+    before unfolding (and before any resizing or preprocessing).
+    """
+
+    def __init__(self, paths) -> None:
+        self.paths = tuple(Path(p) for p in paths)
+
+    def __call__(self, i: int) -> np.ndarray:
+        try:
+            return read_image(self.paths[int(i)])
+        except ImageReadError as exc:
+            raise UserError(f"cannot re-read the raw image {self.paths[int(i)]}: {exc}.") from None
+
+    def __len__(self) -> int:
+        return len(self.paths)
+
+
+def _grid_shape(cfg: DatabaseConfig, scan, entries: list[Entry]) -> tuple[int, int]:
+    if cfg.grid_shape is not None:
+        shape = tuple(int(v) for v in cfg.grid_shape)
+        if len(shape) != 2 or min(shape) < 1:
+            raise UserError(f"db.grid_shape={list(cfg.grid_shape)} must be two positive integers [nx, ny].")
+        return shape
+    if scan.grid_shape is not None:
+        return tuple(int(v) for v in scan.grid_shape)
+    return (max(e.x for e in entries) + 1, max(e.y for e in entries) + 1)
+
+
+def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
+    """Load a database folder into canonical panoramas.
+
+    Parameters
+    ----------
+    cfg : DatabaseConfig
+        ``naming``, ``azimuth``, ``x_axis_column``, ``horizon_row``,
+        ``rad_per_row``, ``spacing_m``, ``grid_shape``, ``on_bad_image``,
+        ``unfold`` and ``extra.bw_cutoff`` are used; the conventions describe
+        the images as they lie on disk (after unfolding, for raw frames) and
+        the grid frame after the naming scheme's index conversion.
+    folder : Path
+        Existing directory holding the images.
+
+    Returns
+    -------
+    ImageDatabase
+        Images ``(N, H, W)`` float32 in ``[0, 1]``, canonical (column 0 along
+        grid +x, azimuth counter-clockwise); positions of the cells that exist;
+        geometry with the on-disk horizon row and vertical angle per row (rows
+        are not changed by the conversion); ``raw`` set when unfolding.
+    """
+    folder = Path(folder)
+    policy = str(cfg.on_bad_image).strip().lower()
+    if policy not in ("error", "skip"):
+        raise UserError(f"db.on_bad_image={cfg.on_bad_image!r} must be 'error' or 'skip'.")
+    skip = policy == "skip"
+    azimuth_sign(cfg.azimuth)  # validate early
+    extra = dict(cfg.extra or {})
+    scan = scan_folder(folder, naming=cfg.naming, grid_shape=cfg.grid_shape, bw_cutoff=extra.get("bw_cutoff"))
+    if scan.ignored:
+        shown = ", ".join(scan.ignored[:5]) + (" ..." if len(scan.ignored) > 5 else "")
+        log.warning("%s: ignoring %d file(s) that do not follow the %s naming scheme: %s",
+                    folder, len(scan.ignored), scan.scheme, shown)
+
+    entries = sorted(scan.entries, key=lambda e: (e.x, e.y, e.path.name))
+    nx, ny = _grid_shape(cfg, scan, entries)
+    skipped: list[str] = []
+
+    def bad(entry: Entry, problem: str, fix: str) -> None:
+        if not skip:
+            raise UserError(f"cannot load database {cfg.name!r}: {entry.path} {problem}; {fix}, {_SKIP_HINT}.")
+        log.warning("skipping %s: it %s", entry.path, problem)
+        skipped.append(entry.path.name)
+
+    seen: dict[tuple[int, int], Entry] = {}
+    for entry in entries:
+        cell = (entry.x, entry.y)
+        if cell in seen:
+            raise UserError(
+                f"cannot load database {cfg.name!r}: grid cell {cell} is given by two files, "
+                f"{seen[cell].path.name} and {entry.path.name} in {folder}; remove or rename one of them."
+            )
+        seen[cell] = entry
+    inside = []
+    for entry in entries:
+        if 0 <= entry.x < nx and 0 <= entry.y < ny:
+            inside.append(entry)
+        else:
+            bad(entry, f"is at grid cell ({entry.x}, {entry.y}), outside the declared {nx} x {ny} grid",
+                "fix db.grid_shape=[nx,ny] (or set it to null to use the bounding box of the files) "
+                "or remove the file")
+
+    unfold = cfg.unfold
+    frames, kept = [], []
+    for entry in inside:
+        try:
+            frames.append(read_image(entry.path))
+            kept.append(entry)
+        except ImageReadError as exc:
+            bad(entry, f"is not a readable image ({exc})", "replace or remove the file")
+
+    if frames:
+        sizes = Counter(f.shape for f in frames)
+        common = sizes.most_common(1)[0][0]
+        example = next(e for e, f in zip(kept, frames) if f.shape == common)
+        ok_frames, ok_entries = [], []
+        for entry, frame in zip(kept, frames):
+            if frame.shape == common:
+                ok_frames.append(frame)
+                ok_entries.append(entry)
+            else:
+                bad(entry, f"is {frame.shape[1]} x {frame.shape[0]} pixels while the other images "
+                    f"(e.g. {example.path.name}) are {common[1]} x {common[0]}",
+                    "a database needs one image size: resize or remove the odd file")
+        frames, kept = ok_frames, ok_entries
+    if not frames:
+        raise UserError(
+            f"cannot load database {cfg.name!r}: none of the {len(entries)} image file(s) in {folder} "
+            f"could be used (skipped: {', '.join(skipped[:5])}); fix the files or db.grid_shape."
+        )
+
+    raw = None
+    if unfold is not None and unfold.enabled:
+        frames = _unfold_all(frames, unfold, kept[0].path)
+        raw = RawFrames(e.path for e in kept)
+    disk = np.stack(frames).astype(np.float32, copy=False)
+    height, width = disk.shape[1:]
+    images = to_canonical(disk, azimuth=cfg.azimuth, x_axis_column=cfg.x_axis_column)
+
+    horizon_row = cfg.horizon_row if cfg.horizon_row is not None else scan.horizon_row
+    rad_per_row = cfg.rad_per_row if cfg.rad_per_row is not None else scan.rad_per_row
+    geometry = PanoramaGeometry(
+        width, height,
+        float(horizon_row) if horizon_row is not None else (height - 1) / 2.0,
+        float(rad_per_row) if rad_per_row is not None else TWO_PI / width,
+    )
+    if scan.meta.get("w") not in (None, width) and not (unfold is not None and unfold.enabled):
+        log.warning("%s: the .db file says w=%s but the images are %d pixels wide",
+                    folder, scan.meta.get("w"), width)
+    meta = {
+        "source": "folder",
+        "path": str(folder),
+        "naming": scan.scheme,
+        "files": [e.path.name for e in kept],
+        "skipped": skipped,
+        "conventions": {"azimuth": cfg.azimuth, "x_axis_column": float(cfg.x_axis_column),
+                        "horizon_row": geometry.horizon_row, "rad_per_row": geometry.rad_per_row},
+        "unfolded": bool(raw is not None),
+    }
+    meta.update({f"scheme_{k}": v for k, v in scan.meta.items()})
+    return ImageDatabase(
+        name=cfg.name,
+        images=images,
+        positions=np.array([(e.x, e.y) for e in kept], dtype=np.int64).reshape(-1, 2),
+        grid_shape=(nx, ny),
+        geometry=geometry,
+        spacing_m=float(cfg.spacing_m),
+        raw=raw,
+        meta=meta,
+    )
+
+
+def _unfold_all(frames, unfold, first_path: Path) -> list[np.ndarray]:
+    h, w = frames[0].shape
+    center = unfold.center if unfold.center is not None else [(w - 1) / 2.0, (h - 1) / 2.0]
+    outer = float(unfold.outer_radius) if unfold.outer_radius else min(w, h) / 2.0 - 1.0
+    inner = float(unfold.inner_radius)
+    if len(center) != 2 or not 0 <= inner < outer or len(unfold.size) != 2 or min(unfold.size) < 1:
+        raise UserError(
+            f"db.unfold is inconsistent (center={list(center)}, inner_radius={inner}, "
+            f"outer_radius={outer}, size={list(unfold.size)}): need center=[cx,cy], "
+            "0 <= inner_radius < outer_radius in pixels of the raw frame, and size=[W,H]."
+        )
+    log.debug("unfolding %d raw frames of %d x %d (first: %s)", len(frames), w, h, first_path)
+    return [unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size)
+            for f in frames]

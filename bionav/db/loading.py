@@ -1,0 +1,154 @@
+"""The one public entry for getting a database: :func:`load_database`."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from bionav.db.config import DatabaseConfig
+from bionav.db.database import ImageDatabase
+from bionav.db.preprocess import preprocess_database, resize_database
+from bionav.errors import UserError
+from bionav.geometry import TWO_PI
+
+log = logging.getLogger(__name__)
+
+#: The real databases of thesis table 3.1 (plus hall2 of appendix B); each has a
+#: synthetic stand-in ``sim_<name>``.
+REAL_DATABASES = ("original", "arboreal", "chairs", "day", "doorlit", "screen", "twilight", "winlit",
+                  "hall1", "hall2", "moeller1", "roeben1", "uni")
+
+
+def as_database_config(cfg) -> DatabaseConfig:
+    """A :class:`DatabaseConfig` from a dataclass, an OmegaConf node or a plain mapping.
+
+    Raises
+    ------
+    UserError
+        Unknown keys or values of the wrong type (message names the key).
+    """
+    if isinstance(cfg, DatabaseConfig):
+        return cfg
+    from omegaconf import OmegaConf
+    from omegaconf.errors import OmegaConfBaseException
+
+    try:
+        if OmegaConf.is_config(cfg):  # resolve ${data_dir} etc. against the full config first
+            cfg = OmegaConf.to_container(cfg, resolve=True)
+        merged = OmegaConf.merge(OmegaConf.structured(DatabaseConfig), cfg)
+        return OmegaConf.to_object(merged)
+    except OmegaConfBaseException as exc:
+        key = getattr(exc, "full_key", None)
+        where = f"db.{key}" if key else "a db.* value"
+        raise UserError(f"invalid db configuration, {where}: {str(exc).splitlines()[0]}; "
+                        f"fix {where} (see the DatabaseConfig fields in bionav/db/config.py).") from None
+
+
+def _missing_folder_message(cfg: DatabaseConfig, folder: Path, data_dir: Path) -> str:
+    name = cfg.name
+    if cfg.source == "folder" and name == "folder" and cfg.path is None:
+        return ("db=folder needs the folder that holds the images: pass db.path=DIR "
+                "(images named <x>_<y>.png, see python -m bionav.db --help).")
+    base = name[4:] if name.startswith("sim_") else name
+    stand_in = (f" db=sim_{base} is its synthetic stand-in, rendered on first use."
+                if base in REAL_DATABASES else "")
+    if cfg.path is not None and Path(cfg.path).resolve() != (Path(data_dir) / name).resolve():
+        where = f"set by db.path={cfg.path}"
+    else:
+        where = f"data_dir={data_dir}, set by data_dir=... or the BIONAV_DATA environment variable"
+    return (f"database {name!r} not found: looked for the folder {folder.resolve()} ({where}). "
+            f"bionav does not ship the real databases; put them under one directory as <dir>/{name}/ and "
+            f"point data_dir=<dir> or the BIONAV_DATA environment variable at it, or give the folder "
+            f"directly with db.path=DIR.{stand_in}")
+
+
+def rotate_views(db: ImageDatabase, *, seed: int) -> ImageDatabase:
+    """Rotate every view by a random whole number of columns (Vardy's protocol).
+
+    Image ``i`` becomes ``roll(images[i], -s_i, axis=-1)`` with ``s_i``
+    uniform in ``[0, W)`` from ``numpy.random.default_rng(seed)``, and its
+    heading becomes ``headings[i] + 2*pi*s_i / W`` (radians CCW from grid +x):
+    column ``j`` of the rotated image looks at grid azimuth
+    ``heading + 2*pi*j / W`` as :mod:`bionav.geometry` requires.
+    """
+    rng = np.random.default_rng(seed)
+    width = db.images.shape[-1]
+    shifts = rng.integers(0, width, size=len(db))
+    cols = (np.arange(width)[None, :] + shifts[:, None]) % width
+    images = np.take_along_axis(db.images, cols[:, None, :], axis=-1)
+    headings = (db.headings + TWO_PI * shifts / width) % TWO_PI
+    meta = dict(db.meta, rotation_seed=int(seed), rotation_shifts=shifts.tolist())
+    return ImageDatabase(name=db.name, images=images, positions=db.positions, grid_shape=db.grid_shape,
+                         geometry=db.geometry, spacing_m=db.spacing_m, headings=headings, raw=db.raw,
+                         meta=meta)
+
+
+def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> ImageDatabase:
+    """Load the database a ``db`` config describes, as canonical panoramas.
+
+    Parameters
+    ----------
+    cfg : DatabaseConfig or DictConfig
+        The ``db`` config node. ``source: synthetic`` renders (or reads from
+        the cache) the stand-in ``cfg.name`` through
+        :func:`bionav.db.synthetic.synthetic_database`; ``source: folder``
+        reads ``cfg.path``, or ``data_dir / cfg.name`` when no path is given
+        (:func:`bionav.db.folder.load_folder`).
+    data_dir : Path
+        Where real databases live (``data_dir=`` / ``BIONAV_DATA``).
+    cache_dir : Path
+        Cache directory for rendered synthetic databases.
+    preprocess : PreprocessConfig or list of steps, optional
+        Applied at the database's native resolution, before the resize to
+        ``db.image_size`` (the thesis filters before unfolding to the final
+        size; see :mod:`bionav.db.preprocess`).
+
+    Returns
+    -------
+    ImageDatabase
+        Resized to ``db.image_size = [W, H]`` (``cv2.INTER_AREA``) if given;
+        folder databases with ``db.rotate_current`` get a random rotation of
+        every view (:func:`rotate_views`, seed ``db.rotation_seed``).
+
+    Raises
+    ------
+    UserError
+        Unknown source, missing folder (the message says where it looked, how
+        to point ``data_dir``/``BIONAV_DATA`` at it and names the ``sim_``
+        stand-in), or any invalid file (see :mod:`bionav.db.folder`).
+    """
+    cfg = as_database_config(cfg)
+    source = str(cfg.source).strip().lower()
+    size = None
+    if cfg.image_size is not None:
+        size = [int(v) for v in cfg.image_size]
+        if len(size) != 2 or min(size) < 1:
+            raise UserError(f"db.image_size={list(cfg.image_size)} must be [W, H] with positive integers.")
+    if source == "synthetic":
+        from bionav.db.synthetic import synthetic_database
+
+        db = synthetic_database(cfg.name, image_size=size, seed=cfg.seed, noise=cfg.noise,
+                                rotate_current=cfg.rotate_current, rotation_seed=cfg.rotation_seed,
+                                cache_dir=Path(cache_dir))
+    elif source == "folder":
+        from bionav.db.folder import load_folder
+
+        if cfg.path is None and cfg.name == "folder":
+            raise UserError(_missing_folder_message(cfg, Path(data_dir), Path(data_dir)))
+        folder = Path(cfg.path).expanduser() if cfg.path is not None else Path(data_dir) / cfg.name
+        if not folder.is_dir():
+            if folder.exists():
+                raise UserError(f"database path {folder} is a file, not a folder; point db.path at the "
+                                "directory that holds the images.")
+            raise UserError(_missing_folder_message(cfg, folder, Path(data_dir)))
+        db = load_folder(cfg, folder)
+    else:
+        raise UserError(f"db.source={cfg.source!r} is not a database source; use synthetic or folder.")
+    db = preprocess_database(db, preprocess)
+    if size is not None:
+        db = resize_database(db, size)
+    if source == "folder" and cfg.rotate_current:
+        db = rotate_views(db, seed=cfg.rotation_seed)
+    return db

@@ -1,0 +1,156 @@
+"""``experiment=contrast_lda``: which spectral contrast separates sky from objects best (thesis 6.2, 6.3).
+
+``python -m bionav experiment=contrast_lda data=sim_natural|sim_artificial|csv [data.path=FILE]``
+
+Writes ``lda_table.csv``/``lda_table.md`` (tables 6.2/6.4), ``significance.md``
+and ``significance_<criterion>.csv`` (tables 6.3/6.5), ``samples.csv`` (the
+data analysed), and plots ``plots/uv_g_uv_ir.png`` (fig. 6.3),
+``plots/pairs.png`` (figs. 6.4/6.5), ``plots/projection_histograms.png``
+(figs. D.1/D.2) and ``plots/criteria.png``. ``metrics.json`` holds ``J``,
+``J_sigma`` and ``n_f`` (a fraction), each keyed by feature name.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from bionav.errors import UserError
+
+#: Names ``data=`` accepts.
+DATASETS = ("sim_natural", "sim_artificial", "csv")
+
+
+def _get(node, key, default=None):
+    try:
+        value = node.get(key, default) if hasattr(node, "get") else getattr(node, key, default)
+    except Exception:  # omegaconf missing value
+        return default
+    return default if value is None else value
+
+
+def load_samples(data):
+    """The sample set a ``data`` config node names.
+
+    Parameters
+    ----------
+    data : mapping
+        ``name`` (``sim_natural``, ``sim_artificial`` or ``csv``) and its
+        options: ``seed``, ``n_objects``, ``n_sky``, ``n_average``,
+        ``noise_counts`` for the simulated sets; ``path`` for ``csv``.
+
+    Returns
+    -------
+    SampleSet
+    """
+    from bionav.spectral.sensor_model import LogSensorModel
+
+    name = str(_get(data, "name", ""))
+    if name == "csv":
+        path = _get(data, "path")
+        if not path or str(path) == "???":
+            raise UserError("data=csv needs the file: add data.path=/path/to/samples.csv (columns class,UV,B,G,R,IR, "
+                            "optional kind,time).")
+        from bionav.spectral.csv_io import read_samples_csv
+
+        try:
+            from hydra.utils import to_absolute_path
+
+            path = to_absolute_path(str(path))
+        except Exception:
+            pass
+        return read_samples_csv(path)
+    if name in ("sim_natural", "sim_artificial"):
+        from bionav.spectral import samples as sim
+
+        sensor = LogSensorModel(noise_counts=float(_get(data, "noise_counts", 4.0)))
+        default_objects = 239 if name == "sim_natural" else 124
+        fn = sim.sim_natural if name == "sim_natural" else sim.sim_artificial
+        return fn(seed=int(_get(data, "seed", 0)), n_objects=int(_get(data, "n_objects", default_objects)),
+                  n_sky=int(_get(data, "n_sky", 233)), sensor=sensor, n_average=int(_get(data, "n_average", 10)))
+    raise UserError(f"Unknown data set {name!r} for experiment=contrast_lda. Choose data=sim_natural, "
+                    f"data=sim_artificial, or data=csv data.path=FILE.")
+
+
+def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator, out_dir, plots_dir,
+            title: str = "", progress=None) -> dict:
+    """Run the whole analysis on a sample set and write tables and plots.
+
+    Parameters
+    ----------
+    samples : SampleSet
+    sigma : float
+        Receptor noise for J_sigma, counts.
+    n_resamples : int
+        Bootstrap resamples for the significance tables (0 skips them).
+    rng : numpy.random.Generator
+    out_dir, plots_dir : path-like
+        Where tables and figures go.
+    title : str
+        Title for tables and figures.
+
+    Returns
+    -------
+    dict
+        Metrics: ``J``, ``J_sigma``, ``n_f`` keyed by feature, plus scalars.
+    """
+    from bionav.experiments import spectral_plots as sp
+    from bionav.spectral import lda_analysis as la
+    from bionav.spectral.csv_io import write_samples_csv
+
+    out_dir, plots_dir = Path(out_dir), Path(plots_dir)
+    results = la.analyse_features(samples, sigma=sigma)
+    la.write_lda_table_csv(results, out_dir / "lda_table.csv")
+    (out_dir / "lda_table.md").write_text(la.lda_table_markdown(results, title=title, sigma=sigma))
+    write_samples_csv(samples, out_dir / "samples.csv")
+    if n_resamples > 0:
+        sig = la.bootstrap_significance(samples, results, sigma=sigma, n_resamples=n_resamples, rng=rng)
+        (out_dir / "significance.md").write_text(la.significance_markdown(sig, title=title, n_resamples=n_resamples))
+        for crit, s in sig.items():
+            la.write_significance_csv(s, out_dir / f"significance_{crit}.csv")
+    sp.plot_pairs(samples, results, plots_dir / "uv_g_uv_ir.png", names=["UV-G", "UV-IR"], title=title)
+    sp.plot_pairs(samples, results, plots_dir / "pairs.png", title=title)
+    sp.plot_projection_histograms(samples, results, plots_dir / "projection_histograms.png", title=title)
+    sp.plot_criteria(results, plots_dir / "criteria.png", title=title)
+    best = max(results, key=lambda n: results[n].J)
+    return {
+        "J": {n: r.J for n, r in results.items()},
+        "J_sigma": {n: r.J_sigma for n, r in results.items()},
+        "n_f": {n: r.n_f for n, r in results.items()},
+        "n_sky": samples.n_sky,
+        "n_objects": samples.n_objects,
+        "best_feature_J": best,
+        "sigma": float(sigma),
+    }
+
+
+SAMPLE_TOPIC = "/spectral5/samples"
+SAMPLE_SCHEMA = {
+    "type": "object",
+    "title": "bionav.Spectral5Sample",
+    "description": "One labelled data point of the five-channel sensor (mean counts).",
+    "properties": {
+        "class": {"type": "string", "enum": ["sky", "object"]},
+        "kind": {"type": "string"}, "time": {"type": "string"},
+        "uv": {"type": "number"}, "b": {"type": "number"}, "g": {"type": "number"},
+        "r": {"type": "number"}, "ir": {"type": "number"},
+    },
+}
+
+
+def run(cfg, ctx) -> dict:
+    """Entry point called by bionav's experiment runner."""
+    exp = cfg.experiment
+    data = _get(cfg, "data", None)
+    if data is None:
+        raise UserError("experiment=contrast_lda needs a data set: data=sim_natural, data=sim_artificial or "
+                        "data=csv data.path=FILE.")
+    samples = load_samples(data)
+    for c, sky, k, t in zip(samples.counts, samples.is_sky, samples.kind, samples.time):
+        ctx.log.write(SAMPLE_TOPIC, {"class": "sky" if sky else "object", "kind": str(k), "time": str(t),
+                                     **{ch: float(v) for ch, v in zip(("uv", "b", "g", "r", "ir"), c)}},
+                      schema_name="bionav.Spectral5Sample", schema=SAMPLE_SCHEMA)
+    title = f"{samples.name}: {samples.n_objects} objects, {samples.n_sky} sky"
+    return analyse(samples, sigma=float(_get(exp, "sigma", 30.0)), n_resamples=int(_get(exp, "n_resamples", 10000)),
+                   rng=ctx.rng, out_dir=ctx.dir, plots_dir=ctx.plots, title=title)

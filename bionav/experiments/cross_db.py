@@ -1,0 +1,141 @@
+"""``experiment=cross_db``: snapshots from one database, current views from another (thesis 5.1.4).
+
+Writes ``cross_db.csv`` (for each measure, rows = snapshot database, columns =
+current-view database), heatmaps like thesis fig. 5.6, and metrics.json with
+AAE*, MAE*, RR* averaged over all off-diagonal database pairs.
+"""
+
+from __future__ import annotations
+
+import csv
+from importlib.resources import files
+from typing import Any
+
+import numpy as np
+import yaml
+from omegaconf import DictConfig, OmegaConf
+
+from bionav.errors import UserError
+from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
+from bionav.evaluation.pairs import home_vector_matrix, prepare_images
+from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
+from bionav.experiments.grid_homing import evaluate_agents
+
+#: settings of cfg.db that apply to every member of the family
+SHARED_DB_KEYS = ("image_size", "seed", "noise", "rotate_current", "rotation_seed")
+MEASURES = ("aae", "mae", "rr")
+
+
+def db_preset(name: str) -> dict:
+    """The ``conf/db/<name>.yaml`` preset from any config package."""
+    from bionav import registry
+
+    for _n, package, _d in registry.config_packages():
+        try:
+            path = files(package) / "db" / f"{name}.yaml"
+            if path.is_file():
+                return yaml.safe_load(path.read_text()) or {}
+        except ModuleNotFoundError:
+            continue
+    raise UserError(f"the cross_db family names the database {name!r}, which has no preset (conf/db/{name}.yaml).")
+
+
+def family_nodes(cfg: DictConfig) -> list[dict]:
+    shared = {k: OmegaConf.to_container(cfg.db, resolve=True).get(k) for k in SHARED_DB_KEYS}
+    nodes = []
+    for name in cfg.experiment.family:
+        node = db_preset(str(name))
+        node.update({k: v for k, v in shared.items() if v is not None})
+        if isinstance(node.get("path"), str) and "${data_dir}" in node["path"]:
+            node["path"] = node["path"].replace("${data_dir}", str(cfg.data_dir))
+        nodes.append(node)
+    return nodes
+
+
+def _plot(path, matrices: dict[str, np.ndarray], names: list[str], title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
+    labels = {"aae": "AAE* (rad)", "mae": "MAE* (rad)", "rr": "RR*"}
+    for ax, key in zip(axes, MEASURES):
+        m = matrices[key]
+        # light = good, as thesis fig. 5.6
+        cmap = "gray" if key == "rr" else "gray_r"
+        im = ax.imshow(m, cmap=cmap, vmin=0, vmax=1 if key == "rr" else max(np.nanmax(m), 1e-9))
+        ax.set_xticks(range(len(names)), names, rotation=60, ha="right", fontsize=7)
+        ax.set_yticks(range(len(names)), names, fontsize=7)
+        ax.set_xlabel("current-view database")
+        ax.set_ylabel("snapshot database")
+        ax.set_title(labels[key])
+        for i in range(len(names)):
+            for j in range(len(names)):
+                ax.text(j, i, f"{m[i, j]:.2f}", ha="center", va="center", fontsize=6, color="tab:red")
+        fig.colorbar(im, ax=ax, shrink=0.8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    exp = cfg.experiment
+    nodes = family_nodes(cfg)
+    names = [str(n) for n in exp.family]
+    dbs = [load_configured_database(cfg, node) for node in ctx.progress(nodes, desc="databases")]
+    first = dbs[0]
+    for name, db in zip(names, dbs):
+        if tuple(db.grid_shape) != tuple(first.grid_shape) or db.geometry != first.geometry:
+            raise UserError(
+                f"cross_db needs one grid and image geometry for the whole family, but {name} differs from "
+                f"{names[0]} ({db.grid_shape} vs {first.grid_shape}); choose databases of one family."
+            )
+    method = make_homing(cfg, ctx, first.geometry)
+    cache = prepared_cache(cfg)
+    prepared = [prepare_images(method, list(db.images), workers=int(cfg.workers), cache=cache) for db in dbs]
+    stride = max(1, int(exp.snapshot_stride))
+    pos = first.positions
+    snap_idx = np.flatnonzero((pos[:, 0] % stride == 0) & (pos[:, 1] % stride == 0))
+
+    n = len(dbs)
+    matrices = {k: np.full((n, n), np.nan) for k in MEASURES}
+    per_pair_ms = []
+    for i in range(n):
+        for j in range(n):
+            hv = home_vector_matrix(
+                method, dbs[i], dbs[j], snapshot_index=snap_idx, workers=int(cfg.workers),
+                prepared=(prepared[i], prepared[j]),
+            )
+            ae = angular_errors(hv.angles, ideal_home_angles(dbs[i].positions[snap_idx], dbs[j].positions))
+            success, _ = evaluate_agents(
+                dbs[j], hv, step_length=float(exp.step_length), success_radius=float(exp.success_radius)
+            )
+            q = quality_measures(ae, success)
+            matrices["aae"][i, j], matrices["mae"][i, j], matrices["rr"][i, j] = q.aae, q.mae, q.rr
+            per_pair_ms.append(hv.ms_per_home_vector)
+            ctx.log.write(
+                "/cross_db/cell",
+                {"snapshot_db": names[i], "current_db": names[j], "aae": q.aae, "mae": q.mae, "rr": q.rr,
+                 "aae_s": q.aae_s, "rr_s": q.rr_s, "snapshots": dbs[i].positions[snap_idx]},
+                schema_name="bionav.CrossDbCell",
+            )
+
+    with open(ctx.dir / "cross_db.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["measure", "snapshot_db", *names])
+        for key in MEASURES:
+            for i in range(n):
+                w.writerow([key, names[i], *[f"{v:.6f}" for v in matrices[key][i]]])
+    _plot(ctx.plots / "cross_db.png", matrices, names, f"cross-database test, homing={cfg.homing.name}")
+    off = ~np.eye(n, dtype=bool)
+    return {
+        "homing": str(cfg.homing.name),
+        "aae": float(np.mean(matrices["aae"][off])),
+        "mae": float(np.mean(matrices["mae"][off])),
+        "rr": float(np.mean(matrices["rr"][off])),
+        "n_databases": n,
+        "n_snapshots": int(len(snap_idx)),
+        "ms_per_home_vector": float(np.mean(per_pair_ms)),
+    }

@@ -1,0 +1,124 @@
+"""``experiment=grid_homing``: all-pairs homing on a grid database (thesis 3.2, 5.1).
+
+Writes metrics.json (aae, mae, rr, n_images, n_pairs, ms_per_home_vector,
+compass_aae for methods with a compass), per_snapshot.csv, run.mcap (home
+vectors per snapshot, agent paths of the plotted snapshots) and plots/.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig
+
+from bionav.evaluation.agent import run_agents
+from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
+from bionav.evaluation.pairs import home_vector_matrix
+from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
+
+HOME_VECTOR_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "snapshot": {"type": "array", "items": {"type": "integer"}, "description": "snapshot cell (x, y)"},
+        "currents": {"type": "array", "description": "current-view cells (x, y)"},
+        "angles": {"type": "array", "description": "home directions, radians CCW in the grid frame (null: none)"},
+        "ae": {"type": "array", "description": "angular errors, radians"},
+        "success": {"type": "array", "description": "agent reached the snapshot"},
+    },
+}
+
+
+def evaluate_agents(db, hv, *, step_length: float, success_radius: float, record: set[int] = frozenset()):
+    """Agent trials from every existing cell towards every evaluated snapshot."""
+    success = np.zeros(hv.angles.shape, dtype=bool)
+    paths = {}
+    for row, si in enumerate(hv.snapshot_index):
+        result, p = run_agents(
+            hv.angles[row], db.positions, db.positions[si], db.positions,
+            grid_shape=db.grid_shape, step_length=step_length, success_radius=success_radius,
+            record_paths=row in record,
+        )
+        success[row] = result.success
+        if p is not None:
+            paths[row] = p
+    return success, paths
+
+
+def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["x", "y", "aae_s", "mae_s", "rr_s"])
+        for (x, y), a, m, r in zip(positions, measures.aae_s, measures.mae_s, measures.rr_s):
+            w.writerow([int(x), int(y), f"{a:.6f}", f"{m:.6f}", f"{r:.6f}"])
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    from bionav.experiments.homing_plots import plot_home_vector_field, plot_per_snapshot_maps
+
+    exp = cfg.experiment
+    db = load_configured_database(cfg)
+    method = make_homing(cfg, ctx, db.geometry)
+    snapshots = None if exp.get("snapshots") is None else list(exp.snapshots)
+    hv = home_vector_matrix(
+        method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
+        cache=prepared_cache(cfg),
+    )
+    s_pos = db.positions[hv.snapshot_index]
+    ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
+    n_plots = min(int(exp.n_quiver_plots), len(hv.snapshot_index))
+    plotted = set(np.linspace(0, len(hv.snapshot_index) - 1, n_plots).round().astype(int).tolist()) if n_plots else set()
+    success, paths = evaluate_agents(
+        db, hv, step_length=float(exp.step_length), success_radius=float(exp.success_radius), record=plotted
+    )
+    q = quality_measures(ae, success)
+
+    for row, si in enumerate(hv.snapshot_index):
+        ctx.log.write(
+            "/grid_homing/home_vectors",
+            {
+                "snapshot": db.positions[si],
+                "currents": db.positions,
+                "angles": [None if not np.isfinite(a) else float(a) for a in hv.angles[row]],
+                "ae": [None if not np.isfinite(a) else float(a) for a in ae[row]],
+                "success": success[row],
+            },
+            schema_name="bionav.HomeVectorField",
+            schema=HOME_VECTOR_SCHEMA,
+        )
+    for row, p in paths.items():
+        ctx.log.write(
+            "/grid_homing/agent_paths",
+            {"snapshot": db.positions[hv.snapshot_index[row]], "paths": [path.tolist() for path in p]},
+            schema_name="bionav.AgentPaths",
+        )
+
+    write_per_snapshot_csv(ctx.dir / "per_snapshot.csv", s_pos, q)
+    label = f"{cfg.homing.name} on {db.name}"
+    for row in sorted(plotted):
+        si = hv.snapshot_index[row]
+        x, y = db.positions[si]
+        plot_home_vector_field(
+            ctx.plots / f"home_vectors_{x}_{y}.png", positions=db.positions, angles=hv.angles[row],
+            snapshot=db.positions[si], grid_shape=db.grid_shape, paths=paths.get(row), success=success[row],
+            title=f"{label}: snapshot ({x}, {y}), AAE$_s$={q.aae_s[row]:.3f} rad, RR$_s$={q.rr_s[row]:.2f}",
+        )
+    plot_per_snapshot_maps(
+        ctx.plots / "per_snapshot.png", positions=s_pos, grid_shape=db.grid_shape, aae_s=q.aae_s, rr_s=q.rr_s,
+        title=f"{label}: AAE*={q.aae:.3f} rad, MAE*={q.mae:.3f} rad, RR*={q.rr:.3f}",
+    )
+    metrics: dict[str, Any] = {
+        "homing": str(cfg.homing.name),
+        "db": db.name,
+        "aae": q.aae,
+        "mae": q.mae,
+        "rr": q.rr,
+        "n_images": len(db),
+        "n_pairs": hv.n_pairs,
+        "ms_per_home_vector": hv.ms_per_home_vector,
+    }
+    if hv.compass_error is not None:
+        metrics["compass_aae"] = float(np.nanmean(np.abs(hv.compass_error)))
+    return metrics

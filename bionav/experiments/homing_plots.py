@@ -1,0 +1,85 @@
+"""Figures of homing experiments (home-vector fields, per-snapshot heatmaps)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_home_vector_field(
+    path: Path,
+    *,
+    positions: np.ndarray,
+    angles: np.ndarray,
+    snapshot: np.ndarray,
+    grid_shape: tuple[int, int],
+    title: str,
+    paths: Sequence[np.ndarray] | None = None,
+    success: np.ndarray | None = None,
+) -> None:
+    """Quiver plot of the home vectors towards one snapshot (grid frame, x right, y up)."""
+    plt = _pyplot()
+    nx, ny = grid_shape
+    fig, ax = plt.subplots(figsize=(0.45 * nx + 2.0, 0.45 * ny + 1.2))
+    ok = np.isfinite(angles)
+    colors = None
+    if success is not None:
+        colors = np.where(success[ok], "tab:blue", "tab:red")
+    ax.quiver(
+        positions[ok, 0], positions[ok, 1], np.cos(angles[ok]), np.sin(angles[ok]),
+        color=colors if colors is not None else "tab:blue", angles="xy", scale_units="xy", scale=1.6, width=0.006,
+    )
+    if paths is not None:
+        for p in paths:
+            ax.plot(p[:, 0], p[:, 1], color="0.6", lw=0.5, alpha=0.6)
+    ax.plot(*snapshot, marker="*", color="gold", markeredgecolor="k", markersize=16, zorder=5)
+    ax.set_xlim(-1, nx)
+    ax.set_ylim(-1, ny)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (grid units)")
+    ax.set_ylabel("y (grid units)")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_per_snapshot_maps(
+    path: Path,
+    *,
+    positions: np.ndarray,
+    grid_shape: tuple[int, int],
+    aae_s: np.ndarray,
+    rr_s: np.ndarray,
+    title: str,
+) -> None:
+    """Heatmaps of AAE_s and RR_s over the grid, like thesis fig. 5.9 (missing cells blank)."""
+    plt = _pyplot()
+    nx, ny = grid_shape
+    maps = []
+    for values in (aae_s, rr_s):
+        m = np.full((ny, nx), np.nan)
+        m[positions[:, 1], positions[:, 0]] = values
+        maps.append(m)
+    fig, axes = plt.subplots(1, 2, figsize=(2 * (0.35 * nx + 1.6), 0.35 * ny + 1.4))
+    for ax, m, label, cmap, vmax in zip(axes, maps, ("AAE$_s$ (rad)", "RR$_s$"), ("magma_r", "viridis"), (np.pi / 2, 1.0)):
+        im = ax.imshow(m, origin="lower", cmap=cmap, vmin=0, vmax=vmax)
+        ax.set_title(label)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        fig.colorbar(im, ax=ax, shrink=0.8)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

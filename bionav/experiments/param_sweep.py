@@ -1,0 +1,283 @@
+"""``experiment=param_sweep``: the parameter-homing sweep of thesis 5.2.1 (tables 5.5-5.7).
+
+One job evaluates one signature on one database at one image size and
+preprocessing, for every ring count ``R`` (ring-based signatures) or every
+number of Fourier coefficients ``K`` (DFT-based signatures) of the sweep;
+[image] has a single configuration. The Hydra multirun over signature x image
+size x preprocessing (x database) is declared in ``conf/experiment/param_sweep.yaml``
+(``experiment.grid=full`` is the thesis grid, ``experiment.grid=ci`` a reduced one).
+
+For every configuration the signatures are computed once per image
+(:meth:`ParameterHoming.prepare`), the home vectors of all pairs come from
+matrix operations on them (:func:`parameter_home_vector_matrix`, identical to
+the per-pair :meth:`ParameterHoming.home_vector`), and AAE*, MAE*, RR* follow
+thesis 3.2 (:mod:`bionav.evaluation`).
+
+Files in the run directory
+--------------------------
+``param_sweep.jsonl``
+    One JSON object per configuration: database, signature, rings, n_coeffs,
+    bins, image size, preprocessing, gradient, rotation invariance, ``rr``,
+    ``aae``, ``mae``, and the per-snapshot ``positions``, ``aae_s``, ``rr_s``.
+    :mod:`bionav.report.ranking` builds the ranking tables from these files.
+``plots/levels.png``
+    RR* and AAE* against R or K.
+``metrics.json``
+    The best configuration of the job (by RR*, ties by AAE*): ``rr``, ``aae``,
+    ``mae``, ``best_rings`` / ``best_n_coeffs``, ``n_configs``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from typing import Any, Sequence
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from bionav.db.database import ImageDatabase
+from bionav.errors import UserError
+from bionav.evaluation.pairs import NEIGHBOUR_OFFSETS, HomeVectorMatrix
+from bionav.geometry import wrap_angle
+
+ROWS_FILE = "param_sweep.jsonl"
+
+CONFIGURATION_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "signature": {"type": "string"},
+        "rings": {"type": ["integer", "null"]},
+        "n_coeffs": {"type": ["integer", "null"]},
+        "rr": {"type": "number", "description": "RR* (0..1)"},
+        "aae": {"type": "number", "description": "AAE*, radians"},
+        "mae": {"type": "number", "description": "MAE*, radians"},
+        "aae_s": {"type": "array", "description": "AAE_s per snapshot, radians"},
+        "rr_s": {"type": "array", "description": "RR_s per snapshot"},
+    },
+}
+
+
+def sweep_levels(signature_cls: type, *, rings: Sequence[int], n_coeffs: Sequence[int]) -> list[dict[str, int]]:
+    """The configurations one job evaluates: one dict of signature parameters each.
+
+    DFT signatures (a ``n_coeffs`` parameter) vary ``K`` over ``n_coeffs``;
+    ring signatures (a ``rings`` parameter) vary ``R`` over ``rings``; a
+    signature with neither ([image]) has one configuration ``{}``.
+    """
+    names = {f.name for f in dataclasses.fields(signature_cls.Config)}
+    if "n_coeffs" in names:
+        return [{"n_coeffs": int(k)} for k in n_coeffs]
+    if "rings" in names:
+        return [{"rings": int(r)} for r in rings]
+    return [{}]
+
+
+def neighbour_table(db: ImageDatabase) -> np.ndarray:
+    """Index of each cell's grid neighbours at offsets ``(+1,0), (-1,0), (0,+1), (0,-1)``; -1 where missing.
+
+    Returns
+    -------
+    ndarray of int, shape (N, 4)
+    """
+    lut = db.cell_index_map()
+    nx, ny = db.grid_shape
+    out = np.full((len(db), len(NEIGHBOUR_OFFSETS)), -1, dtype=np.int64)
+    for k, (dx, dy) in enumerate(NEIGHBOUR_OFFSETS):
+        x = db.positions[:, 0] + dx
+        y = db.positions[:, 1] + dy
+        ok = (x >= 0) & (x < nx) & (y >= 0) & (y < ny)
+        out[ok, k] = lut[x[ok], y[ok]]
+    return out
+
+
+def parameter_home_vector_matrix(homing, db: ImageDatabase, prepared: Sequence[dict]) -> HomeVectorMatrix:
+    """Home vectors of all pairs of a database for a :class:`ParameterHoming` (vectorised).
+
+    The same angles as the all-pairs runner
+    (:func:`bionav.evaluation.pairs.home_vector_matrix`) calling
+    ``homing.home_vector`` pair by pair -- grid-frame angles (own angle plus the
+    current view's heading), NaN on the snapshot's own cell and where the
+    gradient vanishes -- computed with matrix operations on the prepared signatures.
+
+    Parameters
+    ----------
+    homing : ParameterHoming
+    db : ImageDatabase
+        Snapshots and current views.
+    prepared : sequence of dict
+        ``homing.prepare(image)`` of every image of ``db``.
+
+    Returns
+    -------
+    HomeVectorMatrix
+        ``prepare_s`` is 0 (the caller times the per-image work).
+    """
+    from bionav.homing import parameter as ph
+
+    t0 = time.perf_counter()
+    f = np.stack([p["f"] for p in prepared])
+    if homing.gradient == "test_steps":
+        grad = ph.gradient_matrix_from_test_steps(ph.potential_matrix(f, f), neighbour_table(db))
+    else:
+        dfx = np.stack([p["df_dx"] for p in prepared])
+        dfy = np.stack([p["df_dy"] for p in prepared])
+        grad = ph.matched_filter_gradient_matrix(f, f, dfx, dfy)
+    hx, hy = -grad[..., 0], -grad[..., 1]
+    with np.errstate(invalid="ignore"):
+        angles = np.arctan2(hy, hx)
+    angles[(hx == 0) & (hy == 0)] = np.nan
+    angles[~(np.isfinite(hx) & np.isfinite(hy))] = np.nan
+    angles = wrap_angle(angles + db.headings[None, :])
+    same = np.all(db.positions[:, None, :] == db.positions[None, :, :], axis=2)
+    angles[same] = np.nan
+    return HomeVectorMatrix(
+        snapshot_index=np.arange(len(db)),
+        angles=angles,
+        compass_error=None,
+        prepare_s=0.0,
+        pairs_s=time.perf_counter() - t0,
+        n_pairs=int(np.sum(~same)),
+    )
+
+
+def evaluate_configuration(homing, db: ImageDatabase, *, step_length: float = 0.5, success_radius: float = 1.0):
+    """AAE*/MAE*/RR* of one parameter-homing configuration on one database.
+
+    Signatures are computed once per image; home vectors of all pairs by
+    :func:`parameter_home_vector_matrix`; agents and measures as thesis 3.2.
+
+    Returns
+    -------
+    measures : bionav.evaluation.measures.QualityMeasures
+    hv : HomeVectorMatrix
+        With ``prepare_s`` set to the per-image time.
+    """
+    from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
+    from bionav.experiments.grid_homing import evaluate_agents
+
+    t0 = time.perf_counter()
+    use_raw = db.raw is not None and homing.signature.uses_raw
+    prepared = [homing.prepare(img, raw=db.raw(i) if use_raw else None) for i, img in enumerate(db.images)]
+    prepare_s = time.perf_counter() - t0
+    hv = parameter_home_vector_matrix(homing, db, prepared)
+    hv = dataclasses.replace(hv, prepare_s=prepare_s)
+    ae = angular_errors(hv.angles, ideal_home_angles(db.positions, db.positions))
+    success, _ = evaluate_agents(db, hv, step_length=step_length, success_radius=success_radius)
+    return quality_measures(ae, success), hv
+
+
+def _signature_setup(cfg: DictConfig, ctx):
+    from bionav.config import plugin_config
+    from bionav.plugins.homing.parameter import ParameterHoming
+    from bionav.plugins.signatures import signature_class
+
+    if str(cfg.homing.name) != "parameter":
+        raise UserError(
+            f"experiment=param_sweep sweeps parameter homing, but homing={cfg.homing.name} is selected. "
+            f"Drop the homing= override (the experiment selects homing=parameter)."
+        )
+    _, homing_cfg = plugin_config("homing", cfg.homing)
+    if cfg.get("signature"):
+        sig_cls, sig_cfg = plugin_config("signature", cfg.signature)
+    else:
+        sig_cls = signature_class(homing_cfg.signature)
+        sig_cfg = sig_cls.Config()
+    # homing.rings/n_coeffs/bins pass through to the signature's base config; the sweep varies R or K on top
+    names = {f.name for f in dataclasses.fields(sig_cfg)}
+    passed = {k: getattr(homing_cfg, k) for k in ("rings", "n_coeffs", "bins") if getattr(homing_cfg, k) is not None}
+    sig_cfg = dataclasses.replace(sig_cfg, **{k: v for k, v in passed.items() if k in names})
+    homing_cfg = dataclasses.replace(homing_cfg, signature=sig_cls.name, rings=None, n_coeffs=None, bins=None)
+    return ParameterHoming, homing_cfg, sig_cls, sig_cfg
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    from bionav.experiments.common import load_configured_database
+
+    exp = cfg.experiment
+    homing_cls, homing_cfg, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
+    db = load_configured_database(cfg)
+    levels = sweep_levels(sig_cls, rings=list(exp.rings), n_coeffs=list(exp.n_coeffs))
+    preprocess = str(OmegaConf.select(cfg, "preprocess.name", default="none"))
+    size = f"{db.geometry.width}x{db.geometry.height}"
+    rows: list[dict[str, Any]] = []
+    for level in ctx.progress(levels, desc=f"{sig_cls.name} configurations", total=len(levels)):
+        sig = sig_cls(dataclasses.replace(sig_cfg, **level))
+        homing = homing_cls(homing_cfg, geometry=db.geometry, signature=sig)
+        q, hv = evaluate_configuration(
+            homing, db, step_length=float(exp.step_length), success_radius=float(exp.success_radius)
+        )
+        row = {
+            "db": db.name,
+            "signature": sig.name,
+            "rings": getattr(sig.config, "rings", None),
+            "n_coeffs": getattr(sig.config, "n_coeffs", None),
+            "bins": getattr(sig.config, "bins", None),
+            "image_size": size,
+            "preprocess": preprocess,
+            "gradient": homing.gradient,
+            "rotation_invariant": bool(sig.rotation_invariant),
+            "rr": float(q.rr),
+            "aae": float(q.aae),
+            "mae": float(q.mae),
+            "ms_per_home_vector": hv.ms_per_home_vector,
+            "grid_shape": [int(v) for v in db.grid_shape],
+            "positions": db.positions.tolist(),
+            "aae_s": [_finite(v) for v in q.aae_s],
+            "rr_s": [_finite(v) for v in q.rr_s],
+        }
+        rows.append(row)
+        ctx.log.write(
+            "/param_sweep/configuration", row, schema_name="bionav.ParameterConfiguration", schema=CONFIGURATION_SCHEMA
+        )
+    with open(ctx.dir / ROWS_FILE, "w") as f:
+        for row in rows:
+            f.write(json.dumps(row) + "\n")
+    _plot_levels(ctx.plots / "levels.png", rows, title=f"[{sig_cls.name}] on {db.name}, {size}, {preprocess}")
+
+    best = max(rows, key=lambda r: (r["rr"], -r["aae"]))
+    metrics: dict[str, Any] = {
+        "db": db.name,
+        "signature": sig_cls.name,
+        "gradient": best["gradient"],
+        "rotation_invariant": best["rotation_invariant"],
+        "image_size": size,
+        "preprocess": preprocess,
+        "aae": best["aae"],
+        "mae": best["mae"],
+        "rr": best["rr"],
+        "n_configs": len(rows),
+        "n_images": len(db),
+        "ms_per_home_vector": float(np.mean([r["ms_per_home_vector"] for r in rows])),
+    }
+    for key in ("rings", "n_coeffs"):
+        if best[key] is not None and key in levels[0]:
+            metrics[f"best_{key}"] = best[key]
+    return metrics
+
+
+def _plot_levels(path, rows: list[dict[str, Any]], *, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    key = "n_coeffs" if rows[0]["n_coeffs"] is not None and len(rows) > 1 else "rings"
+    x = [r[key] if r[key] is not None else 0 for r in rows]
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    ax.plot(x, [r["rr"] for r in rows], "o-", label="RR*")
+    ax.plot(x, [r["aae"] for r in rows], "s--", label="AAE* (rad)")
+    ax.set_xlabel("number of Fourier coefficients K" if key == "n_coeffs" else "number of rings R")
+    ax.set_ylim(0, max(1.0, max(r["aae"] for r in rows) * 1.05))
+    ax.legend()
+    ax.grid(alpha=0.3)
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

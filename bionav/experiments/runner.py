@@ -1,0 +1,135 @@
+"""Running one experiment: the files every run writes, whatever happens."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import logging
+import os
+import tempfile
+import time
+import traceback
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from bionav import __version__
+from bionav.errors import UserError
+from bionav.experiments.context import RunContext
+from bionav.logs.writer import McapLog
+
+log = logging.getLogger(__name__)
+
+METRICS_FILE = "metrics.json"
+LOG_FILE = "run.mcap"
+
+
+def write_json_atomic(path: Path, data: Mapping[str, Any]) -> None:
+    """Write JSON via a temporary file and ``os.replace`` (never a half-written file)."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as f:
+            json.dump(data, f, indent=2, sort_keys=False, default=_json_scalar)
+            f.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _json_scalar(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def read_metrics(run_dir: Path) -> dict | None:
+    """The metrics.json of a run directory, or ``None`` if absent or unreadable."""
+    try:
+        return json.loads((Path(run_dir) / METRICS_FILE).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def is_completed(run_dir: Path) -> bool:
+    """True when the run directory holds a metrics.json with ``"status": "completed"``."""
+    metrics = read_metrics(run_dir)
+    return bool(metrics) and metrics.get("status") == "completed"
+
+
+def plugin_versions(cfg: DictConfig) -> dict[str, str]:
+    """Selected plugin names with the distribution and version providing them."""
+    from bionav import registry
+
+    out = {"bionav": __version__}
+    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller"}
+    for group, kind in kinds.items():
+        node = cfg.get(group)
+        if not node or not node.get("name"):
+            continue
+        entry = registry.entry_points_of(kind).get(str(node.name))
+        if entry is not None:
+            out[f"{group}"] = f"{entry.name} ({entry.distribution} {entry.version})"
+    return out
+
+
+def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True) -> dict[str, Any]:
+    """Run ``cfg.experiment.name`` in ``run_dir`` and write metrics.json and run.mcap.
+
+    metrics.json is written atomically with ``"status": "completed"`` on
+    success, or ``"status": "failed"`` and ``"error"`` on any failure (the
+    exception is re-raised); run.mcap is closed properly either way. With
+    ``cfg.bionav.resume`` a run directory whose metrics say completed is
+    left untouched and its metrics returned.
+    """
+    run_dir = Path(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    resume = bool(OmegaConf.select(cfg, "bionav.resume", default=False))
+    if resume and is_completed(run_dir):
+        log.info("resume: %s already completed, skipped", run_dir)
+        metrics = read_metrics(run_dir) or {}
+        metrics["resumed"] = True
+        return metrics
+
+    name = str(cfg.experiment.name)
+    started = time.time()
+    mcap = McapLog(run_dir / LOG_FILE)
+    metrics: dict[str, Any] = {"experiment": name}
+    try:
+        mcap.attach("config.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode(), media_type="application/yaml")
+        mcap.metadata("plugins", plugin_versions(cfg))
+        try:
+            module = importlib.import_module(f"bionav.experiments.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"bionav.experiments.{name}":
+                raise
+            raise UserError(f"there is no experiment named {name!r}; choose one with experiment=<name>.") from None
+        ctx = RunContext(
+            dir=run_dir,
+            log=mcap,
+            rng=np.random.default_rng(int(cfg.get("seed", 0))),
+            cfg=cfg,
+            show_progress=show_progress,
+        )
+        result = module.run(cfg, ctx)
+        metrics.update(result or {})
+        metrics["status"] = "completed"
+    except BaseException as exc:
+        metrics["status"] = "failed"
+        metrics["error"] = str(exc) if isinstance(exc, UserError) else f"{type(exc).__name__}: {exc}"
+        if not isinstance(exc, (UserError, KeyboardInterrupt)):
+            (run_dir / "error.log").write_text(traceback.format_exc())
+        raise
+    finally:
+        metrics["wall_time_s"] = round(time.time() - started, 3)
+        try:
+            mcap.close()
+        finally:
+            write_json_atomic(run_dir / METRICS_FILE, metrics)
+    return metrics

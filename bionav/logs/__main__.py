@@ -1,0 +1,77 @@
+"""``python -m bionav.logs info FILE.mcap`` and ``python -m bionav.logs recover IN OUT``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections import Counter
+
+from bionav.errors import UserError
+
+
+def _info(path: str) -> None:
+    from mcap.reader import make_reader
+
+    from bionav.logs.reader import _open
+
+    with _open(path) as f:
+        try:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+        except Exception as exc:
+            raise UserError(
+                f"{path} has no readable summary ({exc}); if the run crashed while writing, repair it with "
+                f"`python -m bionav.logs recover {path} repaired.mcap`."
+            ) from None
+        if summary is None or summary.statistics is None:
+            raise UserError(f"{path} has no summary section; repair it with `python -m bionav.logs recover`.")
+        stats = summary.statistics
+        counts = Counter()
+        for channel_id, n in stats.channel_message_counts.items():
+            counts[channel_id] = n
+        duration = (stats.message_end_time - stats.message_start_time) / 1e9 if stats.message_count else 0.0
+        print(f"file:        {path}")
+        print(f"messages:    {stats.message_count}")
+        print(f"duration:    {duration:.3f} s")
+        print(f"attachments: {stats.attachment_count}   metadata: {stats.metadata_count}")
+        print("channels:")
+        for channel_id, channel in sorted(summary.channels.items()):
+            schema = summary.schemas.get(channel.schema_id)
+            name = schema.name if schema else "(no schema)"
+            print(f"  {channel.topic:40s} {counts[channel_id]:8d}  {name}")
+        f.seek(0)
+        for meta in make_reader(f).iter_metadata():
+            print(f"metadata {meta.name}:")
+            for key, value in sorted(meta.metadata.items()):
+                print(f"  {key} = {value}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bionav.logs", description="Inspect and repair bionav MCAP logs.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p_info = sub.add_parser("info", help="summarise a log: topics, counts, schemas, metadata")
+    p_info.add_argument("file")
+    p_rec = sub.add_parser("recover", help="rewrite a truncated log into a valid, indexed one")
+    p_rec.add_argument("input")
+    p_rec.add_argument("output")
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "info":
+            _info(args.file)
+        else:
+            from bionav.logs.recover import recover
+
+            report = recover(args.input, args.output)
+            state = "truncated input" if report.truncated else "intact input"
+            print(
+                f"recovered {report.messages} messages on {report.channels} channels, "
+                f"{report.attachments} attachments, {report.metadata} metadata records ({state}) -> {args.output}"
+            )
+    except UserError as exc:
+        print(f"bionav.logs: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

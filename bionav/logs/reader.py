@@ -1,0 +1,67 @@
+"""Reading ``run.mcap`` files back (replay, inspection)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Iterable, Iterator
+
+from mcap.reader import make_reader
+
+from bionav.errors import UserError
+
+
+def _open(path: str | Path):
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(f"the log file {path} does not exist; pass the path of a run.mcap written by a bionav run.")
+    return open(path, "rb")
+
+
+def read_messages(path: str | Path, topics: Iterable[str] | None = None) -> Iterator[tuple[str, int, dict]]:
+    """Yield ``(topic, log_time_ns, message)`` for every JSON message, in log-time order.
+
+    Parameters
+    ----------
+    path : path-like
+        An MCAP file written by :class:`bionav.logs.writer.McapLog`.
+    topics : iterable of str, optional
+        Only these topics.
+
+    Raises
+    ------
+    UserError
+        When the file is missing or unreadable (a truncated file needs
+        ``python -m bionav.logs recover`` first).
+    """
+    with _open(path) as f:
+        reader = make_reader(f)
+        try:
+            for schema, channel, message in reader.iter_messages(
+                topics=None if topics is None else list(topics), log_time_order=True
+            ):
+                yield channel.topic, message.log_time, json.loads(message.data)
+        except UserError:
+            raise
+        except Exception as exc:
+            raise UserError(
+                f"cannot read {path}: {exc}. If the run crashed while writing, repair the log with "
+                f"`python -m bionav.logs recover {path} repaired.mcap`."
+            ) from None
+
+
+def read_attachment(path: str | Path, name: str) -> bytes | None:
+    """The data of the first attachment called ``name``, or ``None``."""
+    with _open(path) as f:
+        reader = make_reader(f)
+        for attachment in reader.iter_attachments():
+            if attachment.name == name:
+                return attachment.data
+    return None
+
+
+def read_metadata(path: str | Path) -> dict[str, dict[str, str]]:
+    """All metadata records, keyed by record name."""
+    with _open(path) as f:
+        reader = make_reader(f)
+        return {m.name: dict(m.metadata) for m in reader.iter_metadata()}

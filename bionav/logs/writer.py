@@ -1,0 +1,150 @@
+"""Writing ``run.mcap``: JSON messages with JSON-schema schemas, flushed as it goes."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+from mcap.writer import CompressionType, Writer
+
+#: permissive schema used when a caller gives none
+ANY_OBJECT_SCHEMA = {"type": "object"}
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def to_json_bytes(message: Mapping[str, Any]) -> bytes:
+    """Serialise a message to compact UTF-8 JSON (numpy arrays become lists)."""
+    return json.dumps(message, default=_json_default, separators=(",", ":"), allow_nan=True).encode()
+
+
+class McapLog:
+    """An MCAP log of JSON messages that survives crashes.
+
+    Every ``flush_interval_s`` seconds (checked on each write) the chunk in
+    progress is finished and written, so a crash loses at most the messages of
+    the last interval; :func:`bionav.logs.recover.recover` turns a truncated
+    file into a valid, indexed one.
+
+    Parameters
+    ----------
+    path : path-like
+        Output file (created or overwritten).
+    flush_interval_s : float
+        Longest time between flushes, in seconds.
+    profile : str
+        MCAP profile string written in the header.
+    """
+
+    def __init__(self, path: str | Path, *, flush_interval_s: float = 2.0, profile: str = "bionav") -> None:
+        self.path = Path(path)
+        self._file = open(self.path, "wb")
+        self._writer = Writer(self._file, compression=CompressionType.ZSTD)
+        self._writer.start(profile=profile, library="bionav")
+        self._schemas: dict[tuple[str, str], int] = {}
+        self._channels: dict[str, int] = {}
+        self._sequence: dict[str, int] = {}
+        self._flush_interval = float(flush_interval_s)
+        self._last_flush = time.monotonic()
+        self._closed = False
+
+    # -- channels -------------------------------------------------------------
+    def _channel(self, topic: str, schema_name: str, schema: Mapping[str, Any] | None) -> int:
+        if topic in self._channels:
+            return self._channels[topic]
+        schema_json = json.dumps(dict(schema or ANY_OBJECT_SCHEMA), sort_keys=True)
+        key = (schema_name, schema_json)
+        if key not in self._schemas:
+            self._schemas[key] = self._writer.register_schema(
+                name=schema_name, encoding="jsonschema", data=schema_json.encode()
+            )
+        self._channels[topic] = self._writer.register_channel(
+            topic=topic, message_encoding="json", schema_id=self._schemas[key]
+        )
+        self._sequence[topic] = 0
+        return self._channels[topic]
+
+    # -- writing --------------------------------------------------------------
+    def write(
+        self,
+        topic: str,
+        message: Mapping[str, Any],
+        *,
+        schema_name: str,
+        schema: Mapping[str, Any] | None = None,
+        log_time_ns: int | None = None,
+    ) -> None:
+        """Append one JSON message.
+
+        Parameters
+        ----------
+        topic : str
+            Channel topic, e.g. ``/homing/home_vectors``. The channel is created
+            on the first message of a topic with the given schema.
+        message : mapping
+            JSON-serialisable content (numpy arrays and scalars are converted).
+        schema_name : str
+            Schema name; Foxglove's well-known names where one fits
+            (``foxglove.PoseInFrame``, ``foxglove.RawImage``...), else ``bionav.<Thing>``.
+        schema : mapping, optional
+            JSON schema of the message; a permissive object schema if omitted.
+        log_time_ns : int, optional
+            Log time in nanoseconds since the Unix epoch; now if omitted. Replayed
+            and simulated sessions pass their own clock.
+        """
+        if self._closed:
+            raise RuntimeError(f"the log {self.path} is already closed")
+        channel = self._channel(topic, schema_name, schema)
+        now = time.time_ns()
+        t = now if log_time_ns is None else int(log_time_ns)
+        self._writer.add_message(
+            channel_id=channel,
+            log_time=t,
+            publish_time=t,
+            data=to_json_bytes(message),
+            sequence=self._sequence[topic],
+        )
+        self._sequence[topic] += 1
+        if time.monotonic() - self._last_flush >= self._flush_interval:
+            self.flush()
+
+    def attach(self, name: str, data: bytes, *, media_type: str) -> None:
+        """Attach a file (e.g. the resolved config as YAML)."""
+        t = time.time_ns()
+        self._writer.add_attachment(create_time=t, log_time=t, name=name, media_type=media_type, data=data)
+
+    def metadata(self, name: str, values: Mapping[str, Any]) -> None:
+        """Add a metadata record (string keys and values)."""
+        self._writer.add_metadata(name=name, data={str(k): str(v) for k, v in values.items()})
+
+    def flush(self) -> None:
+        """Write the chunk in progress to disk now."""
+        self._writer.flush()
+        self._last_flush = time.monotonic()
+
+    def close(self) -> None:
+        """Finish the file: write the summary and index. Safe to call twice."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._writer.finish()
+        finally:
+            self._file.close()
+
+    def __enter__(self) -> "McapLog":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

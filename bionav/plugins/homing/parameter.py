@@ -1,0 +1,197 @@
+"""``homing=parameter``: homing by descent in a parameter-signature potential (thesis 5.2).
+
+Select the signature with ``signature=<name>`` (the 19 thesis names, e.g.
+``mffc_phase``) and the gradient estimator with ``homing.gradient``. See
+:mod:`bionav.homing.parameter` for the algorithms and
+:mod:`bionav.plugins.signatures` for the signatures.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping, Optional
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.geometry import PanoramaGeometry
+from bionav.homing.base import HomeVector, HomingMethod
+
+GRADIENTS = ("auto", "test_steps", "matched_filter")
+
+
+@dataclass
+class Config:
+    """Parameters of ``homing=parameter``.
+
+    signature : thesis name of the parameter signature, used when the caller
+        does not pass a signature instance (the command line's ``signature=``
+        group does).
+    gradient : ``test_steps`` (eq. 5.19: potentials at the neighbouring grid
+        images), ``matched_filter`` (Möller & Vardy 2006: predicted images, no
+        test steps; closed forms C.9/C.11 for [mffc_phase]/[mffc_abs]), or
+        ``auto`` = the thesis' protocol: ``matched_filter`` for the ``mffc_*``
+        signatures and ``test_steps`` for all others.
+    rings, n_coeffs, bins : when set, override the signature's parameter of the
+        same name (``None`` keeps the signature's own config); ignored by
+        signatures without that parameter, so one value can be given to a
+        sweep over several signatures.
+    mf_step : size of the predicted move of the matched filter's finite
+        differences, in units of the assumed (equal) landmark distance; used by
+        signatures without a closed-form derivative.
+    """
+
+    signature: str = "mffc_phase"
+    gradient: str = "auto"
+    rings: Optional[int] = None
+    n_coeffs: Optional[int] = None
+    bins: Optional[int] = None
+    mf_step: float = 0.05
+
+
+def _to_gray(image: np.ndarray) -> np.ndarray:
+    img = np.asarray(image, dtype=np.float64)
+    return img.mean(axis=2) if img.ndim == 3 else img
+
+
+class ParameterHoming(HomingMethod):
+    """Parameter homing with one of the 19 signatures of thesis 3.5.
+
+    Parameters
+    ----------
+    config : Config, mapping or None
+        :class:`Config` (a mapping such as an OmegaConf node is accepted).
+    geometry : PanoramaGeometry
+        Geometry of the images passed to :meth:`prepare` (the matched filter's
+        flow templates need azimuth and elevation of every pixel).
+    signature : Signature or mapping, optional
+        A signature instance (e.g. built from the ``signature=`` config group);
+        or a mapping of parameters for the signature named by ``config.signature``;
+        or ``None`` for that signature with its defaults. The signature class is
+        resolved by :func:`bionav.plugins.signatures.signature_class`.
+
+    Notes
+    -----
+    * Signatures are computed once per image in :meth:`prepare`; with the
+      matched filter, ``prepare`` also stores the signature's derivatives for
+      unit moves along ``x`` and ``y`` of that image, so :meth:`home_vector` is
+      only vector arithmetic.
+    * Home vectors are in the current view's own frame: the test-step offsets
+      and the flow templates are both expressed in it. A rotation-invariant
+      signature therefore needs no aligned views (``requires_alignment`` is
+      False); the others do.
+    * The matched filter ignores raw mirror images (predicted images only exist
+      as unfolded panoramas), so [cog]/[cog_l] then use their synthetic mirror image throughout.
+    * Colour images are averaged over their channels.
+    """
+
+    Config = Config
+    requires_alignment = True
+    uses_test_steps = True
+
+    def __init__(self, config: Any = None, *, geometry: PanoramaGeometry, signature: Any = None) -> None:
+        from bionav.homing.signatures.base import Signature, coerce_config
+        from bionav.plugins.signatures import signature_class
+
+        config = coerce_config(Config, config)
+        super().__init__(config, geometry=geometry)
+        if config.gradient not in GRADIENTS:
+            raise UserError(
+                f"homing.gradient={config.gradient!r} is not a gradient estimator of homing=parameter. "
+                f"Choose one of: {', '.join(GRADIENTS)}."
+            )
+        if not isinstance(signature, Signature):
+            signature = signature_class(config.signature)(signature)
+        names = {f.name for f in dataclasses.fields(signature.config)}
+        overrides = {
+            k: getattr(config, k) for k in ("rings", "n_coeffs", "bins") if getattr(config, k) is not None and k in names
+        }
+        if overrides:
+            signature = type(signature)(dataclasses.replace(signature.config, **overrides))
+        if not config.mf_step > 0:
+            raise UserError(f"homing.mf_step={config.mf_step} must be positive; the default is 0.05.")
+        self.signature = signature
+        gradient = config.gradient
+        if gradient == "auto":
+            gradient = "matched_filter" if signature.name.startswith("mffc") else "test_steps"
+        self.gradient = gradient
+        self.uses_test_steps = gradient == "test_steps"
+        self.requires_alignment = not signature.rotation_invariant
+
+    def prepare(self, image: np.ndarray, *, raw: Any = None) -> dict[str, np.ndarray]:
+        """Signature of one image (and, for the matched filter, its derivatives).
+
+        Parameters
+        ----------
+        image : ndarray, shape (H, W) or (H, W, C)
+            Canonical panorama matching ``geometry``.
+        raw : optional
+            Raw mirror image for signatures computed on it ([cog], [cog_l]);
+            ignored by the matched filter.
+
+        Returns
+        -------
+        dict
+            ``f``: signature, shape (L,); with the matched filter also ``df_dx``,
+            ``df_dy``: its derivatives for unit moves (equal distance 1) along the
+            current view's ``x`` and ``y``.
+        """
+        img = _to_gray(image)
+        if self.gradient == "test_steps":
+            return {"f": self.signature.compute(img, raw=raw)}
+        from bionav.homing.flow_templates import translation_derivatives
+
+        geometry = self.geometry
+        if (geometry.height, geometry.width) != img.shape:
+            geometry = geometry.resized(img.shape[1], img.shape[0])
+        phi, psi = translation_derivatives(img, geometry=geometry)
+        step = self.config.mf_step
+        return {
+            "f": self.signature.compute(img),
+            "df_dx": self.signature.derivative(img, phi, step=step),
+            "df_dy": self.signature.derivative(img, psi, step=step),
+        }
+
+    def home_vector(
+        self,
+        snapshot: Mapping[str, np.ndarray],
+        current: Mapping[str, np.ndarray],
+        *,
+        neighbours: Mapping[tuple[int, int], Mapping[str, np.ndarray]] | None = None,
+    ) -> HomeVector:
+        """Negative potential gradient at the current view (eqs. 5.18, 5.19 or C.9/C.11).
+
+        Parameters
+        ----------
+        snapshot, current : dict
+            Results of :meth:`prepare`.
+        neighbours : mapping, optional
+            Test steps only: prepared images of the current position's grid
+            neighbours keyed by ``(dx, dy)`` in the current view's frame.
+            Central differences where both neighbours along an axis exist,
+            one-sided ones otherwise (:func:`bionav.homing.parameter.gradient_from_test_steps`).
+
+        Returns
+        -------
+        HomeVector
+            ``angle`` in radians CCW in the current view's frame; NaN when the
+            gradient vanishes or no test step is available. ``extras``: the
+            potential ``p`` at the current view.
+        """
+        from bionav.homing import parameter as ph
+
+        fs, fc = snapshot["f"], current["f"]
+        p0 = ph.parameter_potential(fs, fc)
+        if self.gradient == "test_steps":
+            if not neighbours:
+                return HomeVector(angle=math.nan, extras={"potential": p0, "reason": "no test steps"})
+            pots = {d: ph.parameter_potential(fs, n["f"]) for d, n in neighbours.items()}
+            grad = ph.gradient_from_test_steps(p0, pots)
+        else:
+            grad = ph.matched_filter_gradient(fs, fc, current["df_dx"], current["df_dy"])
+        hx, hy = -grad
+        if not (np.isfinite(hx) and np.isfinite(hy)) or (hx == 0.0 and hy == 0.0):
+            return HomeVector(angle=math.nan, extras={"potential": p0})
+        return HomeVector(angle=float(math.atan2(hy, hx)), extras={"potential": p0})

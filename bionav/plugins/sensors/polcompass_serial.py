@@ -1,0 +1,116 @@
+"""``sensor=polcompass_serial``: the polarized-light compass read through a DLP-IO8-G.
+
+Hardware (thesis 4.1, appendix A): three POL-OP units (log-ratio amplifiers)
+on analog lines of a DLP-IO8-G USB data-acquisition board, 115200 baud 8N1.
+On opening, the driver sends ``\\`` once to select binary replies; each
+reading then sends, per unit, the line's one-byte analog command (``Z X C V B
+N M ,`` for lines 1-8) and reads two bytes, most significant first, of a
+10-bit count (``V = count * 5 / 1023``). Every failure (missing or busy port,
+silent board, garbage or short reply, unplugged cable) raises
+:class:`~bionav.errors.DeviceError` naming the port and the command.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from bionav.errors import DeviceError, UserError
+from bionav.plugins.sensors.base import SensorPlugin
+
+ANALOG_COMMANDS = b"ZXCVBNM,"
+
+READING_SCHEMA = {
+    "type": "object",
+    "title": "Polarized-light compass raw reading",
+    "properties": {
+        "counts": {"type": "array", "items": {"type": "integer"}, "description": "10-bit ADC counts, one per POL-OP unit"},
+        "lines": {"type": "array", "items": {"type": "integer"}, "description": "DLP-IO8-G analog lines read (1-8)"},
+    },
+    "required": ["counts", "lines"],
+}
+
+
+@dataclass
+class PolCompassSerialConfig:
+    """Parameters of ``sensor=polcompass_serial``."""
+
+    port: str = "/dev/ttyUSB0"
+    baudrate: int = 115200
+    timeout_s: float = 0.5
+    lines: list[int] = field(default_factory=lambda: [1, 2, 3])
+    reconnect_attempts: int = 1
+    reconnect_delay_s: float = 0.5
+
+
+class PolCompassSerial(SensorPlugin):
+    """Polarized-light compass on a DLP-IO8-G board over a serial port."""
+
+    Config = PolCompassSerialConfig
+    schema_name = "bionav.PolCompassReading"
+    schema = READING_SCHEMA
+
+    def __init__(self, config: PolCompassSerialConfig) -> None:
+        super().__init__(config)
+        lines = [int(v) for v in config.lines]
+        bad = [v for v in lines if not 1 <= v <= 8]
+        if bad or not lines:
+            raise UserError(f"sensor.lines={lines} must list DLP-IO8-G analog lines between 1 and 8, e.g. sensor.lines=[1,2,3].")
+        self.lines = lines
+        self._link = None
+
+    def open(self) -> None:
+        from bionav.serialio import SerialLink
+
+        if self._link is not None:
+            return
+        link = SerialLink(
+            self.config.port,
+            baudrate=self.config.baudrate,
+            timeout=self.config.timeout_s,
+            device="DLP-IO8-G (polarized-light compass)",
+            config_key="sensor.port",
+            reconnect_attempts=self.config.reconnect_attempts,
+            reconnect_delay=self.config.reconnect_delay_s,
+        )
+        link.open()
+        link.on_reconnect = self._init_device
+        self._link = link
+        try:
+            self._init_device()
+        except DeviceError:
+            self.close()
+            raise
+
+    def _init_device(self) -> None:
+        self._link.reset_input()
+        self._link.write(b"\\", command="\\ (binary mode)")
+
+    def close(self) -> None:
+        link, self._link = self._link, None
+        if link is not None:
+            link.close()
+
+    def read_line_count(self, line: int) -> int:
+        """One 10-bit count from analog ``line`` (1-8)."""
+        if self._link is None:
+            self.open()
+        cmd = ANALOG_COMMANDS[line - 1 : line]
+        name = f"{cmd.decode()} (analog line {line})"
+
+        def exchange():
+            self._link.write(cmd, command=name)
+            return self._link.read_exact(2, command=name)
+
+        data = self._link.transact(name, exchange)
+        count = (data[0] << 8) | data[1]
+        if count > 1023:
+            raise self._link.error(
+                name,
+                f"sent garbage {data!r} (count {count} > 1023)",
+                "Check that the port is the DLP-IO8-G, not another device, and that nothing else writes to it.",
+            )
+        return count
+
+    def read(self) -> dict:
+        """One reading: the counts of every configured line."""
+        return {"counts": [self.read_line_count(v) for v in self.lines], "lines": list(self.lines)}

@@ -1,0 +1,89 @@
+"""``sensor=polcompass_sim``: the simulated polarized-light compass.
+
+Produces the same raw readings as ``polcompass_serial`` (10-bit counts per
+POL-OP unit) from the physical model: the experiment's sky (or filter-test
+polarizer) integrated over each photodiode's acceptance cone, the log-ratio
+amplifiers with this device's component tolerances, noise and the ADC
+(:mod:`bionav.polcompass`). The tolerances are drawn once from
+``device_seed`` (the same seed is the same physical device); the noise comes
+from the generator the experiment passes in.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.plugins.sensors.base import SensorPlugin
+from bionav.plugins.sensors.polcompass_serial import READING_SCHEMA
+
+
+@dataclass
+class PolCompassSimConfig:
+    """Parameters of ``sensor=polcompass_sim`` (the simulated device)."""
+
+    noise_v: float = 0.005  # output noise per reading, volts (about one ADC step)
+    gain_sigma: float = 0.03  # relative spread of the log-ratio gains
+    offset_sigma_v: float = 0.03  # spread of the output offsets, volts
+    sensitivity_sigma: float = 0.05  # relative spread of the photodiode pairs' sensitivity ratio
+    angle_sigma_deg: float = 1.0  # polarizer mounting spread
+    device_seed: int = 7  # which simulated device (its tolerances)
+    polarizer_efficiency: float = 0.99
+    cone_half_angle_deg: float = 10.0  # Hamamatsu S5821-1 with lens
+    unit_angles_deg: list[float] = field(default_factory=lambda: [0.0, 60.0, 120.0])
+    lines: list[int] = field(default_factory=lambda: [1, 2, 3])
+
+
+def build_hardware(config: PolCompassSimConfig):
+    """The :class:`~bionav.polcompass.SimulatedCompassHardware` described by ``config``."""
+    from bionav.polcompass import CompassOptics, SimulatedCompassHardware, sample_mismatch
+
+    if len(config.unit_angles_deg) != len(config.lines):
+        raise UserError(
+            f"sensor.unit_angles_deg has {len(config.unit_angles_deg)} entries but sensor.lines has "
+            f"{len(config.lines)}; give one polarizer angle per POL-OP unit."
+        )
+    optics = CompassOptics(
+        unit_angles=tuple(np.deg2rad(config.unit_angles_deg)),
+        polarizer_efficiency=config.polarizer_efficiency,
+        cone_half_angle=np.deg2rad(config.cone_half_angle_deg),
+    )
+    mismatch = sample_mismatch(
+        np.random.default_rng(config.device_seed),
+        n_units=len(config.lines),
+        gain_sigma=config.gain_sigma,
+        offset_sigma_v=config.offset_sigma_v,
+        sensitivity_sigma=config.sensitivity_sigma,
+        angle_sigma=np.deg2rad(config.angle_sigma_deg),
+    )
+    return SimulatedCompassHardware(optics=optics, mismatch=mismatch, noise_v=config.noise_v)
+
+
+class PolCompassSim(SensorPlugin):
+    """Simulated polarized-light compass (needs the experiment's simulated scene)."""
+
+    Config = PolCompassSimConfig
+    simulated = True
+    schema_name = "bionav.PolCompassReading"
+    schema = READING_SCHEMA
+
+    def __init__(self, config: PolCompassSimConfig) -> None:
+        super().__init__(config)
+        self.hardware = build_hardware(config)
+        self.scene = None
+        self.rng = None
+
+    def attach_simulation(self, scene, rng) -> None:
+        self.scene = scene
+        self.rng = rng
+
+    def read(self) -> dict:
+        if self.scene is None:
+            raise UserError(
+                "sensor=polcompass_sim needs a simulated sky, which only a simulation experiment provides; "
+                "use it with experiment=pol_compass, or choose sensor=polcompass_serial for the real compass."
+            )
+        counts = self.hardware.counts(self.scene, self.rng)[0]
+        return {"counts": [int(c) for c in counts], "lines": [int(v) for v in self.config.lines]}

@@ -1,0 +1,150 @@
+"""Per-unit calibration of the POL-OP channels from one rotation.
+
+The thesis (4.2.1) notes that component tolerances make the units' output
+swings differ and compensates them in software. Turning the compass under a
+constant polarization pattern through at least half a turn (one period of the
+signal) reveals each channel's tolerances: with ``x = d cos(2a - 2alpha_i)``
+and ``a = a_0 - psi`` (``psi`` the rotation, CCW), the output of unit ``i`` is
+``V_i(psi) = c_i + g_i p(cos(2 psi - beta_i))`` where ``p`` is the odd
+function ``log10((1 + d u) / (1 - d u))``. Its Fourier series in ``2 psi`` has
+only the constant and odd harmonics, so a least-squares fit of
+``m + sum_{k in {1,3,5,7}} A_k cos(2k psi) + B_k sin(2k psi)`` gives
+
+* the centre ``c_i = m`` exactly (offset and photodiode mismatch),
+* the relative gain ``g_i / mean(g)`` from the fundamental's amplitude (all
+  units see the same degree ``d``); the mean gain stays at its nominal value,
+* the polarizer angle relative to unit 0 from the fundamental's phase,
+  ``alpha_i - alpha_0 = -(beta_i - beta_0) / 2``; unit 0 keeps its nominal angle
+  (it defines the sensor frame).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.polcompass.compass import wrap_axial
+
+
+@dataclass(frozen=True)
+class UnitCalibration:
+    """Per-unit constants used to turn volts into e-vector angles.
+
+    Attributes
+    ----------
+    center_v : ndarray, shape ``(K,)``
+        Output for ``x = 0``, volts.
+    volts_per_decade : ndarray, shape ``(K,)``
+        Gain, volts per decade.
+    unit_angles : ndarray, shape ``(K,)``
+        Polarizer angles, radians, sensor frame.
+    """
+
+    center_v: np.ndarray
+    volts_per_decade: np.ndarray
+    unit_angles: np.ndarray
+
+    @classmethod
+    def nominal(cls, unit_angles=(0.0, np.pi / 3.0, 2.0 * np.pi / 3.0), *, center_v=2.5, volts_per_decade=0.5):
+        """The design values (no calibration)."""
+        k = len(unit_angles)
+        return cls(np.full(k, float(center_v)), np.full(k, float(volts_per_decade)), np.asarray(unit_angles, float))
+
+    def to_dict(self) -> dict:
+        """JSON-ready form (angles in radians)."""
+        return {
+            "center_v": [float(v) for v in self.center_v],
+            "volts_per_decade": [float(v) for v in self.volts_per_decade],
+            "unit_angles": [float(v) for v in self.unit_angles],
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "UnitCalibration":
+        """Inverse of :meth:`to_dict`."""
+        try:
+            return cls(
+                np.asarray(data["center_v"], float),
+                np.asarray(data["volts_per_decade"], float),
+                np.asarray(data["unit_angles"], float),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise UserError(
+                f"The calibration data is incomplete or malformed ({exc}); it needs the lists "
+                "center_v, volts_per_decade and unit_angles. Recalibrate with experiment.mode=rotation."
+            ) from None
+
+    @classmethod
+    def load(cls, path) -> "UnitCalibration":
+        """Read a calibration written by :meth:`save`."""
+        p = Path(path)
+        try:
+            return cls.from_dict(json.loads(p.read_text()))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise UserError(
+                f"Cannot read the compass calibration {p} ({exc}); point experiment.calibration_path at a "
+                "calibration.json written by a rotation run, or set it to null to calibrate from the scan."
+            ) from None
+
+    def save(self, path) -> None:
+        """Write the calibration as JSON."""
+        Path(path).write_text(json.dumps(self.to_dict(), indent=2))
+
+
+def calibrate_from_rotation(
+    volts,
+    rotation,
+    *,
+    nominal: UnitCalibration | None = None,
+    harmonics=(1, 3, 5, 7),
+) -> UnitCalibration:
+    """Estimate per-unit centre, gain and polarizer angle from a rotation.
+
+    Parameters
+    ----------
+    volts : ndarray, shape ``(N, K)``
+        Unit output voltages while the compass turns under a constant sky
+        (looking at the zenith) or polarizer.
+    rotation : ndarray, shape ``(N,)``
+        Rotation of the compass for each sample, radians CCW (pan angle).
+        Must cover at least half a turn.
+    nominal : UnitCalibration, optional
+        Design values; their mean gain and unit 0's angle are kept.
+    harmonics : tuple of int, optional
+        Odd harmonics of ``2 psi`` in the fit.
+
+    Returns
+    -------
+    UnitCalibration
+    """
+    volts = np.asarray(volts, float)
+    rotation = np.asarray(rotation, float)
+    if volts.ndim != 2 or volts.shape[0] != rotation.shape[0]:
+        raise ValueError(f"volts must be (N, K) and rotation (N,), got {volts.shape} and {rotation.shape}")
+    k = volts.shape[1]
+    nominal = nominal or UnitCalibration.nominal()
+    if len(nominal.unit_angles) != k:
+        raise ValueError(f"nominal calibration has {len(nominal.unit_angles)} units, data {k}")
+    span = np.ptp(np.unwrap(2.0 * rotation)) / 2.0 if rotation.size else 0.0
+    if span < np.pi * 0.95 or rotation.size < 2 * (2 * len(harmonics) + 1):
+        raise UserError(
+            f"Calibration needs a rotation of at least 180 degrees with enough samples; got "
+            f"{np.degrees(span):.0f} degrees in {rotation.size} samples. Scan a wider pan range "
+            "(experiment.pan_range_deg) or give experiment.calibration_path."
+        )
+    columns = [np.ones_like(rotation)]
+    for h in harmonics:
+        columns += [np.cos(2 * h * rotation), np.sin(2 * h * rotation)]
+    design = np.stack(columns, axis=1)
+    coef, *_ = np.linalg.lstsq(design, volts, rcond=None)  # (1 + 2H, K)
+    center = coef[0]
+    amplitude = np.hypot(coef[1], coef[2])
+    phase = np.arctan2(coef[2], coef[1])
+    gain = np.mean(nominal.volts_per_decade) * amplitude / np.mean(amplitude)
+    angles = nominal.unit_angles[0] + wrap_axial(-(phase - phase[0]) / 2.0 - (nominal.unit_angles - nominal.unit_angles[0])) + (
+        nominal.unit_angles - nominal.unit_angles[0]
+    )
+    return UnitCalibration(center, gain, angles)

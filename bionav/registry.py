@@ -1,0 +1,227 @@
+"""Plugin registry: entry points read once, loaded lazily, failures reported.
+
+Modelled on xarray's backend registry. Each *kind* of plugin has an
+entry-point group (``bionav.homing``, ``bionav.signatures``,
+``bionav.sensors``, ``bionav.controllers``); bionav's own built-ins are
+registered through the same entry points as third-party plugins.
+
+* Entry points are read once per process and cached (:func:`entry_points_of`).
+* A plugin's module is imported only when the plugin is asked for
+  (:func:`load_plugin`) or when all of a kind are listed (:func:`plugins_of`).
+* A plugin that fails to import is a warning when listing and an error naming
+  its distribution only when it is selected.
+* Two distributions claiming one name in one group is an error naming both.
+* Lookup accepts a registry name or the plugin class itself.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import importlib.metadata as importlib_metadata
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+from bionav.errors import PluginError
+
+#: entry-point group of each plugin kind
+GROUPS: dict[str, str] = {
+    "homing": "bionav.homing",
+    "signature": "bionav.signatures",
+    "sensor": "bionav.sensors",
+    "controller": "bionav.controllers",
+}
+#: entry-point group of config packages (folders of YAML files)
+CONFIG_GROUP = "bionav.configs"
+
+
+class PluginWarning(UserWarning):
+    """A plugin could not be loaded; it is skipped unless selected."""
+
+
+@dataclass(frozen=True)
+class PluginEntry:
+    """One registered plugin.
+
+    Attributes
+    ----------
+    kind : str
+        Plugin kind (``homing``, ``signature``, ``sensor``, ``controller``).
+    name : str
+        Registry name (what the user types, e.g. ``homing=sift``).
+    value : str
+        Entry-point target ``module:attribute``.
+    distribution : str
+        Name of the installed distribution that declares the entry point.
+    version : str
+        That distribution's version.
+    """
+
+    kind: str
+    name: str
+    value: str
+    distribution: str
+    version: str
+
+    def describe(self) -> str:
+        return f"{self.name!r} ({self.value}, from {self.distribution} {self.version})"
+
+
+@dataclass(frozen=True)
+class LoadedPlugin:
+    """An entry together with the loaded class, or the error that prevented loading."""
+
+    entry: PluginEntry
+    cls: type | None
+    error: str | None
+
+    @property
+    def config_group(self) -> str:
+        """The Hydra config group the plugin is selected in (``sensor`` plugins may say ``pantilt``)."""
+        if self.cls is not None:
+            return getattr(self.cls, "config_group", self.entry.kind)
+        return self.entry.kind
+
+
+def _check_kind(kind: str) -> str:
+    if kind not in GROUPS:
+        raise PluginError(f"unknown plugin kind {kind!r}; the kinds are {', '.join(sorted(GROUPS))}.")
+    return GROUPS[kind]
+
+
+def _distribution_of(ep: importlib_metadata.EntryPoint) -> tuple[str, str]:
+    dist = getattr(ep, "dist", None)
+    if dist is None:
+        return "unknown", "?"
+    return dist.metadata["Name"] or dist.name, dist.version
+
+
+@functools.cache
+def _all_entry_points() -> dict[str, tuple[importlib_metadata.EntryPoint, ...]]:
+    eps = importlib_metadata.entry_points()
+    return {group: tuple(eps.select(group=group)) for group in (*GROUPS.values(), CONFIG_GROUP)}
+
+
+def clear_cache() -> None:
+    """Forget cached entry points and loaded plugins (after installing a plugin at run time)."""
+    _all_entry_points.cache_clear()
+    entry_points_of.cache_clear()
+    _load_entry.cache_clear()
+
+
+@functools.cache
+def entry_points_of(kind: str) -> dict[str, PluginEntry]:
+    """Registered plugins of one kind, keyed by name, without importing them.
+
+    Raises
+    ------
+    PluginError
+        When two different distributions declare the same name.
+    """
+    group = _check_kind(kind)
+    found: dict[str, PluginEntry] = {}
+    for ep in _all_entry_points()[group]:
+        dist, version = _distribution_of(ep)
+        entry = PluginEntry(kind, ep.name, ep.value, dist, version)
+        previous = found.get(ep.name)
+        if previous is not None and (previous.distribution, previous.value) != (dist, ep.value):
+            raise PluginError(
+                f"two installed distributions register the {kind} plugin {ep.name!r}: "
+                f"{previous.describe()} and {entry.describe()}. Uninstall one of them "
+                f"(pip uninstall {entry.distribution}) or rename its entry point in group {group!r}."
+            )
+        found[ep.name] = entry
+    return found
+
+
+@functools.cache
+def _load_entry(entry: PluginEntry) -> LoadedPlugin:
+    ep = importlib_metadata.EntryPoint(entry.name, entry.value, GROUPS[entry.kind])
+    try:
+        cls = ep.load()
+    except Exception as exc:  # a broken plugin must not break other commands
+        return LoadedPlugin(entry, None, f"{type(exc).__name__}: {exc}")
+    problem = _check_plugin_class(entry.kind, cls)
+    if problem:
+        return LoadedPlugin(entry, None, problem)
+    return LoadedPlugin(entry, cls, None)
+
+
+def _check_plugin_class(kind: str, cls: Any) -> str | None:
+    if not isinstance(cls, type):
+        return f"entry point target is a {type(cls).__name__}, not a class"
+    config = getattr(cls, "Config", None)
+    if config is None or not dataclasses.is_dataclass(config):
+        return "plugin class has no `Config` dataclass (its typed parameters)"
+    return None
+
+
+def plugins_of(kind: str, *, warn: bool = True) -> dict[str, LoadedPlugin]:
+    """Load every plugin of a kind; broken ones are kept with their error.
+
+    Parameters
+    ----------
+    kind : str
+        Plugin kind.
+    warn : bool
+        Emit a :class:`PluginWarning` for each plugin that failed to load.
+    """
+    loaded = {name: _load_entry(entry) for name, entry in entry_points_of(kind).items()}
+    if warn:
+        for plugin in loaded.values():
+            if plugin.error:
+                warnings.warn(
+                    f"bionav: the {kind} plugin {plugin.entry.describe()} failed to load and is "
+                    f"skipped: {plugin.error}",
+                    PluginWarning,
+                    stacklevel=2,
+                )
+    return loaded
+
+
+def load_plugin(kind: str, name_or_class: str | type) -> type:
+    """The plugin class registered under ``name`` (or the class itself, passed through).
+
+    Raises
+    ------
+    PluginError
+        Unknown name (the message lists the available ones) or a plugin that
+        failed to load (the message names its distribution and the error).
+    """
+    _check_kind(kind)
+    if isinstance(name_or_class, type):
+        problem = _check_plugin_class(kind, name_or_class)
+        if problem:
+            raise PluginError(f"{name_or_class.__qualname__} cannot be used as a {kind} plugin: {problem}.")
+        return name_or_class
+    name = str(name_or_class)
+    entries = entry_points_of(kind)
+    if name not in entries:
+        available = ", ".join(sorted(entries)) or "(none installed)"
+        raise PluginError(
+            f"there is no {kind} plugin named {name!r}. Available: {available}. "
+            f"Install the package that provides it, or pick one of these."
+        )
+    plugin = _load_entry(entries[name])
+    if plugin.cls is None:
+        raise PluginError(
+            f"the {kind} plugin {plugin.entry.describe()} failed to load: {plugin.error}. "
+            f"Fix or reinstall {plugin.entry.distribution} (pip install --force-reinstall "
+            f"{plugin.entry.distribution}), or choose another {kind}."
+        )
+    return plugin.cls
+
+
+def config_packages() -> list[tuple[str, str, str]]:
+    """Config packages declared in ``bionav.configs``: ``(name, package, distribution)``.
+
+    bionav's own ``conf`` folder comes first, so third-party YAML can add
+    options but not silently replace built-in ones.
+    """
+    out = []
+    for ep in _all_entry_points()[CONFIG_GROUP]:
+        dist, _ = _distribution_of(ep)
+        out.append((ep.name, ep.value, dist))
+    out.sort(key=lambda item: (item[0] != "bionav", item[0]))
+    return out

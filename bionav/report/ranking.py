@@ -1,0 +1,213 @@
+"""Ranking tables of the parameter-homing sweep (thesis tables 5.5-5.7, figs. 5.9-5.11).
+
+Input rows are the per-configuration records ``experiment=param_sweep`` writes
+to ``param_sweep.jsonl`` (one JSON object per line: ``db``, ``signature``,
+``rings``, ``n_coeffs``, ``image_size``, ``preprocess``,
+``rotation_invariant``, ``rr``, ``aae`` and per-snapshot ``positions``,
+``aae_s``, ``rr_s``, ``grid_shape``).
+
+For each database, each signature's best configuration is the one with the
+highest RR*, ties broken by the lower AAE* (the thesis ranks "by the quality of
+the return ratio"); signatures are then ranked by that RR*.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any, Iterable, Mapping, Sequence
+
+from bionav.report.table import markdown_table
+
+ROWS_FILE = "param_sweep.jsonl"
+
+#: columns of a ranking table (the thesis' columns, in its order)
+RANKING_COLUMNS = (
+    "rank", "parameter", "rr", "aae", "rings", "n_coeffs", "image_size", "preprocess", "rot_invariant",
+)  # fmt: skip
+
+
+def load_sweep_rows(root: Path) -> list[dict[str, Any]]:
+    """Every configuration record (``param_sweep.jsonl``) below ``root``.
+
+    Unreadable lines (a job killed mid-write) are skipped.
+    """
+    rows = []
+    for path in sorted(Path(root).rglob(ROWS_FILE)):
+        for line in path.read_text().splitlines():
+            try:
+                rows.append(json.loads(line))
+            except ValueError:
+                continue
+    return rows
+
+
+def _key(row: Mapping[str, Any]) -> tuple[float, float]:
+    rr = row.get("rr")
+    aae = row.get("aae")
+    rr = -math.inf if rr is None or not math.isfinite(rr) else rr
+    aae = math.inf if aae is None or not math.isfinite(aae) else aae
+    return (rr, -aae)
+
+
+def best_configurations(rows: Iterable[Mapping[str, Any]]) -> dict[str, dict[str, list[Mapping[str, Any]]]]:
+    """Best configuration per database and signature, ranked.
+
+    Returns
+    -------
+    dict
+        ``{db: [row, ...]}`` with one row per signature (its best
+        configuration by RR*, ties by AAE*), sorted best first.
+    """
+    best: dict[str, dict[str, Mapping[str, Any]]] = {}
+    for row in rows:
+        db = str(row.get("db", "?"))
+        sig = str(row["signature"])
+        current = best.setdefault(db, {}).get(sig)
+        if current is None or _key(row) > _key(current):
+            best[db][sig] = row
+    return {db: sorted(sigs.values(), key=_key, reverse=True) for db, sigs in sorted(best.items())}
+
+
+def ranking_table(rows: Iterable[Mapping[str, Any]], *, db: str | None = None) -> list[dict[str, Any]]:
+    """The thesis' ranking table (5.5-5.7) for one database.
+
+    Parameters
+    ----------
+    rows : iterable of mapping
+        Configuration records (see the module docstring).
+    db : str, optional
+        Database to rank; required when ``rows`` hold several.
+
+    Returns
+    -------
+    list of dict
+        One row per signature with :data:`RANKING_COLUMNS`: ``rank`` (1 = best),
+        ``parameter`` (``[name]``), ``rr`` (RR*), ``aae`` (AAE*, radians),
+        ``rings`` / ``n_coeffs`` (``-`` when not a parameter of the signature),
+        ``image_size`` (``WxH``), ``preprocess``, ``rot_invariant`` (``y``/``n``).
+    """
+    ranked = best_configurations(rows)
+    if db is None:
+        if len(ranked) > 1:
+            raise ValueError(f"rows hold several databases ({', '.join(ranked)}); pass db=")
+        db = next(iter(ranked), None)
+    out = []
+    for i, row in enumerate(ranked.get(db, []), start=1):
+        out.append(
+            {
+                "rank": i,
+                "parameter": f"[{row['signature']}]",
+                "rr": row["rr"],
+                "aae": row["aae"],
+                "rings": "-" if row.get("rings") is None else int(row["rings"]),
+                "n_coeffs": "-" if row.get("n_coeffs") is None else int(row["n_coeffs"]),
+                "image_size": row.get("image_size", ""),
+                "preprocess": row.get("preprocess", ""),
+                "rot_invariant": "y" if row.get("rotation_invariant") else "n",
+            }
+        )
+    return out
+
+
+def ranking_markdown(table: Sequence[Mapping[str, Any]], *, db: str) -> str:
+    """A ranking table as a Markdown section (heading, table)."""
+    head = f"## Parameter homing ranking: {db}\n\nBest configuration per signature by RR* (AAE* in radians).\n"
+    return head + "\n" + markdown_table(table, RANKING_COLUMNS)
+
+
+def plot_per_snapshot(path: Path, ranked: Sequence[Mapping[str, Any]], *, db: str, top: int = 8) -> None:
+    """RR_s and AAE_s heatmaps over the grid for the ``top`` ranked signatures (figs. 5.9-5.11).
+
+    Parameters
+    ----------
+    path : Path
+        PNG to write.
+    ranked : sequence of mapping
+        Best configurations of one database, best first (:func:`best_configurations`).
+    db : str
+        Database name for the title.
+    top : int
+        How many signatures to show.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    shown = [r for r in ranked[:top] if r.get("positions")]
+    if not shown:
+        return
+    nx, ny = shown[0]["grid_shape"]
+    fig, axes = plt.subplots(2, len(shown), figsize=(len(shown) * (0.22 * nx + 0.9), 2 * (0.22 * ny + 0.9)), squeeze=False)
+    images = [None, None]
+    for col, row in enumerate(shown):
+        pos = np.asarray(row["positions"], dtype=int)
+        for r, (key, label, cmap, vmax) in enumerate((("rr_s", "RR$_s$", "viridis", 1.0), ("aae_s", "AAE$_s$ (rad)", "magma_r", np.pi / 2))):
+            m = np.full((ny, nx), np.nan)
+            m[pos[:, 1], pos[:, 0]] = [np.nan if v is None else v for v in row[key]]
+            ax = axes[r, col]
+            images[r] = ax.imshow(m, origin="lower", cmap=cmap, vmin=0, vmax=vmax)
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if r == 0:
+                ax.set_title(f"{col + 1}. [{row['signature']}]\nRR*={row['rr']:.3f}", fontsize=8)
+            else:
+                ax.set_title(f"AAE*={row['aae']:.3f}", fontsize=8)
+            if col == 0:
+                ax.set_ylabel(label)
+    for r in range(2):
+        fig.colorbar(images[r], ax=axes[r, :].tolist(), shrink=0.9)
+    fig.suptitle(f"Parameter homing on {db}: RR$_s$ and AAE$_s$ per snapshot position (best {len(shown)})", fontsize=9)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def write_parameter_report(root: Path, *, top: int = 8) -> list[str]:
+    """Write ranking tables and figures for every database swept below ``root``.
+
+    Writes ``ranking_<db>.csv``, ``ranking_<db>.md`` and ``plots/ranking_<db>.png``
+    into ``root``.
+
+    Returns
+    -------
+    list of str
+        One Markdown section per database (empty when ``root`` holds no parameter sweep).
+    """
+    import csv
+
+    root = Path(root)
+    rows = load_sweep_rows(root)
+    if not rows:
+        return []
+    sections = []
+    for db, ranked in best_configurations(rows).items():
+        table = ranking_table(rows, db=db)
+        with open(root / f"ranking_{db}.csv", "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(RANKING_COLUMNS))
+            writer.writeheader()
+            writer.writerows(table)
+        text = ranking_markdown(table, db=db)
+        (root / f"ranking_{db}.md").write_text(text + "\n")
+        (root / "plots").mkdir(exist_ok=True)
+        plot_per_snapshot(root / "plots" / f"ranking_{db}.png", ranked, db=db, top=top)
+        sections.append(text)
+    return sections
+
+
+def ranking_sections(root: Path, rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Report hook: the parameter-homing ranking sections when ``rows`` hold ``param_sweep`` runs.
+
+    Parameters
+    ----------
+    root : Path
+        The sweep (or run tree) directory; ranking files are written into it
+        (:func:`write_parameter_report`).
+    rows : sequence of mapping
+        The summary rows of the runs below ``root`` (``experiment`` per run).
+    """
+    if not any(r.get("experiment") == "param_sweep" for r in rows):
+        return []
+    return write_parameter_report(root)

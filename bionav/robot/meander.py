@@ -1,0 +1,208 @@
+"""The meander: lanes, lane changes, wall following and lane keeping.
+
+Shared machinery of the ``triangulation`` and ``odometry`` controllers
+(thesis section 7.1): the first lane is driven by wall following, at its end
+the robot turns by 90 degrees on the spot, drives forward by the inter-lane
+distance, turns by another 90 degrees and drives the next lane antiparallel to
+the previous one, and so on.
+
+State estimate. The controller keeps its pose in the *lane frame* ``R_k`` of
+the current lane ``k``: origin at the lane's start on its desired line, ``+x``
+along the direction of travel, ``+y`` to the left. The estimate is propagated
+every tick by the odometry increment (which is wrong by the unknown wheel
+error) and corrected by *fixes*: on the first lane by the wall sensor (every
+tick), on later lanes by whatever the subclass measures (visual triangulation
+against the previous lane for ``triangulation``, nothing for ``odometry``).
+A fix replaces ``y`` and the heading by ``y + g (y_meas - y)`` (gain ``g``).
+
+Lane keeping is pure pursuit of a point ``lookahead`` metres ahead on the
+desired line: desired heading ``atan2(-y, lookahead)``, turn rate
+``omega = heading_gain * wrap(desired - heading)`` (clipped), plus an optional
+integral term that learns a constant turn-rate bias (the wheel error).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bionav.geometry import wrap_angle
+from bionav.robot.controller import Command, Controller, LanePlan, Observation
+from bionav.robot.kinematics import Pose, wheel_speeds
+
+
+@dataclass
+class MeanderConfig:
+    """Parameters shared by the meander controllers (SI units, radians unless ``_deg``).
+
+    Attributes
+    ----------
+    speed : float
+        Forward speed on lanes, m/s.
+    turn_rate : float
+        Turn rate of the 90-degree turns on the spot, rad/s.
+    track_width : float
+        The controller's belief about the wheel distance (m), used to turn
+        ``(v, omega)`` into wheel speeds.
+    lookahead : float
+        Pure-pursuit look-ahead distance on the desired lane, m.
+    heading_gain : float
+        Turn rate per radian of heading error, 1/s.
+    max_steer_rate : float
+        Largest turn rate while driving a lane, rad/s.
+    bias_gain : float
+        Integral gain (1/s^2) of the turn-rate bias estimate; 0 disables it.
+    wall_gate_deg : float
+        Wall readings whose heading disagrees with the estimate by more than
+        this are ignored (a corner, an open door).
+    turn_tolerance_deg : float
+        A turn on the spot ends when the heading is this close to its target.
+    """
+
+    speed: float = 0.10
+    turn_rate: float = 0.5
+    track_width: float = 0.30
+    lookahead: float = 0.30
+    heading_gain: float = 1.5
+    max_steer_rate: float = 0.5
+    bias_gain: float = 0.0
+    wall_gate_deg: float = 20.0
+    turn_tolerance_deg: float = 0.5
+
+
+class MeanderController(Controller):
+    """Base class of meander controllers; subclasses add lane fixes through :meth:`lane_fix`."""
+
+    Config = MeanderConfig
+
+    def reset(self, plan: LanePlan, *, homing=None, rng=None) -> None:
+        self.plan = plan
+        self.homing = homing
+        self.rng = rng
+        self.lane = 0
+        self.phase = "lane"
+        self.est = Pose(0.0, 0.0, 0.0)  # pose in the current lane frame
+        self.origin_in_prev = Pose(0.0, 0.0, 0.0)  # R_k's origin in R_{k-1}
+        self.bias = 0.0  # learned turn-rate bias, rad/s
+        self._prev_odo: Pose | None = None
+        self._prev_time = 0.0
+        self._lane_end_x = 0.0
+
+    def lane_side(self, lane: int) -> int:
+        """Side (+1 left, -1 right, in lane ``lane``'s frame) on which lane ``lane + 1`` lies.
+
+        Turns alternate: a meander turns left, right, left, ... when
+        ``plan.turn == "left"``.
+        """
+        return self.plan.side * (1 if lane % 2 == 0 else -1)
+
+    # ------------------------------------------------------------------ hooks
+    def lane_fix(self, obs: Observation, info: dict) -> tuple[float, float] | None:
+        """Measure ``(y, heading)`` in the current lane frame on lanes after the first.
+
+        Called every tick while driving a lane ``k >= 1``; return ``None`` when
+        there is nothing new. Subclasses write their internals into ``info``.
+        """
+        return None
+
+    def lane_tick(self, obs: Observation, info: dict) -> None:
+        """Called every tick while driving any lane, before the fix (e.g. to grab an image)."""
+
+    def post_fix(self, obs: Observation, info: dict) -> None:
+        """Called every tick while driving any lane, after the fix (e.g. to store a snapshot)."""
+
+    # ------------------------------------------------------------------ control
+    def _apply_fix(self, y: float, heading: float, gain: float) -> None:
+        self.est = Pose(
+            self.est.x,
+            self.est.y + gain * (y - self.est.y),
+            float(wrap_angle(self.est.theta + gain * wrap_angle(heading - self.est.theta))),
+        )
+
+    def _wall_fix(self, obs: Observation) -> None:
+        if obs.wall is None:
+            return
+        heading = -obs.wall.angle
+        if abs(wrap_angle(heading - self.est.theta)) > np.radians(self.config.wall_gate_deg):
+            return
+        # the wall is on the right at -wall_offset in R_0
+        self._apply_fix(obs.wall.distance - self.plan.wall_offset, heading, 1.0)
+
+    def _wheels(self, v: float, omega: float) -> tuple[float, float]:
+        return wheel_speeds(v, omega, track_width=self.config.track_width)
+
+    def _lane_command(self, dt: float) -> tuple[float, float]:
+        c = self.config
+        desired = np.arctan2(-self.est.y, c.lookahead)
+        err = float(wrap_angle(desired - self.est.theta))
+        if c.bias_gain > 0:
+            self.bias += c.bias_gain * err * dt
+        omega = float(np.clip(c.heading_gain * err + self.bias, -c.max_steer_rate, c.max_steer_rate))
+        v = c.speed * max(0.0, float(np.cos(err)))
+        return self._wheels(v, omega)
+
+    def _turn_command(self, target: float) -> tuple[float, float] | None:
+        err = float(wrap_angle(target - self.est.theta))
+        if abs(err) < np.radians(self.config.turn_tolerance_deg):
+            return None
+        omega = float(np.clip(2.0 * err, -self.config.turn_rate, self.config.turn_rate))
+        return self._wheels(0.0, omega)
+
+    def step(self, obs: Observation) -> Command:
+        if self._prev_odo is None:
+            self._prev_odo, self._prev_time = obs.odometry, obs.time
+        self.est = self.est.compose(obs.odometry.relative_to(self._prev_odo))
+        dt = obs.time - self._prev_time
+        self._prev_odo, self._prev_time = obs.odometry, obs.time
+        info: dict = {}
+        side = self.lane_side(self.lane)
+
+        if self.phase == "lane":
+            self.lane_tick(obs, info)
+            if self.lane == 0:
+                self._wall_fix(obs)
+            else:
+                fix = self.lane_fix(obs, info)
+                if fix is not None:
+                    self._apply_fix(fix[0], fix[1], getattr(self.config, "fix_gain", 1.0))
+            self.post_fix(obs, info)
+            if self.est.x >= self.plan.lane_length or obs.bumper:
+                info["lane_end"] = self.lane
+                info["lane_end_bumper"] = bool(obs.bumper)
+                if self.lane == self.plan.n_lanes - 1:
+                    self.phase = "done"
+                    return Command(0.0, 0.0, True, info)
+                self._lane_end_x = self.est.x
+                self.phase = "turn1"
+            else:
+                return Command(*self._lane_command(dt), False, info)
+
+        if self.phase == "turn1":
+            cmd = self._turn_command(side * np.pi / 2)
+            if cmd is not None:
+                return Command(*cmd, False, info)
+            self.phase = "shift"
+
+        if self.phase == "shift":
+            if side * self.est.y < self.plan.spacing and not obs.bumper:
+                c = self.config
+                err = float(wrap_angle(side * np.pi / 2 - self.est.theta))
+                omega = float(np.clip(c.heading_gain * err, -c.max_steer_rate, c.max_steer_rate))
+                return Command(*self._wheels(c.speed, omega), False, info)
+            self.phase = "turn2"
+
+        if self.phase == "turn2":
+            cmd = self._turn_command(np.pi)
+            if cmd is not None:
+                return Command(*cmd, False, info)
+            # enter lane k+1: its frame starts across from where lane k ended
+            origin = Pose(self._lane_end_x, side * self.plan.spacing, np.pi)
+            self.est = self.est.relative_to(origin)
+            self.origin_in_prev = origin
+            self.lane += 1
+            self.phase = "lane"
+            info["lane_start"] = self.lane
+            return Command(*self._lane_command(dt), False, info)
+
+        return Command(0.0, 0.0, True, info)

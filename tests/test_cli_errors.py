@@ -1,0 +1,62 @@
+"""Bad input on the command line: one clear message, non-zero exit, no traceback."""
+
+import json
+import os
+
+import pytest
+
+from helpers import run_bionav
+
+
+def _clean_failure(proc, *needles):
+    assert proc.returncode != 0, proc.stdout
+    assert "Traceback" not in proc.stderr, proc.stderr
+    for needle in needles:
+        assert needle in proc.stderr, proc.stderr
+
+
+def test_help_lists_choices(tmp_path):
+    proc = run_bionav("--help", cwd=tmp_path)
+    assert proc.returncode == 0
+    assert "homing: " in proc.stdout and "sift" in proc.stdout and "mfdid" in proc.stdout
+    assert "experiment: " in proc.stdout and "grid_homing" in proc.stdout
+
+
+def test_unknown_homing_lists_available(tmp_path):
+    proc = run_bionav("homing=siftt", cwd=tmp_path)
+    _clean_failure(proc, "unknown homing 'siftt'", "sift", "mfdid")
+    assert proc.returncode == 2
+
+
+def test_unknown_database_lists_available(tmp_path):
+    proc = run_bionav("db=sim_nowhere", cwd=tmp_path)
+    _clean_failure(proc, "unknown db 'sim_nowhere'", "sim_original")
+
+
+def test_wrong_parameter_type(tmp_path):
+    proc = run_bionav("homing.window=wide", cwd=tmp_path)
+    _clean_failure(proc, "window")
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root can write anywhere")
+def test_unwritable_output_dir_nonroot(tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o500)
+    proc = run_bionav(f"hydra.run.dir={locked}/run", cwd=tmp_path)
+    _clean_failure(proc, "not writable")
+
+
+def test_unwritable_output_dir(tmp_path):
+    target = tmp_path / "a_file"
+    target.write_text("not a directory")
+    proc = run_bionav(f"hydra.run.dir={target}/run", cwd=tmp_path)
+    _clean_failure(proc)
+
+
+def test_failed_run_writes_failed_metrics(tmp_path):
+    run_dir = tmp_path / "run"
+    proc = run_bionav("experiment.name=no_such_experiment", f"hydra.run.dir={run_dir}", cwd=tmp_path)
+    _clean_failure(proc, "no experiment named 'no_such_experiment'")
+    metrics = json.loads((run_dir / "metrics.json").read_text())
+    assert metrics["status"] == "failed" and "no_such_experiment" in metrics["error"]
+    assert (run_dir / "run.mcap").stat().st_size > 0

@@ -1,0 +1,58 @@
+"""experiment=contrast_lda end to end on small data."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from omegaconf import OmegaConf
+
+from bionav.errors import UserError
+from bionav.experiments import contrast_lda
+from bionav.spectral.bands import feature_subsets
+
+from spectral_ctx import FakeContext
+
+
+def test_contrast_lda_small_simulated_run(tmp_path):
+    cfg = OmegaConf.create({"experiment": {"name": "contrast_lda", "sigma": 30.0, "n_resamples": 200},
+                            "data": {"name": "sim_natural", "seed": 3, "n_objects": 60, "n_sky": 50}})
+    ctx = FakeContext(tmp_path)
+    m = contrast_lda.run(cfg, ctx)
+    names = list(feature_subsets())
+    assert set(m["J"]) == set(names) == set(m["J_sigma"]) == set(m["n_f"])
+    for n in names:
+        assert 0 < m["J_sigma"][n] <= m["J"][n]
+        assert 0 <= m["n_f"][n] < 0.5
+    json.dumps(m)  # JSON-serialisable
+    assert m["n_sky"] == 50 and m["n_objects"] == 60
+    rows = list(csv.DictReader(open(tmp_path / "lda_table.csv")))
+    assert [r["feature"] for r in rows] == names
+    assert float(rows[0]["J"]) == pytest.approx(m["J"]["UV"], rel=1e-5)
+    for f in ("lda_table.md", "significance.md", "significance_J.csv", "significance_n_f.csv", "samples.csv",
+              "plots/pairs.png", "plots/uv_g_uv_ir.png", "plots/projection_histograms.png"):
+        assert (tmp_path / f).stat().st_size > 0, f
+    md = (tmp_path / "lda_table.md").read_text()
+    assert "| J |" in md and "UV-IR" in md or "**UV**" in md
+    assert len(ctx.log.messages) == 110 and ctx.log.messages[0][0] == "/spectral5/samples"
+
+
+def test_contrast_lda_csv_round_trip_and_errors(tmp_path):
+    rng = np.random.default_rng(0)
+    lines = ["class,UV,B,G,R,IR,kind"]
+    for i in range(30):
+        lines.append("sky," + ",".join(f"{v:.1f}" for v in rng.normal([3000, 2900, 2850, 2700, 2600], 80)) + ",blue")
+    for i in range(30):
+        lines.append("object," + ",".join(f"{v:.1f}" for v in rng.normal([1800, 2000, 2100, 2000, 2600], 80)) + ",tree")
+    p = tmp_path / "mine.csv"
+    p.write_text("\n".join(lines) + "\n")
+    cfg = OmegaConf.create({"experiment": {"name": "contrast_lda", "n_resamples": 0},
+                            "data": {"name": "csv", "path": str(p)}})
+    m = contrast_lda.run(cfg, FakeContext(tmp_path))
+    assert m["n_f"]["UV"] == 0.0 and m["J"]["UV"] > 50
+    bad = OmegaConf.create({"experiment": {"name": "contrast_lda"}, "data": {"name": "csv", "path": "???"}})
+    with pytest.raises(UserError, match="data.path"):
+        contrast_lda.run(bad, FakeContext(tmp_path))
+    bad = OmegaConf.create({"experiment": {"name": "contrast_lda"}, "data": {"name": "nope"}})
+    with pytest.raises(UserError, match="sim_natural"):
+        contrast_lda.run(bad, FakeContext(tmp_path))

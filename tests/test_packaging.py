@@ -1,0 +1,66 @@
+"""Packaging: the wheel ships conf/ and the entry points; the example plugin installs and is selectable."""
+
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from helpers import run_bionav
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _pip(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "pip", *args], cwd=cwd, capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory):
+    out = tmp_path_factory.mktemp("wheel")
+    proc = _pip("wheel", str(ROOT), "--no-deps", "--no-build-isolation", "-w", str(out), "-q", cwd=out)
+    assert proc.returncode == 0, proc.stderr
+    return next(out.glob("bionav-*.whl"))
+
+
+def test_wheel_ships_configs_and_entry_points(wheel):
+    with zipfile.ZipFile(wheel) as z:
+        names = set(z.namelist())
+        entry_points = next(z.read(n).decode() for n in names if n.endswith("entry_points.txt"))
+    for required in ("bionav/conf/config.yaml", "bionav/conf/experiment/grid_homing.yaml",
+                     "bionav/conf/db/sim_original.yaml", "bionav/conf/preprocess/bw1.yaml"):
+        assert required in names
+    assert "[bionav.homing]" in entry_points and "sift = bionav.plugins.homing.sift:SiftHoming" in entry_points
+    assert "[bionav.configs]" in entry_points
+
+
+def test_wheel_install_runs_from_outside_the_checkout(wheel, tmp_path):
+    target = tmp_path / "site"
+    proc = _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    env = {"PYTHONPATH": str(target)}
+    proc = run_bionav("--help", cwd=tmp_path, env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert "sim_original" in proc.stdout and "grid_homing" in proc.stdout
+
+
+def test_example_plugin_selected_from_the_cli(tmp_path):
+    target = tmp_path / "site"
+    example = ROOT / "examples" / "bionav-plugin-example"
+    proc = _pip("install", "--no-deps", "--no-build-isolation", "--target", str(target), str(example), "-q", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    env = {"PYTHONPATH": os.pathsep.join([str(target), os.environ.get("PYTHONPATH", "")])}
+    listing = run_bionav(cwd=tmp_path, env=env, module="bionav.plugins")
+    assert "homing=alv" in listing.stdout and "bionav-plugin-example" in listing.stdout
+    help_text = run_bionav("--help", cwd=tmp_path, env=env)
+    assert "alv" in help_text.stdout and "alv_bright" in help_text.stdout
+    cfg = run_bionav("homing=alv", "homing.quantile=0.8", "--cfg", "job", cwd=tmp_path, env=env)
+    assert cfg.returncode == 0, cfg.stderr
+    assert "quantile: 0.8" in cfg.stdout and "band_deg: 10.0" in cfg.stdout
+    bad = run_bionav("homing=alv", "homing.quantile=high", "--cfg", "job", cwd=tmp_path, env=env)
+    assert bad.returncode != 0 and "quantile" in bad.stderr
+    preset = run_bionav("homing=alv_bright", "--cfg", "job", cwd=tmp_path, env=env)
+    assert preset.returncode == 0, preset.stderr
+    assert "quantile: 0.9" in preset.stdout and "dark_landmarks: false" in preset.stdout

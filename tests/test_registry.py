@@ -1,0 +1,88 @@
+"""Registry failure modes: broken plugin, duplicate name, missing Config, lookup by name or class."""
+
+import warnings
+
+import pytest
+
+from bionav import registry
+from bionav.errors import PluginError
+
+GOOD = """
+from dataclasses import dataclass
+from bionav.homing.base import HomingMethod, HomeVector
+
+@dataclass
+class Cfg:
+    gain: float = 1.0
+
+class Good(HomingMethod):
+    Config = Cfg
+    def home_vector(self, s, c, *, neighbours=None):
+        return HomeVector(0.0)
+
+class NoConfig(HomingMethod):
+    pass
+"""
+
+
+def test_builtins_are_registered_through_entry_points():
+    entries = registry.entry_points_of("homing")
+    assert {"sift", "mfdid"} <= set(entries)
+    assert entries["sift"].distribution == "bionav"
+    assert registry.load_plugin("homing", "sift").__name__ == "SiftHoming"
+
+
+def test_lookup_accepts_name_or_class(fake_distributions):
+    fake_distributions("fake-good", {"bionav.homing": {"good": "fakeplug_good:Good"}}, {"fakeplug_good": GOOD})
+    cls = registry.load_plugin("homing", "good")
+    assert registry.load_plugin("homing", cls) is cls
+
+
+def test_unknown_name_lists_available():
+    with pytest.raises(PluginError, match="Available: .*mfdid.*sift"):
+        registry.load_plugin("homing", "nonexistent")
+
+
+def test_broken_plugin_is_a_warning_and_an_error_only_when_selected(fake_distributions):
+    fake_distributions(
+        "fake-broken",
+        {"bionav.homing": {"broken": "fakeplug_broken:Method"}},
+        {"fakeplug_broken": "import a_module_that_does_not_exist\n"},
+    )
+    with pytest.warns(registry.PluginWarning, match="broken.*fake-broken"):
+        loaded = registry.plugins_of("homing")
+    assert loaded["broken"].cls is None and "ModuleNotFoundError" in loaded["broken"].error
+    assert loaded["sift"].cls is not None  # others unaffected
+    with pytest.raises(PluginError, match="fake-broken.*failed to load.*a_module_that_does_not_exist"):
+        registry.load_plugin("homing", "broken")
+
+
+def test_missing_attribute_and_missing_config(fake_distributions):
+    fake_distributions(
+        "fake-attrs",
+        {"bionav.homing": {"noattr": "fakeplug_attrs:DoesNotExist", "nocfg": "fakeplug_attrs:NoConfig"}},
+        {"fakeplug_attrs": GOOD},
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        loaded = registry.plugins_of("homing")
+    assert "AttributeError" in loaded["noattr"].error
+    assert "Config" in loaded["nocfg"].error
+    with pytest.raises(PluginError, match="fake-attrs"):
+        registry.load_plugin("homing", "nocfg")
+
+
+def test_duplicate_name_from_two_distributions_names_both(fake_distributions):
+    fake_distributions("fake-one", {"bionav.homing": {"twin": "fakeplug_one:Good"}}, {"fakeplug_one": GOOD})
+    fake_distributions("fake-two", {"bionav.homing": {"twin": "fakeplug_two:Good"}}, {"fakeplug_two": GOOD})
+    with pytest.raises(PluginError, match="fake-one.*fake-two|fake-two.*fake-one"):
+        registry.entry_points_of("homing")
+
+
+def test_entry_points_are_read_once(fake_distributions, monkeypatch):
+    registry.entry_points_of("homing")
+    calls = []
+    monkeypatch.setattr(registry.importlib_metadata, "entry_points", lambda: calls.append(1))
+    registry.entry_points_of("homing")
+    registry.load_plugin("homing", "sift")
+    assert calls == []

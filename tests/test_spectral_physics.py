@@ -1,0 +1,127 @@
+"""Physics of the five-channel sensor model against closed forms and known facts."""
+
+import numpy as np
+import pytest
+
+from bionav.spectral.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
+from bionav.spectral.materials import MATERIALS
+from bionav.spectral.sensor_model import LogSensorModel
+from bionav.spectral.sky import (
+    CloudField,
+    SkyState,
+    clear_sky_radiance,
+    direction,
+    illumination,
+    rayleigh_optical_depth,
+    relative_air_mass,
+    sky_radiance,
+    solar_spectrum,
+)
+
+
+def test_band_peaks_and_bandwidths_match_table_6_1():
+    wl = np.arange(250.0, 1200.0, 0.1)
+    s = band_sensitivity(wl)
+    for row, peak, fwhm in zip(s, PEAK_NM, FWHM_NM):
+        assert wl[np.argmax(row)] == pytest.approx(peak, abs=0.1)
+        above = wl[row >= 0.5]
+        assert above[-1] - above[0] == pytest.approx(fwhm, abs=0.3)
+
+
+def test_band_integrate_flat_spectrum():
+    flat = np.ones(161)
+    sig = band_integrate(flat)
+    # integral of a unit-peak Gaussian = sd * sqrt(2 pi)
+    sd = np.asarray(FWHM_NM) / (2 * np.sqrt(2 * np.log(2)))
+    np.testing.assert_allclose(sig, sd * np.sqrt(2 * np.pi), rtol=0.02)
+
+
+def test_feature_names():
+    f = feature_subsets()
+    assert len(f) == 16
+    assert list(f)[:6] == ["UV", "B", "G", "R", "IR", "UV-B"]
+    assert f["R-IR"] == (3, 4) and f["all"] == (0, 1, 2, 3, 4)
+
+
+def test_rayleigh_and_air_mass_known_values():
+    assert rayleigh_optical_depth([550.0])[0] == pytest.approx(0.0973, rel=0.02)
+    # lambda^-4 with the Hansen & Travis depolarisation/dispersion corrections
+    corr = (1 + 0.0113 / 0.35**2 + 0.00013 / 0.35**4) / (1 + 0.0113 / 0.7**2 + 0.00013 / 0.7**4)
+    assert rayleigh_optical_depth([350.0])[0] / rayleigh_optical_depth([700.0])[0] == pytest.approx(16 * corr)
+    assert relative_air_mass(np.pi / 2) == pytest.approx(1.0, abs=1e-3)
+    assert relative_air_mass(np.deg2rad(30.0)) == pytest.approx(1.9942, abs=0.01)
+
+
+def test_solar_constant():
+    wl = np.arange(100.0, 100000.0, 1.0)
+    assert np.sum(solar_spectrum(wl)) == pytest.approx(1361, rel=0.01)
+
+
+def test_clear_sky_is_blue_and_clouds_flatten_it():
+    wl = np.array([350.0, 440.0, 500.0, 680.0, 800.0])
+    zenith = np.array([0.0, 0.0, 1.0])
+    clear = SkyState(np.deg2rad(45.0))
+    ratio_clear = clear_sky_radiance(clear, zenith, wl) / solar_spectrum(wl)
+    assert np.all(np.diff(ratio_clear) < 0)  # relative radiance falls with wavelength
+    assert ratio_clear[0] / ratio_clear[-1] > 2  # Rayleigh lambda^-4, diluted by grey-ish aerosol
+    overcast = clear.with_clouds(cover=1.0, optical_depth=40.0)
+    ratio_cloud = sky_radiance(overcast, zenith, wl) / solar_spectrum(wl)
+    assert ratio_cloud[0] / ratio_cloud[-1] < 0.5 * ratio_clear[0] / ratio_clear[-1]
+    # the sky darkens as the sun sets
+    low = SkyState(np.deg2rad(5.0))
+    assert np.all(clear_sky_radiance(low, zenith, wl) < clear_sky_radiance(clear, zenith, wl))
+
+
+def test_single_scattering_thin_limit():
+    """Optically thin limit: L = E0 tau P(gamma) / (4 pi) m_v exp(-tau m_s) (m_v ~ m_s)."""
+    wl = np.array([800.0])
+    state = SkyState(np.deg2rad(90.0), turbidity=1e-9)
+    tau = rayleigh_optical_depth(wl)
+    d = direction(np.deg2rad(89.999), 0.0)
+    expected = solar_spectrum(wl) * tau * 0.75 * 2 / (4 * np.pi) * np.exp(-tau)
+    assert clear_sky_radiance(state, d, wl)[0] == pytest.approx(expected[0], rel=0.01)
+
+
+def test_cloud_field_cover_fraction_and_motion():
+    field = CloudField(cover=0.4, optical_depth=20.0, seed=3, softness=0.01)
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=(20000, 3))
+    v[:, 2] = np.abs(v[:, 2]) + 0.3
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    tau = field.optical_depth_at(v)
+    assert np.mean(tau > 10) == pytest.approx(0.4, abs=0.07)
+    assert not np.allclose(tau, field.optical_depth_at(v, time_s=300.0))
+
+
+def test_shadow_is_bluer_than_sun():
+    ill = illumination(SkyState(np.deg2rad(40.0), np.deg2rad(90.0)))
+    up = np.array([0.0, 0.0, 1.0])
+    sun = band_integrate(ill.on_surface(up, sunlit=1.0))
+    shade = band_integrate(ill.on_surface(up, sunlit=0.0))
+    assert np.all(shade < sun)
+    assert shade[0] / shade[4] > 2 * sun[0] / sun[4]
+
+
+def test_sensor_chain():
+    sensor = LogSensorModel(noise_counts=0.0)
+    white = np.asarray(sensor.white_radiance)
+    rng = np.random.default_rng(0)
+    assert sensor.counts_per_decade == pytest.approx(819.2)
+    r = sensor.read(white, rng=rng)[0]
+    np.testing.assert_array_equal(r, np.full(6, 3277))
+    r10 = sensor.read(white / 10, rng=rng)[0]
+    np.testing.assert_array_equal(r10[:5], np.full(5, 3277 - 819))
+    assert np.all(sensor.read(white * 1e3, rng=rng)[0, :5] == 4095)
+    assert np.all(sensor.read(white * 1e-6, rng=rng)[0, :5] == 0)
+    np.testing.assert_allclose(sensor.log_radiance(sensor.ideal_counts(white * 0.3)), np.log10(0.3))
+    noisy = LogSensorModel(noise_counts=5.0).read(white, rng=rng, n_readings=4000)
+    assert noisy[..., 0].std() == pytest.approx(5.0, rel=0.1)
+
+
+def test_vegetation_red_edge_and_low_uv():
+    for name in ("grass", "shrub", "tree"):
+        uv, b, g, r, ir = MATERIALS[name].reflectance
+        assert ir > 5 * r and r < g and uv < 0.05
+    for name in ("paint_white", "plastic_white"):
+        assert MATERIALS[name].reflectance[0] < 0.1 < MATERIALS[name].reflectance[1]
+    assert len(CHANNELS) == 5
