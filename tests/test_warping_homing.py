@@ -21,8 +21,8 @@ POSES = [((0.5, 0.3), 0.5), ((-0.6, 0.2), -1.0), ((0.2, -0.6), 2.5), ((-0.4, -0.
 @pytest.fixture(scope="module")
 def views():
     w, h = 576, 100  # the warping plugins resize to their own 288 x 50
-    snap, geometry = render_pillar_panorama((0.0, 0.0), width=w, height=h, supersample=2)
-    currents = [render_pillar_panorama(p, heading=hd, width=w, height=h, supersample=2)[0] for p, hd in POSES]
+    snap, geometry = render_pillar_panorama((0.0, 0.0), width=w, height=h, supersample=1)
+    currents = [render_pillar_panorama(p, heading=hd, width=w, height=h, supersample=1)[0] for p, hd in POSES]
     return geometry, snap, currents
 
 

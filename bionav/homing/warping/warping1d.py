@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from bionav.homing.warping.kernels import PARALLEL_LOCK
 from bionav.homing.warping.search import WarpingResult, rho_grid
 from bionav.geometry import wrap_angle
 
@@ -72,13 +73,14 @@ def warping1d_scores(snapshot, current, *, alphas, psis, rhos):
     c = np.ascontiguousarray(current, dtype=np.float64)
     if s.ndim != 1 or s.shape != c.shape:
         raise ValueError(f"need two horizon strips of equal length, got shapes {s.shape} and {c.shape}")
-    return _warp1d_scores(
-        s,
-        np.concatenate([c, c, c, c, c[:1]]),
-        np.asarray(alphas, dtype=np.float64),
-        np.asarray(psis, dtype=np.float64),
-        np.asarray(rhos, dtype=np.float64),
-    )
+    with PARALLEL_LOCK:
+        return _warp1d_scores(
+            s,
+            np.concatenate([c, c, c, c, c[:1]]),
+            np.asarray(alphas, dtype=np.float64),
+            np.asarray(psis, dtype=np.float64),
+            np.asarray(rhos, dtype=np.float64),
+        )
 
 
 def warping1d(
