@@ -74,13 +74,13 @@ def register_configs() -> dict[str, list[str]]:
             warnings.simplefilter("default", registry.PluginWarning)
             loaded = registry.plugins_of(kind)
         for name, plugin in loaded.items():
-            group = plugin.config_group
-            names.setdefault(group, []).append(name)
-            if plugin.cls is None:
-                store.store(group=group, name=name, node=BrokenPluginNode(name=name), provider="bionav")
-                continue
-            node_cls = plugin_node_class(name, plugin.cls.Config)
-            store.store(group=group, name=name, node=node_cls, provider=plugin.entry.distribution)
+            for group in plugin.config_groups:
+                names.setdefault(group, []).append(name)
+                if plugin.cls is None:
+                    store.store(group=group, name=name, node=BrokenPluginNode(name=name), provider="bionav")
+                    continue
+                node_cls = plugin_node_class(name, plugin.cls.Config)
+                store.store(group=group, name=name, node=node_cls, provider=plugin.entry.distribution)
     return names
 
 

@@ -77,11 +77,21 @@ class LoadedPlugin:
     error: str | None
 
     @property
+    def config_groups(self) -> tuple[str, ...]:
+        """The Hydra config groups the plugin is selected in.
+
+        ``sensor`` plugins may say ``pantilt``; a plugin serving several groups
+        (``replay``) sets ``config_group`` to a tuple of them.
+        """
+        if self.cls is None:
+            return (self.entry.kind,)
+        group = getattr(self.cls, "config_group", self.entry.kind)
+        return tuple(group) if isinstance(group, (tuple, list)) else (str(group),)
+
+    @property
     def config_group(self) -> str:
-        """The Hydra config group the plugin is selected in (``sensor`` plugins may say ``pantilt``)."""
-        if self.cls is not None:
-            return getattr(self.cls, "config_group", self.entry.kind)
-        return self.entry.kind
+        """The first (main) config group of :attr:`config_groups`."""
+        return self.config_groups[0]
 
 
 def _check_kind(kind: str) -> str:

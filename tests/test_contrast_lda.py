@@ -46,7 +46,7 @@ def test_contrast_lda_csv_round_trip_and_errors(tmp_path):
         lines.append("object," + ",".join(f"{v:.1f}" for v in rng.normal([1800, 2000, 2100, 2000, 2600], 80)) + ",tree")
     p = tmp_path / "mine.csv"
     p.write_text("\n".join(lines) + "\n")
-    cfg = OmegaConf.create({"experiment": {"name": "contrast_lda", "n_resamples": 0},
+    cfg = OmegaConf.create({"experiment": {"name": "contrast_lda", "n_resamples": 0, "plots": False},
                             "data": {"name": "csv", "path": str(p)}})
     m = contrast_lda.run(cfg, FakeContext(tmp_path))
     assert m["n_f"]["UV"] == 0.0 and m["J"]["UV"] > 50

@@ -7,8 +7,8 @@ from bionav.errors import DeviceError
 from bionav.plugins.sensors.spectral5 import (
     Spectral5Serial,
     Spectral5Sim,
-    reading_messages,
-    readings_from_messages,
+    reading_counts,
+    reading_message,
 )
 from bionav.spectral import protocol
 from bionav.spectral.fake_device import FakeSpectral5
@@ -94,9 +94,10 @@ def test_sim_sensor_and_messages():
     assert sky.shape == (3, 6) and np.all(sky == sky[0])
     # sky brighter than grass in UV, grass brighter than clear sky in IR
     assert sky[0, 0] > ground[0, 0] and ground[0, 4] > sky[0, 4]
-    msgs = reading_messages(sky, pan=0.0, tilt=1.0)
-    assert msgs[0]["uv"] == sky[0, 0] and msgs[0]["tilt"] == 1.0
-    np.testing.assert_array_equal(readings_from_messages(msgs), sky)
+    msg = reading_message(sky)
+    assert msg["counts"][0][0] == sky[0, 0] and len(msg["counts"]) == 3
+    np.testing.assert_array_equal(reading_counts(msg), sky)
+    assert sim.read()["counts"][0] == ground[0].tolist()
 
 
 def test_fake_driven_by_the_simulator():
@@ -104,3 +105,4 @@ def test_fake_driven_by_the_simulator():
     sim.point(1.0, 0.5)
     with FakeSpectral5(source=sim.measure) as fake, _driver(fake.port) as drv:
         np.testing.assert_array_equal(drv.measure(2), sim.measure(2))
+        assert drv.read() == {"counts": [sim.measure(1)[0].tolist()]}

@@ -74,7 +74,7 @@ def load_samples(data):
 
 
 def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator, out_dir, plots_dir,
-            title: str = "", progress=None) -> dict:
+            title: str = "", plots: bool = True) -> dict:
     """Run the whole analysis on a sample set and write tables and plots.
 
     Parameters
@@ -89,6 +89,8 @@ def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator
         Where tables and figures go.
     title : str
         Title for tables and figures.
+    plots : bool
+        Draw the figures.
 
     Returns
     -------
@@ -109,10 +111,11 @@ def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator
         (out_dir / "significance.md").write_text(la.significance_markdown(sig, title=title, n_resamples=n_resamples))
         for crit, s in sig.items():
             la.write_significance_csv(s, out_dir / f"significance_{crit}.csv")
-    sp.plot_pairs(samples, results, plots_dir / "uv_g_uv_ir.png", names=["UV-G", "UV-IR"], title=title)
-    sp.plot_pairs(samples, results, plots_dir / "pairs.png", title=title)
-    sp.plot_projection_histograms(samples, results, plots_dir / "projection_histograms.png", title=title)
-    sp.plot_criteria(results, plots_dir / "criteria.png", title=title)
+    if plots:
+        sp.plot_pairs(samples, results, plots_dir / "uv_g_uv_ir.png", names=["UV-G", "UV-IR"], title=title)
+        sp.plot_pairs(samples, results, plots_dir / "pairs.png", title=title)
+        sp.plot_projection_histograms(samples, results, plots_dir / "projection_histograms.png", title=title)
+        sp.plot_criteria(results, plots_dir / "criteria.png", title=title)
     best = max(results, key=lambda n: results[n].J)
     return {
         "J": {n: r.J for n, r in results.items()},
@@ -153,4 +156,5 @@ def run(cfg, ctx) -> dict:
                       schema_name="bionav.Spectral5Sample", schema=SAMPLE_SCHEMA)
     title = f"{samples.name}: {samples.n_objects} objects, {samples.n_sky} sky"
     return analyse(samples, sigma=float(_get(exp, "sigma", 30.0)), n_resamples=int(_get(exp, "n_resamples", 10000)),
-                   rng=ctx.rng, out_dir=ctx.dir, plots_dir=ctx.plots, title=title)
+                   rng=ctx.rng, out_dir=ctx.dir, plots_dir=ctx.plots, title=title,
+                   plots=bool(_get(exp, "plots", True)))

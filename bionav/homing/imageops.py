@@ -25,10 +25,15 @@ def resize_panorama(
     return out, geometry.resized(w, h)
 
 
-def gaussian_lowpass(image: np.ndarray, *, sigma: float) -> np.ndarray:
-    """Gaussian low-pass with ``sigma`` in pixels, cyclic in azimuth, reflected at top and bottom."""
-    if sigma <= 0:
+def gaussian_lowpass(image: np.ndarray, *, sigma_azimuth: float, sigma_elevation: float = 0.0) -> np.ndarray:
+    """Gaussian low-pass of a panorama ``(H, W)``, sigmas in pixels.
+
+    Cyclic along the azimuth (columns), reflected at the top and bottom rows.
+    """
+    if sigma_azimuth <= 0 and sigma_elevation <= 0:
         return image
     from scipy.ndimage import gaussian_filter
 
-    return gaussian_filter(image.astype(np.float32), sigma=sigma, mode=("reflect", "wrap"))
+    return gaussian_filter(
+        image.astype(np.float32), sigma=(sigma_elevation, sigma_azimuth), mode=("reflect", "wrap")
+    )

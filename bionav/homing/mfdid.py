@@ -10,7 +10,11 @@ robot moves by ``(dx, dy)``, so ``dC/dx = -C_theta sin(theta) / d`` and
 
     h = ( sum (C - S) C_theta sin(theta),  -sum (C - S) C_theta cos(theta) )
 
-(the positive factor ``2/d`` dropped). Angles are radians, CCW, in the
+(the positive factor ``2/d`` dropped). With ``vertical_flow``, the
+elevation flow of the same assumption (all points at one horizontal
+distance ``d``, so a point at elevation ``eps`` moves by
+``deps = sin(eps) cos(eps) (cos(theta) dx + sin(theta) dy) / d``) adds
+``C_eps sin(eps) cos(eps) (cos(theta), sin(theta))`` to the summands. Angles are radians, CCW, in the
 current view's frame; images are canonical panoramas (:mod:`bionav.geometry`)
 and must be aligned.
 
@@ -38,12 +42,21 @@ def azimuthal_derivative(image: np.ndarray, *, geometry: PanoramaGeometry) -> np
     return (np.roll(image, -1, axis=1) - np.roll(image, 1, axis=1)) / (2.0 * geometry.rad_per_column)
 
 
+def elevation_derivative(image: np.ndarray, *, geometry: PanoramaGeometry) -> np.ndarray:
+    """``dI/deps`` per pixel (central differences along the column, one-sided at the ends), per radian.
+
+    Elevation grows upwards, rows downwards, hence the sign.
+    """
+    return -np.gradient(image, axis=0) / geometry.rad_per_row
+
+
 def mfdid_home_vector(
     snapshot: np.ndarray,
     current: np.ndarray,
     *,
     geometry: PanoramaGeometry,
     current_derivative: np.ndarray | None = None,
+    current_elevation_derivative: np.ndarray | None = None,
 ) -> np.ndarray:
     """MFDID home vector, shape ``(2,)``, in the current view's frame (not normalised).
 
@@ -55,9 +68,18 @@ def mfdid_home_vector(
         Their pixel geometry.
     current_derivative : ndarray, shape (H, W), optional
         Precomputed :func:`azimuthal_derivative` of ``current``.
+    current_elevation_derivative : ndarray, shape (H, W), optional
+        :func:`elevation_derivative` of ``current``; when given, the vertical
+        flow template is used as well.
     """
     if current_derivative is None:
         current_derivative = azimuthal_derivative(current, geometry=geometry)
     theta = geometry.column_azimuths()
-    weighted = np.sum((current - snapshot) * current_derivative, axis=0)  # (W,)
-    return np.array([np.dot(weighted, np.sin(theta)), -np.dot(weighted, np.cos(theta))])
+    diff = current - snapshot
+    horizontal = np.sum(diff * current_derivative, axis=0)  # (W,)
+    h = np.array([np.dot(horizontal, np.sin(theta)), -np.dot(horizontal, np.cos(theta))])
+    if current_elevation_derivative is not None:
+        eps = geometry.row_elevations()[:, None]
+        vertical = np.sum(diff * current_elevation_derivative * np.sin(eps) * np.cos(eps), axis=0)
+        h += np.array([np.dot(vertical, np.cos(theta)), np.dot(vertical, np.sin(theta))])
+    return h

@@ -25,8 +25,7 @@ def main() -> int:
             print("  (none)")
         for name, plugin in sorted(loaded.items()):
             e = plugin.entry
-            group = plugin.config_group
-            select = f"{group}={name}"
+            select = " ".join(f"{group}={name}" for group in plugin.config_groups)
             state = "ok" if plugin.cls is not None else "FAILED"
             print(f"  {select:28s} {e.distribution} {e.version:10s} {state}")
             if plugin.error:

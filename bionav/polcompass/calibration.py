@@ -114,7 +114,8 @@ def calibrate_from_rotation(
     nominal : UnitCalibration, optional
         Design values; their mean gain and unit 0's angle are kept.
     harmonics : tuple of int, optional
-        Odd harmonics of ``2 psi`` in the fit.
+        Odd harmonics of ``2 psi`` in the fit; only as many as keep the fit
+        twice overdetermined in the number of distinct angles are used.
 
     Returns
     -------
@@ -128,11 +129,14 @@ def calibrate_from_rotation(
     nominal = nominal or UnitCalibration.nominal()
     if len(nominal.unit_angles) != k:
         raise ValueError(f"nominal calibration has {len(nominal.unit_angles)} units, data {k}")
-    span = np.ptp(np.unwrap(2.0 * rotation)) / 2.0 if rotation.size else 0.0
-    if span < np.pi * 0.95 or rotation.size < 2 * (2 * len(harmonics) + 1):
+    span = np.ptp(np.unwrap(2.0 * np.sort(rotation))) / 2.0 if rotation.size else 0.0
+    n_angles = np.unique(np.round(np.mod(2.0 * rotation, 2.0 * np.pi), 9)).size
+    # Keep the fit at least twice overdetermined in distinct angles (few positions: fewer harmonics).
+    harmonics = tuple(harmonics[: max(0, min(len(harmonics), (n_angles // 2 - 1) // 2))])
+    if span < np.pi * 0.95 or not harmonics:
         raise UserError(
-            f"Calibration needs a rotation of at least 180 degrees with enough samples; got "
-            f"{np.degrees(span):.0f} degrees in {rotation.size} samples. Scan a wider pan range "
+            f"Calibration needs a rotation of at least 180 degrees at 6 or more distinct angles; got "
+            f"{np.degrees(span):.0f} degrees at {n_angles} angles. Scan a wider pan range "
             "(experiment.pan_range_deg) or give experiment.calibration_path."
         )
     columns = [np.ones_like(rotation)]

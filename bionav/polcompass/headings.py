@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bionav.geometry import wrap_angle
-from bionav.polcompass.compass import wrap_axial
+from bionav.polcompass.compass import choose_candidate, wrap_axial
 from bionav.polcompass.optics import CompassOptics
 
 
@@ -176,9 +176,9 @@ def solve_pose(
     if not np.any(far):
         return PoseSolution(float(roots[best]), np.nan, float(errors[best]), np.nan, True)
     alt = int(np.flatnonzero(far)[np.argmin(errors[far])])
-    return PoseSolution(
-        float(roots[best]), float(roots[alt]), float(errors[best]), float(errors[alt]), bool(errors[alt] - errors[best] > margin)
-    )
+    # The candidate pair (best root, its partner about a half turn away), chosen by the error function.
+    chosen, resolved = choose_candidate(roots[best], roots[alt], errors[best], errors[alt], margin=margin)
+    return PoseSolution(float(chosen), float(roots[alt]), float(errors[best]), float(errors[alt]), bool(resolved))
 
 
 @dataclass(frozen=True)

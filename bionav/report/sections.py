@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from bionav.report.ranking import ranking_sections
 from bionav.report.table import markdown_table
 
 
@@ -78,9 +79,5 @@ def extra_sections(root: Path, rows: list[dict[str, Any]]) -> list[str]:
             "Significance: * 5 %, ** 1 %, *** 0.1 % (the BCa interval of the difference excludes zero).\n\n"
             + markdown_table(comparisons, cols)
         )
-    try:
-        from bionav.report.ranking import ranking_sections
-    except ImportError:
-        return sections
     sections += ranking_sections(root, rows)
     return sections

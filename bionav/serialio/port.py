@@ -19,6 +19,13 @@ import serial
 
 from bionav.errors import DeviceError
 
+try:  # POSIX: tcdrain() on a vanished device raises termios.error, not OSError
+    import termios
+
+    _LOST_ERRORS: tuple = (serial.SerialException, OSError, termios.error)
+except ImportError:  # Windows
+    _LOST_ERRORS = (serial.SerialException, OSError)
+
 
 class ConnectionLost(DeviceError):
     """The device vanished mid-command (unplugged); :meth:`SerialLink.transact` may reconnect."""
@@ -197,7 +204,7 @@ class SerialLink:
             raise self.error(
                 command, f"did not accept data within {self.write_timeout:g} s", "Check the cable and flow control."
             ) from None
-        except (serial.SerialException, OSError) as exc:
+        except _LOST_ERRORS as exc:
             self.close()
             raise ConnectionLost(str(self._lost(command, exc))) from None
 

@@ -160,3 +160,52 @@ class FakeSpectral5:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Serve a fake five-channel board and a fake PTU-46 looking into one simulated backyard.
+
+    ``python -m bionav.spectral.fake_device [--time ISO] [--cloud-cover F] [--cloud-optical-depth F]``
+    prints the two pseudo-terminal paths; point ``sensor=spectral5_serial sensor.port=...`` and
+    ``pantilt=ptu46 pantilt.port=...`` at them to run ``experiment=contrast_scan`` over the real
+    drivers. Ctrl-C stops.
+    """
+    import argparse
+    import sys
+    import time
+
+    from bionav.plugins.sensors.fakes.ptu46 import FakePTU46
+    from bionav.plugins.sensors.spectral5 import Spectral5Sim
+    from bionav.spectral.scene import backyard_scene
+    from bionav.spectral.sky import CloudField, SkyState
+
+    parser = argparse.ArgumentParser(prog="python -m bionav.spectral.fake_device", description=main.__doc__)
+    parser.add_argument("--time", default="2009-06-17T11:27:04+02:00", help="ISO 8601 time with zone")
+    parser.add_argument("--cloud-cover", type=float, default=0.6)
+    parser.add_argument("--cloud-optical-depth", type=float, default=30.0)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    sky = SkyState.from_time(args.time, clouds=CloudField(cover=args.cloud_cover,
+                                                          optical_depth=args.cloud_optical_depth, seed=args.seed))
+    scene = backyard_scene(sky, seed=args.seed)
+    sim = Spectral5Sim(Spectral5Sim.Config(seed=args.seed))
+    sim.attach_simulation(scene, None)
+    ptu = FakePTU46(scene.set_pose)
+    ptu.start()
+    board = FakeSpectral5(source=sim.measure, seed=args.seed)
+    print(f"spectral5    sensor=spectral5_serial sensor.port={board.port}", flush=True)
+    print(f"{ptu.name:12s} pantilt=ptu46 pantilt.port={ptu.port}", flush=True)
+    print("serving; Ctrl-C stops", file=sys.stderr, flush=True)
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        board.close()
+        ptu.stop()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -42,7 +42,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.special import ndtri
+from scipy.special import ndtr, ndtri
 
 from bionav.spectral.bands import WAVELENGTHS_NM, band_integrate
 
@@ -114,6 +114,10 @@ class CloudField:
         Drift of the field (east, north) in m/s; ``time_s`` in :meth:`optical_depth_at` moves it.
     softness : float
         Width of the cloud edge in units of the field's standard deviation.
+    resolution : float
+        Angular resolution (radians) of a line of sight; cloud detail finer than
+        its footprint on the layer is averaged (no aliasing near the horizon,
+        where distant clouds merge into a uniform cover).
     """
 
     cover: float = 0.0
@@ -122,8 +126,9 @@ class CloudField:
     height_m: float = 1500.0
     scale_m: float = 1500.0
     wind_mps: tuple = (5.0, 2.0)
-    softness: float = 0.4
+    softness: float = 0.15
     n_waves: int = 24
+    resolution: float = float(np.deg2rad(1.0))
 
     def _waves(self):
         r = np.random.default_rng(self.seed)
@@ -156,17 +161,22 @@ class CloudField:
             return np.zeros(d.shape[:-1])
         if self.cover >= 1:
             return np.full(d.shape[:-1], float(self.optical_depth))
-        dz = np.maximum(d[..., 2], np.sin(np.deg2rad(2.0)))
+        dz = np.maximum(d[..., 2], np.sin(np.deg2rad(1.0)))
         reach = self.height_m / dz
         px = origin_m[0] + d[..., 0] * reach - self.wind_mps[0] * time_s
         py = origin_m[1] + d[..., 1] * reach - self.wind_mps[1] * time_s
         kvec, phase, amp = self._waves()
-        f = np.cos(px[..., None] * kvec[:, 0] + py[..., None] * kvec[:, 1] + phase) @ amp
+        # anti-aliasing: a line of sight averages the layer over a footprint that
+        # grows with distance and obliquity; waves much smaller than it are damped
+        footprint = reach * self.resolution / dz
+        damp = np.exp(-0.5 * (np.linalg.norm(kvec, axis=1) * footprint[..., None]) ** 2)
+        a = amp * damp
+        f = np.sum(a * np.cos(px[..., None] * kvec[:, 0] + py[..., None] * kvec[:, 1] + phase), axis=-1)
+        lost = np.clip(1.0 - 0.5 * np.sum(a**2, axis=-1), 0.0, 1.0)  # variance no longer resolved
         thr = ndtri(1.0 - self.cover)
-        density = np.clip((f - thr) / self.softness + 0.5, 0.0, 1.0)
-        # far clouds near the horizon are seen through long paths: keep the core depth
-        tau = self.optical_depth * density
-        return np.where(d[..., 2] > np.sin(np.deg2rad(2.0)), tau, self.optical_depth * self.cover)
+        # probability that the resolved field plus unresolved detail exceeds the threshold
+        density = ndtr((f - thr) / np.sqrt(self.softness**2 + lost))
+        return self.optical_depth * density
 
 
 @dataclass(frozen=True)

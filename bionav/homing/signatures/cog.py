@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.homing.signatures.rings import ring_edges, ring_index
+from bionav.homing.signatures.rings import ring_edges
 
 
 @dataclass(frozen=True)

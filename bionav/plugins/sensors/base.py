@@ -36,8 +36,18 @@ class DevicePlugin:
     schema_name: ClassVar[str] = "bionav.Reading"
     schema: ClassVar[dict] = {"type": "object"}
 
+    #: where the user sets this plugin's parameters (``sensor``, ``pantilt``, or e.g.
+    #: ``experiment.reference`` when an experiment uses a sensor under another role);
+    #: the experiment may overwrite it so error messages name the right key
+    config_prefix: str | None = None
+
     def __init__(self, config: Any) -> None:
         self.config = config
+
+    def config_key(self, field: str) -> str:
+        """The full config key of one parameter, for messages (``sensor.port``)."""
+        group = self.config_group if isinstance(self.config_group, str) else self.config_group[0]
+        return f"{self.config_prefix or group}.{field}"
 
     def attach_simulation(self, scene: Any, rng: Any) -> None:
         """Receive the simulated world (simulated plugins only; others ignore it)."""
@@ -54,6 +64,51 @@ class DevicePlugin:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+class SerialDeviceMixin:
+    """Open/close of a device behind one serial link (pyserial, timeouts, reconnect).
+
+    The using class sets ``device_name`` (for messages), has a ``config`` with
+    ``port``, ``baudrate``, ``timeout_s``, ``reconnect_attempts`` and
+    ``reconnect_delay_s``, and implements ``_init_device()``, which is run
+    after every (re)connection.
+    """
+
+    device_name: ClassVar[str] = "serial device"
+    _link: Any = None
+
+    def open(self) -> None:
+        from bionav.errors import DeviceError
+        from bionav.serialio import SerialLink
+
+        if self._link is not None:
+            return
+        link = SerialLink(
+            self.config.port,
+            baudrate=self.config.baudrate,
+            timeout=self.config.timeout_s,
+            device=self.device_name,
+            config_key=self.config_key("port"),
+            reconnect_attempts=self.config.reconnect_attempts,
+            reconnect_delay=self.config.reconnect_delay_s,
+        )
+        link.open()
+        link.on_reconnect = self._init_device
+        self._link = link
+        try:
+            self._init_device()
+        except DeviceError:
+            self.close()
+            raise
+
+    def _init_device(self) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        link, self._link = self._link, None
+        if link is not None:
+            link.close()
 
 
 class SensorPlugin(DevicePlugin):

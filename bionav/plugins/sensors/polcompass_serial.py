@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from bionav.errors import DeviceError, UserError
-from bionav.plugins.sensors.base import SensorPlugin
+from bionav.errors import UserError
+from bionav.plugins.sensors.base import SensorPlugin, SerialDeviceMixin
 
 ANALOG_COMMANDS = b"ZXCVBNM,"
 
@@ -42,9 +42,10 @@ class PolCompassSerialConfig:
     reconnect_delay_s: float = 0.5
 
 
-class PolCompassSerial(SensorPlugin):
+class PolCompassSerial(SerialDeviceMixin, SensorPlugin):
     """Polarized-light compass on a DLP-IO8-G board over a serial port."""
 
+    device_name = "DLP-IO8-G (polarized-light compass)"
     Config = PolCompassSerialConfig
     schema_name = "bionav.PolCompassReading"
     schema = READING_SCHEMA
@@ -58,37 +59,9 @@ class PolCompassSerial(SensorPlugin):
         self.lines = lines
         self._link = None
 
-    def open(self) -> None:
-        from bionav.serialio import SerialLink
-
-        if self._link is not None:
-            return
-        link = SerialLink(
-            self.config.port,
-            baudrate=self.config.baudrate,
-            timeout=self.config.timeout_s,
-            device="DLP-IO8-G (polarized-light compass)",
-            config_key="sensor.port",
-            reconnect_attempts=self.config.reconnect_attempts,
-            reconnect_delay=self.config.reconnect_delay_s,
-        )
-        link.open()
-        link.on_reconnect = self._init_device
-        self._link = link
-        try:
-            self._init_device()
-        except DeviceError:
-            self.close()
-            raise
-
     def _init_device(self) -> None:
         self._link.reset_input()
         self._link.write(b"\\", command="\\ (binary mode)")
-
-    def close(self) -> None:
-        link, self._link = self._link, None
-        if link is not None:
-            link.close()
 
     def read_line_count(self, line: int) -> int:
         """One 10-bit count from analog ``line`` (1-8)."""

@@ -21,8 +21,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from bionav.errors import DeviceError
-from bionav.plugins.sensors.base import PanTiltPlugin
+from bionav.plugins.sensors.base import PanTiltPlugin, SerialDeviceMixin
 
 
 @dataclass
@@ -38,9 +37,10 @@ class PTU46Config:
     reconnect_delay_s: float = 0.5
 
 
-class PTU46(PanTiltPlugin):
+class PTU46(SerialDeviceMixin, PanTiltPlugin):
     """Directed Perception PTU-46-17.5."""
 
+    device_name = "PTU-46 pan-tilt unit"
     Config = PTU46Config
     config_group = "pantilt"
 
@@ -51,29 +51,6 @@ class PTU46(PanTiltPlugin):
         self._limits = None
 
     # -- life cycle ---------------------------------------------------------
-    def open(self) -> None:
-        from bionav.serialio import SerialLink
-
-        if self._link is not None:
-            return
-        link = SerialLink(
-            self.config.port,
-            baudrate=self.config.baudrate,
-            timeout=self.config.timeout_s,
-            device="PTU-46 pan-tilt unit",
-            config_key="pantilt.port",
-            reconnect_attempts=self.config.reconnect_attempts,
-            reconnect_delay=self.config.reconnect_delay_s,
-        )
-        link.open()
-        link.on_reconnect = self._init_device
-        self._link = link
-        try:
-            self._init_device()
-        except DeviceError:
-            self.close()
-            raise
-
     def _init_device(self) -> None:
         link = self._link
         link.write(b"ED ", command="ED ")
@@ -81,11 +58,6 @@ class PTU46(PanTiltPlugin):
         link.drain(quiet=self.config.settle_s, limit=5 * self.config.settle_s + 1.0)
         self._res = (self._query_float("PR "), self._query_float("TR "))
         self._limits = tuple(self._query_int(c) for c in ("PN ", "PX ", "TN ", "TX "))
-
-    def close(self) -> None:
-        link, self._link = self._link, None
-        if link is not None:
-            link.close()
 
     # -- protocol -----------------------------------------------------------
     def _command(self, text: str, *, timeout: float | None = None) -> str:

@@ -6,11 +6,13 @@ over bionav's line protocol (documented in :mod:`bionav.spectral.protocol`);
 :mod:`bionav.spectral`. Both return raw readings as an integer array of shape
 ``(n, 6)``: ``uv, b, g, r, ir, ref`` 12-bit ADC counts.
 
-Experiments record every raw reading to ``run.mcap`` under the topic
-:data:`RAW_TOPIC` (``/spectral5/raw``, schema ``bionav.Spectral5Reading``: one
-message per reading with integer fields ``uv, b, g, r, ir, ref`` and, where the
-sensor sits on a pan-tilt unit, ``pan`` and ``tilt`` in radians), so that a
-session can be replayed.
+Both are ``bionav.sensors`` plugins with the life cycle of bionav's sensor
+contract (``open``/``close``/context manager, ``attach_simulation(scene, rng)``)
+and ``read() -> dict``: one raw reading ``{"counts": [[uv, b, g, r, ir, ref],
+...]}`` (the reply to one ``M<n>``). Experiments record every raw reading to
+``run.mcap`` under :data:`RAW_TOPIC` (``/sensor/raw``, schema
+``bionav.Spectral5Reading``) as it is taken, and pan-tilt states under
+``/pantilt/state``, so that ``sensor=replay`` re-runs a session from its log.
 
 This module stays light: pyserial and the physical model are imported inside
 methods.
@@ -19,46 +21,60 @@ methods.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
 from bionav.errors import DeviceError
+from bionav.plugins.sensors.base import SensorPlugin
 
-#: MCAP topic of raw readings.
-RAW_TOPIC = "/spectral5/raw"
+#: MCAP topic of raw readings (the convention of ``sensor=replay``: one message per ``read()``).
+RAW_TOPIC = "/sensor/raw"
 #: Schema name and JSON schema of one raw reading message.
 RAW_SCHEMA_NAME = "bionav.Spectral5Reading"
 RAW_SCHEMA = {
     "type": "object",
     "title": RAW_SCHEMA_NAME,
-    "description": "One raw reading of the five-channel log sensor (12-bit ADC counts).",
+    "description": "The reply to one measure command of the five-channel log sensor: n readings of "
+                   "uv, b, g, r, ir, ref 12-bit ADC counts.",
     "properties": {
-        "uv": {"type": "integer"}, "b": {"type": "integer"}, "g": {"type": "integer"},
-        "r": {"type": "integer"}, "ir": {"type": "integer"}, "ref": {"type": "integer"},
-        "pan": {"type": "number", "description": "pan angle, radians CCW"},
-        "tilt": {"type": "number", "description": "tilt angle, radians, positive up"},
+        "counts": {"type": "array", "items": {"type": "array", "items": {"type": "integer"},
+                                               "minItems": 6, "maxItems": 6}},
     },
-    "required": ["uv", "b", "g", "r", "ir", "ref"],
+    "required": ["counts"],
 }
-_FIELDS = ("uv", "b", "g", "r", "ir", "ref")
+
+
+def reading_message(readings) -> dict:
+    """A raw reply ``(n, 6)`` as the dict ``read()`` returns and ``/sensor/raw`` records."""
+    return {"counts": np.asarray(readings, dtype=np.int64).reshape(-1, 6).tolist()}
+
+
+def reading_counts(message) -> np.ndarray:
+    """Inverse of :func:`reading_message`: the ``(n, 6)`` int array of a raw reading dict."""
+    return np.asarray(message["counts"], dtype=np.int64).reshape(-1, 6)
 
 
 class BadReply(DeviceError):
     """A garbage, short, incomplete or missing reply (worth retrying the command)."""
 
 
-def reading_messages(readings, **extra) -> list[dict]:
-    """Raw readings ``(n, 6)`` as :data:`RAW_TOPIC` messages (``extra`` fields added to each)."""
-    return [dict(zip(_FIELDS, (int(v) for v in row)), **extra) for row in np.asarray(readings).reshape(-1, 6)]
+class _Spectral5Base(SensorPlugin):
+    """What both spectral5 plugins share: schema of raw readings, life cycle, ``read()``."""
+
+    config_group = "sensor"
+    simulated = False
+    schema_name = RAW_SCHEMA_NAME
+    schema = RAW_SCHEMA
+
+    def measure(self, n: int | None = None) -> np.ndarray:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def read(self) -> dict:
+        """One raw reading: the reply to ``M<readings_per_point>`` as ``{"counts": [[uv, b, g, r, ir, ref], ...]}``."""
+        return reading_message(self.measure())
 
 
-def readings_from_messages(messages) -> np.ndarray:
-    """Inverse of :func:`reading_messages`: ``(n, 6)`` int array from message dicts."""
-    return np.array([[int(m[f]) for f in _FIELDS] for m in messages], dtype=np.int64).reshape(-1, 6)
-
-
-class Spectral5Serial:
+class Spectral5Serial(_Spectral5Base):
     """Driver of the five-channel sensor board (ADuC812) over a serial line.
 
     Protocol: :mod:`bionav.spectral.protocol` (9600 8N1, ``M<n>\\r`` /
@@ -126,12 +142,6 @@ class Spectral5Serial:
                 self._serial.close()
             finally:
                 self._serial = None
-
-    def __enter__(self) -> "Spectral5Serial":
-        return self.open()
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     # -- protocol ---------------------------------------------------------
     def _fail(self, command: bytes, problem: str) -> BadReply:
@@ -239,17 +249,20 @@ class Spectral5Serial:
         raise AssertionError("unreachable")  # pragma: no cover
 
 
-class Spectral5Sim:
+class Spectral5Sim(_Spectral5Base):
     """Simulated five-channel sensor from the physical model of :mod:`bionav.spectral`.
 
-    The sensor looks along a direction set by :meth:`point` (pan = azimuth,
-    radians CCW from east; tilt = elevation, radians) into a scene: a callable
-    ``scene(pan, tilt) -> band radiance (5,)``. The default scene is an open
-    field under a clear sky with the sun at 45 degrees: sky above the horizon,
-    sunlit grass below it.
+    The sensor reads its *scene*: any object with ``band_radiance() -> (5,)``
+    (the band radiance along the current optical axis) and ``set_pose(pan,
+    tilt)`` (radians), such as :class:`bionav.spectral.scene.OutdoorScene`. An
+    experiment hands its scene over with :meth:`attach_simulation` (a
+    simulated pan-tilt unit aims it); without one, the sensor looks into an
+    open field under a clear sky with the sun at 45 degrees (sky above the
+    horizon, sunlit grass below), aimed with :meth:`point`.
     """
 
     config_group = "sensor"
+    simulated = True
 
     @dataclass
     class Config:
@@ -260,38 +273,48 @@ class Spectral5Sim:
         noise_counts : float
             Standard deviation of per-reading noise, ADC counts.
         readings_per_point : int
-            Readings per measurement.
+            Readings per measurement (``n`` of the board's ``M<n>``).
         seed : int
-            Seed of the noise when no generator is passed.
+            Seed of the noise until an experiment attaches its generator.
         """
 
         noise_counts: float = 4.0
         readings_per_point: int = 1
         seed: int = 0
 
-    def __init__(self, config: "Spectral5Sim.Config | None" = None, *, rng: np.random.Generator | None = None,
-                 scene: Callable | None = None, **_ignored) -> None:
+    def __init__(self, config: "Spectral5Sim.Config | None" = None, **_ignored) -> None:
         from bionav.spectral.sensor_model import LogSensorModel
 
         self.config = config or self.Config()
-        self.rng = rng if rng is not None else np.random.default_rng(self.config.seed)
+        self.rng = np.random.default_rng(self.config.seed)
         self.model = LogSensorModel(noise_counts=self.config.noise_counts)
-        self.scene = scene or _open_field_scene()
-        self.pan = 0.0
-        self.tilt = 0.0
+        self.scene = None
+
+    def attach_simulation(self, scene, rng) -> None:
+        """Read ``scene`` from now on, with noise drawn from ``rng``."""
+        if not hasattr(scene, "band_radiance"):
+            raise TypeError(f"spectral5_sim needs a spectral scene with band_radiance(), got {type(scene).__name__}")
+        self.scene = scene
+        if rng is not None:
+            self.rng = rng
+
+    def _scene(self):
+        if self.scene is None:
+            self.scene = OpenField()
+        return self.scene
 
     def point(self, pan: float, tilt: float) -> None:
-        """Aim the sensor: ``pan`` azimuth and ``tilt`` elevation in radians."""
-        self.pan, self.tilt = float(pan), float(tilt)
+        """Aim the sensor: ``pan`` azimuth and ``tilt`` elevation in radians (sets the scene's pose)."""
+        self._scene().set_pose(pan, tilt)
 
     def identify(self) -> str:
         """Identification line (as the board would send it)."""
         return "SPECTRAL5 simulated (bionav.spectral physical model)"
 
     def measure(self, n: int | None = None) -> np.ndarray:
-        """``n`` readings ``(n, 6)`` of the scene in the current direction."""
+        """``n`` readings ``(n, 6)`` of the scene along the current optical axis."""
         n = int(n or self.config.readings_per_point)
-        rad = np.asarray(self.scene(self.pan, self.tilt), dtype=float)
+        rad = np.asarray(self._scene().band_radiance(), dtype=float)
         return self.model.read(rad, rng=self.rng, n_readings=n)
 
     def open(self) -> "Spectral5Sim":
@@ -300,25 +323,30 @@ class Spectral5Sim:
     def close(self) -> None:
         """Nothing to release."""
 
-    def __enter__(self) -> "Spectral5Sim":
-        return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+class OpenField:
+    """The default scene of ``spectral5_sim``: clear sky (sun at 45 degrees elevation) over sunlit grass.
 
+    Pan is the azimuth (radians CCW from east), tilt the elevation (radians).
+    """
 
-def _open_field_scene():
-    from bionav.spectral.bands import band_integrate
-    from bionav.spectral.materials import MATERIALS
-    from bionav.spectral.sky import SkyState, band_sky_radiance, direction, illumination
+    def __init__(self) -> None:
+        from bionav.spectral.bands import band_integrate
+        from bionav.spectral.materials import MATERIALS
+        from bionav.spectral.sky import SkyState, illumination
 
-    state = SkyState(sun_elevation=np.deg2rad(45.0), sun_azimuth=np.deg2rad(200.0))
-    grass = np.asarray(MATERIALS["grass"].reflectance)
-    ground = grass * band_integrate(illumination(state).global_horizontal) / np.pi
+        self.sky = SkyState(sun_elevation=np.deg2rad(45.0), sun_azimuth=np.deg2rad(200.0))
+        grass = np.asarray(MATERIALS["grass"].reflectance)
+        self._ground = grass * band_integrate(illumination(self.sky).global_horizontal) / np.pi
+        self.pose = (0.0, 0.0)
 
-    def scene(pan, tilt):
+    def set_pose(self, pan: float, tilt: float) -> None:
+        self.pose = (float(pan), float(tilt))
+
+    def band_radiance(self) -> np.ndarray:
+        from bionav.spectral.sky import band_sky_radiance, direction
+
+        pan, tilt = self.pose
         if tilt > 0:
-            return band_sky_radiance(state, direction(tilt, pan))
-        return ground
-
-    return scene
+            return band_sky_radiance(self.sky, direction(tilt, pan))
+        return self._ground

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from bionav.errors import DeviceError, UserError
-from bionav.plugins.sensors.base import SensorPlugin
+from bionav.errors import UserError
+from bionav.plugins.sensors.base import SensorPlugin, SerialDeviceMixin
 
 READING_SCHEMA = {
     "type": "object",
@@ -48,9 +48,10 @@ class TCM2Config:
     reconnect_delay_s: float = 0.5
 
 
-class TCM2(SensorPlugin):
+class TCM2(SerialDeviceMixin, SensorPlugin):
     """PNI TCM2 electronic compass."""
 
+    device_name = "TCM2 compass"
     Config = TCM2Config
     schema_name = "bionav.TCM2Reading"
     schema = READING_SCHEMA
@@ -61,40 +62,12 @@ class TCM2(SensorPlugin):
             raise UserError(f"sensor.output={config.output!r} is not a TCM2 output format; choose standard, nmea or keep.")
         self._link = None
 
-    def open(self) -> None:
-        from bionav.serialio import SerialLink
-
-        if self._link is not None:
-            return
-        link = SerialLink(
-            self.config.port,
-            baudrate=self.config.baudrate,
-            timeout=self.config.timeout_s,
-            device="TCM2 compass",
-            config_key="sensor.port",
-            reconnect_attempts=self.config.reconnect_attempts,
-            reconnect_delay=self.config.reconnect_delay_s,
-        )
-        link.open()
-        link.on_reconnect = self._init_device
-        self._link = link
-        try:
-            self._init_device()
-        except DeviceError:
-            self.close()
-            raise
-
     def _init_device(self) -> None:
         self._link.write(b"h\r", command="h")
         if self.config.output != "keep":
             cmd = "sdo=t" if self.config.output == "standard" else "sdo=n"
             self._link.write(cmd.encode() + b"\r", command=cmd)
         self._link.drain(quiet=0.05, limit=1.0)
-
-    def close(self) -> None:
-        link, self._link = self._link, None
-        if link is not None:
-            link.close()
 
     def read(self) -> dict:
         from bionav.plugins.sensors.tcm2_protocol import TCM2FormatError, parse_line

@@ -91,19 +91,40 @@ class FakeSerialDevice:
                     setattr(self, name, None)
 
     # -- faults -------------------------------------------------------------
-    def inject(self, kind: str, *, after: int = 0, count: int = 1) -> None:
-        """Let the ``count`` commands following the next ``after`` ones suffer fault ``kind``."""
+    def inject(self, kind: str, *, on: bytes | None = None, after: int = 0, count: int = 1) -> None:
+        """Let ``count`` commands suffer fault ``kind``.
+
+        Parameters
+        ----------
+        kind : str
+            One of :data:`FAULTS`.
+        on : bytes, optional
+            Only commands equal to this count (default: every command).
+        after : int, optional
+            Let this many (matching) commands pass unharmed first.
+        count : int, optional
+            How many (matching) commands are hit.
+        """
         if kind not in FAULTS:
             raise ValueError(f"unknown fault {kind!r}; choose from {FAULTS}")
         with self._lock:
-            for _ in range(after):
-                self._faults.append(None)
-            for _ in range(count):
-                self._faults.append(kind)
+            self._faults.append([kind, on, int(after), int(count)])
 
-    def _next_fault(self):
+    def _next_fault(self, command: bytes):
         with self._lock:
-            return self._faults.popleft() if self._faults else None
+            if not self._faults:
+                return None
+            entry = self._faults[0]
+            kind, on, after, count = entry
+            if on is not None and command != on:
+                return None
+            if after > 0:
+                entry[2] -= 1
+                return None
+            entry[3] -= 1
+            if entry[3] <= 0:
+                self._faults.popleft()
+            return kind
 
     # -- protocol hooks -----------------------------------------------------
     def split_commands(self, buffer: bytes) -> tuple[list[bytes], bytes]:
@@ -160,7 +181,7 @@ class FakeSerialDevice:
             commands, self._buffer = self.split_commands(self._buffer)
             for command in commands:
                 self.received.append(command)
-                fault = self._next_fault()
+                fault = self._next_fault(command)
                 if fault == "unplug":
                     self._unplugged.set()
                     self._close_fds()

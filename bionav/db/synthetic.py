@@ -1,0 +1,370 @@
+"""Synthetic stand-ins for the image databases of thesis table 3.1.
+
+``synthetic_database("sim_original")`` renders (or loads from the on-disk
+cache) a grid of canonical panoramas in a procedurally generated world with
+the grid shape, spacing and mirror field of view of the real database, adds
+camera noise and 8-bit quantisation, and optionally rotates every image by a
+random whole number of columns (Vardy's protocol for current views).
+
+The stand-ins (:data:`SYNTHETIC_DATABASES`):
+
+=============== ======= ======= ======== ======= ==========================================
+name            grid    spacing #images  mirror  world
+=============== ======= ======= ======== ======= ==========================================
+sim_original    10x17   0.3 m   170      ultra   laboratory, curtains closed, both bands on
+sim_arboreal    10x17   0.3 m   170      ultra   + arboreal plant in the middle
+sim_chairs      10x17   0.3 m   170      ultra   + office chairs
+sim_day         10x17   0.3 m   170      ultra   curtains open, daylight
+sim_doorlit     10x17   0.3 m   170      ultra   only the door-side light band on
+sim_screen      10x17   0.3 m   170      ultra   + white projection screen
+sim_twilight    10x17   0.3 m   170      ultra   curtains open, twilight
+sim_winlit      10x17   0.3 m   170      ultra   only the window-side light band on
+sim_hall1       10x20   0.5 m   170      ultra   dim achromatic hall with pillars
+sim_hall2       10x20   0.5 m   170      ultra   another part of the hall
+sim_moeller1    11x22   0.1 m   242      ultra   living room
+sim_roeben1     11x36   0.1 m   396      ultra   living room with kitchen
+sim_uni         10x17   1.0 m   170      normal  outdoors: buildings, trees, sky, sun
+=============== ======= ======= ======== ======= ==========================================
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterable
+
+import numpy as np
+
+from bionav.db.database import ImageDatabase
+from bionav.errors import UserError
+from bionav.geometry import PanoramaGeometry
+
+#: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
+NATIVE_SIZE = (561, 81)
+
+#: Bump when the database pipeline (noise, quantisation, layout) changes.
+DATABASE_VERSION = 1
+
+
+def ultra_wide_geometry(width: int = NATIVE_SIZE[0], height: int = NATIVE_SIZE[1]) -> PanoramaGeometry:
+    """Ultra-wide-view mirror: square pixels, horizon on the middle row (about +-26 deg at 561 x 81)."""
+    return PanoramaGeometry.square_pixels(*NATIVE_SIZE).resized(width, height)
+
+
+def normal_view_geometry(width: int = NATIVE_SIZE[0], height: int = NATIVE_SIZE[1]) -> PanoramaGeometry:
+    """Normal-view mirror: narrower view upwards (about +17 deg) and more of the ground (about -34 deg)."""
+    native = PanoramaGeometry.square_pixels(*NATIVE_SIZE, horizon_row=27.0)
+    return native.resized(width, height)
+
+
+def _lab(variant: str):
+    def build(seed: int):
+        from bionav.world.worlds.lab import build_lab_variant
+
+        return build_lab_variant(variant, seed)
+
+    return build
+
+
+def _lazy(module: str, func: str, **kwargs):
+    def build(seed: int):
+        import importlib
+
+        return getattr(importlib.import_module(module), func)(seed, **kwargs)
+
+    return build
+
+
+@dataclass(frozen=True)
+class SyntheticSpec:
+    """One synthetic stand-in of thesis table 3.1.
+
+    Attributes
+    ----------
+    name : str
+        ``sim_<thesis name>``.
+    grid_shape : (int, int)
+        ``(nx, ny)`` of the declared grid.
+    spacing_m : float
+        Grid spacing in metres.
+    n_images : int
+        Number of existing cells (table 3.1).
+    mirror : str
+        ``ultra-wide`` or ``normal-view``.
+    description : str
+        What the world shows.
+    builder : callable
+        ``builder(seed) -> World``.
+    geometry : callable
+        ``geometry(W, H) -> PanoramaGeometry``.
+    """
+
+    name: str
+    grid_shape: tuple[int, int]
+    spacing_m: float
+    n_images: int
+    mirror: str
+    description: str
+    builder: Callable
+    geometry: Callable[[int, int], PanoramaGeometry] = ultra_wide_geometry
+    native_size: tuple[int, int] = NATIVE_SIZE
+
+
+def _spec(name, grid, spacing, n, mirror, description, builder) -> SyntheticSpec:
+    geom = normal_view_geometry if mirror == "normal-view" else ultra_wide_geometry
+    return SyntheticSpec(name, grid, spacing, n, mirror, description, builder, geom)
+
+
+#: The 13 synthetic stand-ins, by name.
+SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
+    s.name: s
+    for s in [
+        _spec("sim_original", (10, 17), 0.3, 170, "ultra-wide",
+              "laboratory, curtains and door closed, both ceiling light bands on", _lab("original")),
+        _spec("sim_arboreal", (10, 17), 0.3, 170, "ultra-wide",
+              "the laboratory with an arboreal plant in the middle", _lab("arboreal")),
+        _spec("sim_chairs", (10, 17), 0.3, 170, "ultra-wide", "the laboratory with chairs added", _lab("chairs")),
+        _spec("sim_day", (10, 17), 0.3, 170, "ultra-wide",
+              "the laboratory with open curtains and daylight", _lab("day")),
+        _spec("sim_doorlit", (10, 17), 0.3, 170, "ultra-wide",
+              "the laboratory with only the door-side light band on", _lab("doorlit")),
+        _spec("sim_screen", (10, 17), 0.3, 170, "ultra-wide",
+              "the laboratory with a white projection screen", _lab("screen")),
+        _spec("sim_twilight", (10, 17), 0.3, 170, "ultra-wide",
+              "the laboratory with open curtains at twilight", _lab("twilight")),
+        _spec("sim_winlit", (10, 17), 0.3, 170, "ultra-wide",
+              "the laboratory with only the window-side light band on", _lab("winlit")),
+        _spec("sim_hall1", (10, 20), 0.5, 170, "ultra-wide",
+              "a large, dim, achromatic hall with pillars (cells missing around obstacles)",
+              _lazy("bionav.world.worlds.hall", "build_hall", part=1)),
+        _spec("sim_hall2", (10, 20), 0.5, 170, "ultra-wide", "another part of the hall",
+              _lazy("bionav.world.worlds.hall", "build_hall", part=2)),
+        _spec("sim_moeller1", (11, 22), 0.1, 242, "ultra-wide", "a living room",
+              _lazy("bionav.world.worlds.living", "build_living_room")),
+        _spec("sim_roeben1", (11, 36), 0.1, 396, "ultra-wide",
+              "a living room with kitchen, furniture close to the grid",
+              _lazy("bionav.world.worlds.living", "build_living_kitchen")),
+        _spec("sim_uni", (10, 17), 1.0, 170, "normal-view",
+              "outdoors at a university entrance: buildings, trees, sky and sun",
+              _lazy("bionav.world.worlds.outdoor", "build_campus")),
+    ]
+}
+
+
+def available_databases() -> list[str]:
+    """Names of the synthetic stand-ins."""
+    return sorted(SYNTHETIC_DATABASES)
+
+
+def default_cache_dir() -> Path:
+    """``$BIONAV_CACHE`` if set, else ``~/.cache/bionav``."""
+    env = os.environ.get("BIONAV_CACHE")
+    return Path(env) if env else Path.home() / ".cache" / "bionav"
+
+
+def get_spec(name: str) -> SyntheticSpec:
+    """The :class:`SyntheticSpec` of a stand-in; raises :class:`UserError` for unknown names."""
+    if name not in SYNTHETIC_DATABASES:
+        raise UserError(
+            f"Unknown synthetic database {name!r}. Available synthetic databases: "
+            f"{', '.join(available_databases())}. Choose one of them with db=<name>."
+        )
+    return SYNTHETIC_DATABASES[name]
+
+
+def cache_key(params: dict) -> str:
+    """SHA-256 of the JSON of every parameter that determines a database's pixels."""
+    return hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def _write_npz_atomic(path: Path, **arrays) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez(fh, **arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def quantise(images: np.ndarray, *, noise: float, rng: np.random.Generator) -> np.ndarray:
+    """Add Gaussian camera noise (std ``noise``) and quantise to 8 bits.
+
+    Parameters
+    ----------
+    images : ndarray, float in [0, 1]
+    noise : float
+        Standard deviation of the additive noise in units of full scale.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    ndarray, uint8, same shape
+    """
+    x = np.asarray(images, np.float64)
+    if noise > 0:
+        x = x + rng.normal(0.0, noise, size=x.shape)
+    return np.clip(np.rint(x * 255.0), 0, 255).astype(np.uint8)
+
+
+def render_world_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *,
+                        progress: Callable[[Iterable], Iterable] | None = None, threads: int | None = 1) -> np.ndarray:
+    """Render the canonical panoramas (heading 0) at the given grid cells.
+
+    Returns
+    -------
+    ndarray, shape (N, H, W, C), float32 in [0, 1]
+    """
+    from bionav.world.render import render_panorama
+
+    out = np.empty((len(positions), geometry.height, geometry.width, world.scene.n_channels), np.float32)
+    it = range(len(positions))
+    if progress is not None:
+        it = progress(it)
+    for k in it:
+        i, j = positions[k]
+        out[k] = render_panorama(world.scene, position=world.cell_position(i, j), heading=0.0, geometry=geometry,
+                                 threads=threads)
+    return out
+
+
+def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | None = None, seed: int = 0,
+                       noise: float = 0.01, rotate_current: bool = False, rotation_seed: int = 0,
+                       cache_dir: str | Path | None = None,
+                       progress: Callable[[Iterable], Iterable] | None = None,
+                       threads: int | None = 1) -> ImageDatabase:
+    """Render (or load from cache) one synthetic stand-in database.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`available_databases` (``sim_original`` ...).
+    image_size : (int, int), optional
+        ``(W, H)``; the images are rendered directly at this size with the
+        mirror's field of view (:meth:`PanoramaGeometry.resized`). Default
+        :data:`NATIVE_SIZE`.
+    seed : int
+        Which world of this kind (``db.seed``); also seeds the camera noise.
+    noise : float
+        Standard deviation of the camera noise before 8-bit quantisation.
+    rotate_current : bool
+        Roll every image by a random whole number of columns ``k`` (Vardy's
+        protocol, :func:`bionav.db.rotation.rotate_views`);
+        ``headings[i] = 2*pi*k_i/W`` records the rotation (radians CCW from
+        grid +x).
+    rotation_seed : int
+        Seed of the random rotations.
+    cache_dir : path, optional
+        Where rendered databases are cached (``.npz``, keyed by a hash of
+        every world and render parameter); default :func:`default_cache_dir`.
+    progress : callable, optional
+        Wraps the render loop (e.g. ``ctx.progress``), called only on a cache miss.
+    threads : int or None
+        Render threads (see :func:`bionav.world.render.render_panorama`);
+        the images do not depend on it.
+
+    Returns
+    -------
+    ImageDatabase
+        Canonical panoramas ``(N, H, W)`` (grey) or ``(N, H, W, C)``, float32
+        in [0, 1], positions ``(N, 2)`` of the existing cells.
+    """
+    from bionav.world.render import RENDERER_VERSION
+
+    spec = get_spec(name)
+    if image_size is None:
+        w, h = spec.native_size
+    else:
+        try:
+            w, h = (int(v) for v in image_size)
+        except (TypeError, ValueError):
+            raise UserError(f"db.image_size must be [W, H] with two integers, got {image_size!r}.") from None
+    if w < 8 or h < 2:
+        raise UserError(f"db.image_size [W, H] = [{w}, {h}] is too small; use at least [8, 2].")
+    if noise < 0:
+        raise UserError(f"db.noise must be >= 0, got {noise}.")
+    geometry = spec.geometry(w, h)
+    world = spec.builder(int(seed))
+    positions = np.argwhere(world.cells).astype(np.int64)
+    if world.grid_shape != spec.grid_shape:
+        raise RuntimeError(f"{name}: world grid {world.grid_shape} differs from table {spec.grid_shape}")
+    compiled_digest = world.scene.compile().digest()
+    params = {
+        "renderer_version": RENDERER_VERSION,
+        "database_version": DATABASE_VERSION,
+        "name": name,
+        "seed": int(seed),
+        "noise": float(noise),
+        "geometry": [geometry.width, geometry.height, geometry.horizon_row, geometry.rad_per_row],
+        "grid_origin": list(map(float, world.grid_origin)),
+        "spacing": float(world.spacing),
+        "camera_height": float(world.camera_height),
+        "positions": positions.tolist(),
+        "exposure": float(world.scene.exposure),
+        "scene": compiled_digest,
+    }
+    key = cache_key(params)
+    cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
+    path = cdir / f"{name}-{w}x{h}-seed{int(seed)}-{key[:20]}.npz"
+    images_u8 = None
+    if path.exists():
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if str(z["key"]) == key:
+                    images_u8 = z["images"]
+        except (OSError, ValueError, KeyError):
+            images_u8 = None  # unreadable cache file: render again and overwrite
+    cached = images_u8 is not None
+    if not cached:
+        imgs = render_world_images(world, positions, geometry, progress=progress, threads=threads)
+        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x6E6F6973]))
+        images_u8 = quantise(imgs, noise=noise, rng=rng)
+        try:
+            _write_npz_atomic(path, images=images_u8, positions=positions, key=np.array(key),
+                              params=np.array(json.dumps(params)))
+        except OSError:
+            pass  # a read-only cache is not fatal: the database is still returned
+    images = images_u8.astype(np.float32) / np.float32(255.0)
+    if images.shape[-1] == 1:
+        images = images[..., 0]
+    meta = {
+        "source": "synthetic",
+        "world": spec.description,
+        "seed": int(seed),
+        "noise": float(noise),
+        "mirror": spec.mirror,
+        "channels": list(world.scene.channels),
+        "grid_origin_m": list(map(float, world.grid_origin)),
+        "camera_height_m": float(world.camera_height),
+        "cache_file": str(path),
+        "from_cache": cached,
+        "rotate_current": bool(rotate_current),
+        "rotation_seed": int(rotation_seed),
+    }
+    db = ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
+                       geometry=geometry, spacing_m=float(spec.spacing_m), meta=meta)
+    if rotate_current:
+        from bionav.db.rotation import rotate_views
+
+        db = rotate_views(db, seed=rotation_seed)
+    return db
+
+
+def synthetic_database_from_config(cfg, *, cache_dir: str | Path | None = None,
+                                   progress: Callable[[Iterable], Iterable] | None = None) -> ImageDatabase:
+    """:func:`synthetic_database` from a ``db`` config node (:class:`bionav.db.config.DatabaseConfig`)."""
+    size = cfg.image_size
+    return synthetic_database(
+        cfg.name, image_size=None if size is None else list(size), seed=int(cfg.seed), noise=float(cfg.noise),
+        rotate_current=bool(cfg.rotate_current), rotation_seed=int(cfg.rotation_seed), cache_dir=cache_dir,
+        progress=progress,
+    )

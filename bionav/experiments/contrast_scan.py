@@ -1,0 +1,239 @@
+"""``experiment=contrast_scan``: 2-D scans with the five-channel sensor on a pan-tilt unit (thesis 6.4, 6.5.1).
+
+The sensor scans ``n_pan x n_tilt`` directions (thesis: 113 x 26 steps of 2 and
+3 degrees) column by column, once per entry of ``experiment.times`` (default:
+the 14 scans of the one-day dataset, 17 June 2009, 11:27 to 20:43, with cloud
+cover clearing in the evening). Simulated (``sensor=spectral5_sim``, the default:
+a backyard scene under the spectral daylight model; the sun moves and the clouds
+drift while a scan runs), on hardware (``sensor=spectral5_serial
+sensor.port=... pantilt=ptu46 pantilt.port=...``), or replayed from a log
+(``sensor=replay pantilt=replay sensor.path=... pantilt.path=...``).
+
+Outputs: channel, contrast and separation images (figs. 6.8/6.9, D.7-D.17,
+6.18-6.25), the separated pixels in the UV-IR plane (figs. 6.16/6.17), the
+seven stability measures of every single channel and dual contrast against the
+first scan, before and after sky/object separation with the ``J_sigma`` lines
+learned on natural samples (figs. 6.10-6.15, D.3-D.6; ``stability.csv``),
+and the raw scans in ``scans.npz``. Metrics: ``logMSEvar`` and
+``logMSEvar_separated`` per feature (mean over the later scans),
+``sky_accuracy`` per feature where the true sky is known (simulation), and
+summary scalars.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.experiments.contrast_lda import _get, load_samples
+
+SCAN_TOPIC = "/contrast_scan/scan"
+TRUTH_TOPIC = "/contrast_scan/sky_truth"
+SENSOR_TOPIC = "/sensor/raw"
+PANTILT_TOPIC = "/pantilt/state"
+_SCAN_SCHEMA = {
+    "type": "object", "title": "bionav.ContrastScan",
+    "properties": {"index": {"type": "integer"}, "time": {"type": "string"},
+                   "cloud_cover": {"type": "number"}, "cloud_optical_depth": {"type": "number"}},
+}
+_TRUTH_SCHEMA = {
+    "type": "object", "title": "bionav.SkyTruth",
+    "description": "True sky mask of a simulated scan, rows of 0/1 (row 0 = highest tilt).",
+    "properties": {"index": {"type": "integer"}, "sky": {"type": "array"}},
+}
+
+
+def _per_scan(value, k, n, what):
+    v = [value] if isinstance(value, (int, float, str)) else list(value)
+    if len(v) == 1:
+        return float(v[0])
+    if len(v) != n:
+        raise UserError(f"experiment.{what} has {len(v)} entries but experiment.times has {n}; give one value or "
+                        f"one per scan.")
+    return float(v[k])
+
+
+def _parse_time(text):
+    try:
+        t = _dt.datetime.fromisoformat(str(text))
+    except ValueError:
+        raise UserError(f"experiment.times entry {text!r} is not an ISO 8601 time; write e.g. "
+                        f"2009-06-17T11:27:04+02:00.") from None
+    if t.tzinfo is None:
+        raise UserError(f"experiment.times entry {text!r} has no time zone; append it, e.g. +02:00.")
+    return t
+
+
+def learn_discriminants(node, *, sigma: float) -> dict:
+    """``J_sigma`` discriminants per feature learned on the labelled samples a ``data`` node names."""
+    from bionav.spectral.lda_analysis import analyse_features
+
+    samples = load_samples(node)
+    return {n: r.lda_sigma for n, r in analyse_features(samples, sigma=sigma).items()}
+
+
+def run(cfg, ctx) -> dict:
+    """Entry point called by bionav's experiment runner."""
+    from bionav.spectral.scan import DirectPanTilt, ScanGrid, run_scan
+    from bionav.spectral.scene import backyard_scene
+    from bionav.spectral.sky import CloudField, SkyState
+
+    exp = cfg.experiment
+    times = [_parse_time(t) for t in _get(exp, "times", [])]
+    if not times:
+        raise UserError("experiment.times is empty; give the scan times, e.g. experiment.times=[2009-06-17T11:27:04+02:00].")
+    n_scans = len(times)
+    grid = ScanGrid.from_steps(
+        n_pan=int(_get(exp, "n_pan", 113)), pan_step=np.deg2rad(float(_get(exp, "pan_step_deg", 2.0))),
+        n_tilt=int(_get(exp, "n_tilt", 26)), tilt_step=np.deg2rad(float(_get(exp, "tilt_step_deg", 3.0))),
+        tilt_start=np.deg2rad(float(_get(exp, "tilt_start_deg", -45.0))),
+        pan_centre=np.deg2rad(float(_get(exp, "pan_centre_deg", 0.0))),
+    )
+    sensor_node = _get(cfg, "sensor")
+    if not sensor_node:
+        raise UserError("experiment=contrast_scan needs a sensor: sensor=spectral5_sim (simulation), "
+                        "sensor=spectral5_serial sensor.port=... (hardware) or sensor=replay sensor.path=run.mcap.")
+    sensor = ctx.plugin("sensor", sensor_node)
+    pantilt_node = _get(cfg, "pantilt")
+    pantilt = ctx.plugin("sensor", pantilt_node) if pantilt_node else DirectPanTilt()
+    simulated = bool(getattr(sensor, "simulated", False) or getattr(pantilt, "simulated", False))
+    if not pantilt_node and not simulated and not hasattr(sensor, "recorded"):
+        raise UserError("A real sensor needs a real pan-tilt unit for experiment=contrast_scan: add pantilt=ptu46 "
+                        "pantilt.port=/dev/ttyUSB1 (or use sensor=spectral5_sim for a simulated scan).")
+
+    covers = _get(exp, "cloud_cover", [0.5])
+    depths = _get(exp, "cloud_optical_depth", [30.0])
+    scan_s = 60.0 * float(_get(exp, "scan_minutes", 20.0))
+    cloud_seed = int(_get(exp, "cloud_seed", 0))
+    t0 = times[0]
+
+    def sky_at(k, t):
+        clouds = CloudField(cover=_per_scan(covers, k, n_scans, "cloud_cover"),
+                            optical_depth=_per_scan(depths, k, n_scans, "cloud_optical_depth"), seed=cloud_seed)
+        return SkyState.from_time(t, clouds=clouds, time_s=(t - t0).total_seconds(),
+                                  turbidity=float(_get(exp, "turbidity", 0.1)))
+
+    scene = None
+    if simulated:
+        scene = backyard_scene(sky_at(0, t0), seed=int(_get(exp, "scene_seed", 0)))
+        for device in (sensor, pantilt):
+            if hasattr(device, "attach_simulation"):
+                device.attach_simulation(scene, ctx.rng)
+
+    def record_move(state):
+        ctx.log.write(PANTILT_TOPIC, state, schema_name="bionav.PanTiltState")
+
+    def record_reading(msg):
+        ctx.log.write(SENSOR_TOPIC, msg, schema_name=getattr(sensor, "schema_name", "bionav.Spectral5Reading"),
+                      schema=getattr(sensor, "schema", None))
+
+    scans, truths = [], []
+    with sensor, pantilt:
+        if hasattr(pantilt, "limits") and pantilt_node:
+            try:
+                ctx.log.write("/pantilt/info", {"limits": list(pantilt.limits()), "resolution": list(pantilt.resolution())},
+                              schema_name="bionav.PanTiltInfo")
+            except (NotImplementedError, UserError):
+                pass
+        for k, t in enumerate(times):
+            ctx.log.write(SCAN_TOPIC, {"index": k, "time": t.isoformat(),
+                                       "cloud_cover": _per_scan(covers, k, n_scans, "cloud_cover"),
+                                       "cloud_optical_depth": _per_scan(depths, k, n_scans, "cloud_optical_depth")},
+                          schema_name="bionav.ContrastScan", schema=_SCAN_SCHEMA)
+
+            def before_column(j, k=k, t=t):
+                if scene is not None:
+                    scene.sky = sky_at(k, t + _dt.timedelta(seconds=scan_s * j / grid.shape[1]))
+                    scene.prefetch(*_reached(pantilt, np.full(grid.shape[0], grid.pans[j]), grid.tilts))
+
+            scans.append(run_scan(sensor, pantilt, grid, before_column=before_column, on_move=record_move,
+                                  on_reading=record_reading, progress=ctx.progress))
+            if scene is not None:
+                scene.sky = sky_at(k, t + _dt.timedelta(seconds=scan_s / 2))
+                p, tl = grid.angles()
+                _, truth = scene.render(scene.view_direction(p, tl))
+                truths.append(truth)
+                ctx.log.write(TRUTH_TOPIC, {"index": k, "sky": truth.astype(int).tolist()},
+                              schema_name="bionav.SkyTruth", schema=_TRUTH_SCHEMA)
+        if scene is None and hasattr(sensor, "recorded"):
+            truths = [np.asarray(m["sky"], dtype=bool) for m in sensor.recorded(TRUTH_TOPIC)]
+    scans = np.stack(scans)
+    return analyse_scans(scans, times, truths if len(truths) == n_scans else None, cfg=cfg, ctx=ctx, grid=grid)
+
+
+def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
+    """Contrast images, separation, stability series, plots and metrics of a set of scans."""
+    import csv
+
+    from bionav.spectral.bands import CHANNELS, dual_contrasts
+    from bionav.spectral.scan import separation_images, stability_series
+    from bionav.spectral.stability import MEASURES
+
+    exp = cfg.experiment
+    sigma = float(_get(exp, "sigma", 30.0))
+    learn = _get(exp, "learn", None) or {"name": "sim_natural", "seed": int(_get(cfg, "seed", 0))}
+    disc = learn_discriminants(learn, sigma=sigma)
+    names = list(CHANNELS) + list(dual_contrasts())
+    np.savez_compressed(ctx.dir / "scans.npz", counts=scans, times=np.array([t.isoformat() for t in times]),
+                        pans=grid.pans, tilts=grid.tilts)
+    rows = stability_series(scans[..., :5], disc, names=names)
+    with open(ctx.dir / "stability.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=["scan", "time", "feature", "separated", *MEASURES])
+        w.writeheader()
+        for r in rows:
+            w.writerow({**r, "time": times[r["scan"]].isoformat()})
+    hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
+    if bool(_get(exp, "plots", True)):
+        _plots(scans, times, hours, rows, disc, names, ctx.plots)
+    metrics: dict = {"n_scans": int(len(scans)), "n_readings": int(scans.shape[0] * scans.shape[1] * scans.shape[2])}
+    if len(scans) > 1:
+        for sep, key in ((False, "logMSEvar"), (True, "logMSEvar_separated")):
+            per = {n: float(np.mean([r["logMSEvar"] for r in rows if r["feature"] == n and r["separated"] == sep]))
+                   for n in names}
+            metrics[key] = per
+            metrics[f"{key}_single_mean"] = _finite_mean([per[n] for n in CHANNELS])
+            metrics[f"{key}_dual_mean"] = _finite_mean([per[n] for n in dual_contrasts()])
+    if truths is not None:
+        acc = {}
+        for n in names:
+            acc[n] = float(np.mean([np.mean(separation_images(s[..., :5], {n: disc[n]})[n] == tr)
+                                    for s, tr in zip(scans, truths)]))
+        metrics["sky_accuracy"] = acc
+        metrics["best_sky_accuracy_feature"] = max(acc, key=acc.get)
+    return metrics
+
+
+def _reached(pantilt, pans, tilts):
+    """The poses a pan-tilt unit reaches for commanded ones (its quantisation, if it has one)."""
+    try:
+        res_pan, res_tilt = pantilt.resolution()
+    except (AttributeError, NotImplementedError, UserError):
+        return pans, tilts
+    return np.round(pans / res_pan) * res_pan, np.round(tilts / res_tilt) * res_tilt
+
+
+def _finite_mean(values) -> float:
+    finite = [v for v in values if np.isfinite(v)]
+    return float(np.mean(finite)) if finite else float("nan")
+
+
+def _plots(scans, times, hours, rows, disc, names, plots):
+    from bionav.experiments import spectral_plots as sp
+    from bionav.spectral.scan import separation_images
+
+    labels = [t.strftime("%H:%M") for t in times]
+    (plots / "scans").mkdir(exist_ok=True)
+    for k in range(len(scans)):
+        sp.plot_channel_images(scans[k], plots / "scans" / f"channels_{k:02d}.png", title=f"scan {k}: {labels[k]}")
+    for k, tag in ((0, "first"), (len(scans) - 1, "last")):
+        sp.plot_contrast_images(scans[k], plots / f"contrasts_{tag}.png", title=f"dual-channel contrasts, {labels[k]}")
+        seps = separation_images(scans[k, ..., :5], {n: disc[n] for n in names})
+        sp.plot_separation_images(seps, plots / f"separation_{tag}.png",
+                                  title=f"sky (black) / objects (white), J_sigma lines of natural samples, {labels[k]}")
+        sp.plot_separated_scatter(scans[k], seps["UV-IR"], disc["UV-IR"], plots / f"separated_uv_ir_{tag}.png",
+                                  title=f"UV-IR pixels classified, {labels[k]}")
+    if len(scans) > 1:
+        sp.plot_stability(rows, hours[1:], plots / "stability.png", separated=False)
+        sp.plot_stability(rows, hours[1:], plots / "stability_separated.png", separated=True)

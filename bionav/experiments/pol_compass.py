@@ -1,0 +1,521 @@
+"""``experiment=pol_compass``: the polarized-light compass experiments of thesis chapter 4.
+
+Modes (``mode=<name>``, i.e. ``experiment.mode``):
+
+``filter_test``
+    Thesis 4.2.1, fig. 4.2: the compass under unpolarized light seen through
+    one extra polarizer; the pan-tilt unit turns the compass against the
+    filter in 3 degree steps, 100 samples each; mean unit voltages per angle.
+``rotation``
+    The pan-tilt unit turns the compass through its whole pan range (about
+    +-159 degrees, more than the signal's 180 degree period), ``N`` samples
+    per step; heading error against the pan angle after removing the constant
+    offset, axial (modulo 180 degrees) unless the error function can resolve
+    the candidate pair (only for tilted views, ``experiment.tilt_deg != 0``).
+``vs_em_compass``
+    Thesis 4.2.2, figs. 4.4-4.5: against the TCM2 electromagnetic compass on
+    the same plate at 18 positions, 100 samples each (averaged and raw).
+``evector_scan``
+    Thesis 4.2.3, fig. 4.6: a pan/tilt grid over the sky, e-vector angle and
+    degree per point in a polar plot, against the sky model.
+``partial_sky``
+    Thesis 9.1 (future work), simulation: heading error of a scanning compass
+    (a model fitted to every clear patch, which also resolves the pair) and of
+    the zenith-only compass against the clear-sky fraction and the sun
+    elevation.
+
+Metrics: ``heading_rmse_deg``, ``heading_mae_deg``, ``n_samples`` (plus
+``axial``, ``resolved_fraction`` and mode-specific keys). The simulated and
+the real compass share everything after the ADC; every raw reading is in
+``run.mcap`` (see :mod:`bionav.plugins.sensors.replay`), and a replay
+reproduces the metrics exactly.
+"""
+
+from __future__ import annotations
+
+import csv
+from contextlib import ExitStack
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from bionav.errors import UserError
+from bionav.experiments.pol_compass_session import (
+    SESSION_SCHEMA,
+    SESSION_TOPIC,
+    Session,
+    cloud_field,
+    resolve_sun,
+    sky_model,
+    start_fakes,
+)
+
+MODES = ("filter_test", "rotation", "vs_em_compass", "evector_scan", "partial_sky")
+
+
+# ---------------------------------------------------------------------------
+# processing shared by simulated, real and replayed sessions (after the ADC)
+# ---------------------------------------------------------------------------
+def counts_of(readings: list[dict]) -> np.ndarray:
+    """ADC counts of recorded compass readings, shape ``(N, K)``."""
+    return np.asarray([r["counts"] for r in readings], dtype=float)
+
+
+def evectors_from_counts(counts, calibration, *, solver: str = "least_squares"):
+    """E-vector angle, degree and delogarithmised unit outputs from ADC counts.
+
+    Parameters
+    ----------
+    counts : ndarray, shape ``(N, K)``
+        10-bit counts (``V = count * 5 / 1023``).
+    calibration : UnitCalibration
+    solver : {'least_squares', 'two_unit'}
+        Three-unit least squares, or eqs. 4.4-4.5 on the first two units.
+
+    Returns
+    -------
+    angle : ndarray, shape ``(N,)``
+        E-vector angle in the sensor frame, radians ``[-pi/2, pi/2)``.
+    degree : ndarray, shape ``(N,)``
+    x : ndarray, shape ``(N, K)``
+    """
+    from bionav.polcompass import (
+        counts_to_volts,
+        delogarithmise,
+        least_squares_evector,
+        two_unit_evector,
+        volts_to_decades,
+    )
+
+    volts = counts_to_volts(counts)
+    x = delogarithmise(volts_to_decades(volts, center_v=calibration.center_v, volts_per_decade=calibration.volts_per_decade))
+    if solver == "least_squares":
+        angle, degree = least_squares_evector(x, calibration.unit_angles)
+    elif solver == "two_unit":
+        angle, degree = two_unit_evector(x[:, 0], x[:, 1], calibration.unit_angles[0], calibration.unit_angles[1])
+    else:
+        raise UserError(f"experiment.solver={solver!r} is unknown; choose least_squares or two_unit.")
+    return angle, degree, x
+
+
+def pose_headings(angle, x, tilts, *, sun, predictor, unit_angles, margin):
+    """Sensor heading of every reading; tilted readings resolved by the error function.
+
+    Returns
+    -------
+    heading : ndarray, shape ``(N,)``
+        Radians CCW from east (for zenith readings: the candidate in
+        ``[-pi, pi)`` of eq. 4.6's pair).
+    resolved : ndarray of bool, shape ``(N,)``
+    """
+    from bionav.polcompass import solve_pose, zenith_heading
+
+    heading = np.asarray(zenith_heading(angle, sun_azimuth=sun.azimuth), float)
+    resolved = np.zeros(heading.shape, dtype=bool)
+    for i in np.flatnonzero(np.abs(tilts) > 1e-12):
+        sol = solve_pose(x[i], float(angle[i]), float(tilts[i]), predictor=predictor, unit_angles=unit_angles, margin=margin)
+        heading[i], resolved[i] = sol.heading, sol.resolved
+    return heading, resolved
+
+
+def summarize(errors, *, axial: bool, n: int) -> dict[str, Any]:
+    """The contract's metrics from a :class:`~bionav.polcompass.HeadingErrors`."""
+    return {"heading_rmse_deg": errors.rmse_deg, "heading_mae_deg": errors.mae_deg, "n_samples": int(n), "axial": bool(axial)}
+
+
+def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir):
+    from bionav.polcompass import UnitCalibration, calibrate_from_rotation
+
+    nominal = UnitCalibration.nominal(unit_angles)
+    how = str(exp.calibration)
+    if how == "auto":
+        how = "rotation" if np.all(np.abs(tilts) < 1e-12) else "nominal"
+    if how == "nominal":
+        cal = nominal
+    elif how == "rotation":
+        cal = calibrate_from_rotation(volts, pans, nominal=nominal)
+    elif how == "file":
+        if not exp.get("calibration_path"):
+            raise UserError("experiment.calibration=file needs experiment.calibration_path=<calibration.json of a rotation run>.")
+        cal = UnitCalibration.load(exp.calibration_path)
+    else:
+        raise UserError(f"experiment.calibration={how!r} is unknown; choose auto, rotation, nominal or file.")
+    if out_dir is not None:
+        cal.save(out_dir / "calibration.json")
+    return cal, how
+
+
+def _pan_grid(session: Session, exp, step_deg: float):
+    lo, hi, tlo, thi = session.pantilt.limits()
+    rng = exp.get("pan_range_deg")
+    if rng is not None:
+        lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
+    step = np.deg2rad(step_deg)
+    n = int(np.floor((hi - lo) / step + 1e-9)) + 1
+    return lo + step * np.arange(n), (tlo, thi)
+
+
+def _check_tilt(tilt: float, limits) -> None:
+    if not limits[0] - 1e-12 <= tilt <= limits[1] + 1e-12:
+        raise UserError(
+            f"tilt {np.degrees(tilt):.1f} deg is outside the pan-tilt unit's range "
+            f"[{np.degrees(limits[0]):.1f}, {np.degrees(limits[1]):.1f}] deg; change experiment.tilt_deg / the scan's tilts_deg."
+        )
+
+
+def _scan(session: Session, poses, samples: int, *, desc: str | None, with_reference: bool = False):
+    """Visit poses ``[(pan, tilt), ...]``, take ``samples`` readings at each; all recorded.
+
+    ``desc=None`` draws no progress bar.
+    """
+    pans, tilts, readings, refs, index = [], [], [], [], []
+    visit = poses if desc is None else session.progress(poses, desc=desc, total=len(poses))
+    for k, (pan, tilt) in enumerate(visit):
+        state = session.move(pan, tilt)
+        for _ in range(samples):
+            readings.append(session.read())
+            if with_reference:
+                refs.append(session.read_reference())
+            pans.append(state["pan"])
+            tilts.append(state["tilt"])
+            index.append(k)
+    return np.asarray(pans), np.asarray(tilts), readings, refs, np.asarray(index)
+
+
+# ---------------------------------------------------------------------------
+# modes
+# ---------------------------------------------------------------------------
+def rotation_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None, filter_test=False) -> dict:
+    """``rotation`` and ``filter_test``: turn the compass through the pan range."""
+    from bionav.experiments import pol_compass_plots as plots_mod
+    from bionav.polcompass import CompassOptics, EvectorPredictor, counts_to_volts, heading_errors
+
+    tilt = 0.0 if filter_test else np.deg2rad(float(exp.tilt_deg))
+    pans_cmd, tilt_limits = _pan_grid(session, exp, float(exp.step_deg))
+    _check_tilt(tilt, tilt_limits)
+    pans, tilts, readings, _, index = _scan(
+        session, [(p, tilt) for p in pans_cmd], int(exp.samples_per_step), desc="filter test" if filter_test else "rotation"
+    )
+    counts = counts_of(readings)
+    volts = counts_to_volts(counts)
+    cal, how = _calibration(exp, volts, pans, tilts, unit_angles=unit_angles, out_dir=out_dir)
+    angle, degree, x = evectors_from_counts(counts, cal, solver=str(exp.solver))
+    predictor = EvectorPredictor(sky_model(exp.sky, session.sun), CompassOptics(unit_angles=tuple(cal.unit_angles)))
+    heading, resolved = pose_headings(
+        angle, x, tilts, sun=session.sun, predictor=predictor, unit_angles=cal.unit_angles, margin=float(exp.ambiguity_margin)
+    )
+    axial = bool(filter_test or not np.all(resolved))
+    errors = heading_errors(heading, pans, axial=axial)
+    metrics = summarize(errors, axial=axial, n=len(readings))
+    metrics.update(
+        resolved_fraction=float(np.mean(resolved)),
+        heading_offset_deg=float(np.degrees(errors.offset)),
+        mean_degree=float(np.mean(degree)),
+        calibration=how,
+    )
+    if plots is not None:
+        steps = np.unique(index)
+        mean_v = np.stack([volts[index == k].mean(axis=0) for k in steps])
+        step_pan = np.array([pans[index == k][0] for k in steps])
+        if filter_test:
+            plots_mod.plot_unit_voltages(plots / "fig4_2_unit_voltages.png", np.degrees(-step_pan), mean_v,
+                                         xlabel="filter angle relative to the compass (deg, CCW)")
+        else:
+            plots_mod.plot_unit_voltages(plots / "unit_voltages.png", np.degrees(step_pan), mean_v, xlabel="pan (deg)")
+        plots_mod.plot_rotation(plots / "heading_vs_pan.png", pans, heading - errors.offset, errors.errors, axial=axial)
+    return metrics
+
+
+def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
+    """``vs_em_compass``: the polarized-light compass against the TCM2 (figs. 4.4, 4.5)."""
+    from bionav.experiments import pol_compass_plots as plots_mod
+    from bionav.polcompass import counts_to_volts, heading_errors, zenith_heading
+    from bionav.sky.sun import compass_to_azimuth
+
+    lo, hi, tlo, thi = session.pantilt.limits()
+    rng = exp.get("pan_range_deg")
+    if rng is not None:
+        lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
+    positions = np.linspace(lo, hi, int(exp.vs_em.positions))
+    pans, tilts, readings, refs, index = _scan(
+        session, [(p, 0.0) for p in positions], int(exp.vs_em.samples), desc="vs TCM2", with_reference=True
+    )
+    counts = counts_of(readings)
+    cal, _ = _calibration(exp, counts_to_volts(counts), pans, tilts, unit_angles=unit_angles, out_dir=out_dir)
+    angle, _, _ = evectors_from_counts(counts, cal, solver=str(exp.solver))
+    pol = np.asarray(zenith_heading(angle, sun_azimuth=session.sun.azimuth))
+    tcm2 = np.asarray(compass_to_azimuth(np.deg2rad([r["heading_deg"] for r in refs])))
+    errors = heading_errors(pol, tcm2, axial=True)
+    metrics = summarize(errors, axial=True, n=len(readings))
+    # Averaged per position (fig. 4.4): circular means (axial for the polarized-light compass).
+    steps = np.unique(index)
+    pol_avg = np.array([np.angle(np.mean(np.exp(2j * pol[index == k]))) / 2 for k in steps])
+    tcm2_avg = np.array([np.angle(np.mean(np.exp(1j * tcm2[index == k]))) for k in steps])
+    avg_errors = heading_errors(pol_avg, tcm2_avg, axial=True)
+    metrics.update(heading_offset_deg=float(np.degrees(errors.offset)), averaged_rmse_deg=avg_errors.rmse_deg, n_positions=int(len(steps)))
+    if plots is not None:
+        plots_mod.plot_vs_em(plots / "fig4_4_averaged.png", pol_avg - avg_errors.offset, tcm2_avg, averaged=True)
+        plots_mod.plot_vs_em(plots / "fig4_5_raw.png", pol - errors.offset, tcm2, averaged=False)
+    return metrics
+
+
+def _scan_poses(session: Session, node, *, pan_step_deg: float):
+    lo, hi, tlo, thi = session.pantilt.limits()
+    step = np.deg2rad(pan_step_deg)
+    pans = lo + step * np.arange(int(np.floor((hi - lo) / step + 1e-9)) + 1)
+    tilts = np.deg2rad(np.asarray(list(node.tilts_deg), float))
+    for t in tilts:
+        _check_tilt(t, (tlo, thi))
+    return [(p, t) for t in tilts for p in pans]
+
+
+def evector_scan_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
+    """``evector_scan``: a pan/tilt grid over the sky (fig. 4.6) against the sky model."""
+    from bionav.experiments import pol_compass_plots as plots_mod
+    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, wrap_axial
+
+    poses = _scan_poses(session, exp.scan, pan_step_deg=float(exp.scan.pan_step_deg))
+    cal = _rotation_calibration(session, exp, unit_angles=unit_angles, out_dir=out_dir)
+    pans, tilts, readings, _, index = _scan(session, poses, int(exp.scan.samples), desc="e-vector scan")
+    angle, degree, _ = evectors_from_counts(counts_of(readings), cal, solver=str(exp.solver))
+    predictor = EvectorPredictor(sky_model(exp.sky, session.sun), CompassOptics(unit_angles=tuple(cal.unit_angles)))
+    fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=float(exp.min_degree))
+    model_angle, model_degree = predictor.at(fit.heading + pans, tilts)
+    residual = wrap_axial(angle - model_angle)
+    rmse = float(np.degrees(np.sqrt(np.mean(residual**2))))
+    metrics = {
+        "heading_rmse_deg": rmse,
+        "heading_mae_deg": float(np.degrees(np.mean(np.abs(residual)))),
+        "n_samples": len(readings),
+        "axial": True,
+        "fitted_heading_deg": float(np.degrees(fit.heading)),
+        "resolved_fraction": float(fit.resolved),
+        "mean_degree": float(np.mean(degree)),
+    }
+    if session.true_mount_heading is not None:  # simulated (or a replay of a simulated session)
+        from bionav.geometry import wrap_angle
+
+        metrics["fitted_heading_error_deg"] = float(np.degrees(wrap_angle(fit.heading - session.true_mount_heading)))
+    if plots is not None:
+        steps = np.unique(index)
+        first = np.array([np.flatnonzero(index == k)[0] for k in steps])
+        mean_angle = np.array([np.angle(np.mean(np.exp(2j * angle[index == k]))) / 2 for k in steps])
+        mean_degree = np.array([degree[index == k].mean() for k in steps])
+        plots_mod.plot_evector_field(
+            plots / "fig4_6_evector_field.png", pans[first], tilts[first], mean_angle, mean_degree,
+            model_angle[first], model_degree[first],
+        )
+    return metrics
+
+
+def _rotation_calibration(session: Session, exp, *, unit_angles, out_dir):
+    """Calibrate the units from one zenith rotation (one reading per pan step, recorded) before a scan.
+
+    ``experiment.calibration``: ``auto``/``rotation`` rotate, ``nominal`` and
+    ``file`` do not.
+    """
+    from bionav.polcompass import UnitCalibration, counts_to_volts
+
+    how = str(exp.calibration)
+    if how == "nominal":
+        return UnitCalibration.nominal(unit_angles)
+    if how == "file":
+        return _calibration(exp, None, None, None, unit_angles=unit_angles, out_dir=out_dir)[0]
+    pans_cmd, _ = _pan_grid(session, exp, float(exp.step_deg))
+    pans, tilts, readings, _, _ = _scan(session, [(p, 0.0) for p in pans_cmd], 1, desc=None)
+    return _calibration(exp, counts_to_volts(counts_of(readings)), pans, tilts, unit_angles=unit_angles, out_dir=out_dir)[0]
+
+
+def partial_sky_mode(session: Session, exp, *, unit_angles, rng_scene, plots=None, out_dir=None) -> dict:
+    """``partial_sky`` (thesis 9.1): heading error against clear-sky fraction and sun elevation."""
+    from bionav.experiments import pol_compass_plots as plots_mod
+    from bionav.geometry import wrap_angle
+    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, wrap_axial, zenith_heading
+    from bionav.sky import SunPosition
+
+    if session.scene is None:
+        raise UserError(
+            "mode=partial_sky is a simulation experiment: use sensor=polcompass_sim pantilt=sim "
+            "(or sensor=replay pantilt=replay with the log of such a run)."
+        )
+    node = exp.partial
+    poses = _scan_poses(session, node, pan_step_deg=float(node.pan_step_deg))
+    session.scene.source = sky_model(exp.sky, session.sun)  # calibrate under the configured (clear) sky
+    cal = _rotation_calibration(session, exp, unit_angles=unit_angles, out_dir=out_dir)
+    optics = CompassOptics(unit_angles=tuple(cal.unit_angles))
+    rows = []
+    conditions = [(float(e), float(c)) for e in node.sun_elevations_deg for c in node.cloud_covers]
+    trials = int(node.trials)
+    for elevation_deg, cover in session.progress(conditions, desc="partial sky", total=len(conditions)):
+        sun = SunPosition(np.deg2rad(float(exp.sky.sun_azimuth_deg)), np.deg2rad(elevation_deg))
+        predictor = EvectorPredictor(sky_model(exp.sky, sun), optics)
+        for trial in range(trials):
+            clouds = cloud_field(exp.sky, rng_scene, cover=cover)
+            session.scene.source = sky_model(exp.sky, sun, clouds=clouds)
+            session.scene.mount_heading = float(rng_scene.uniform(-np.pi, np.pi))
+            clear = 1.0 if clouds is None else clouds.clear_fraction()
+            pans, tilts, readings, _, _ = _scan(session, poses, int(node.samples), desc=None)
+            angle, degree, _ = evectors_from_counts(counts_of(readings), cal, solver=str(exp.solver))
+            fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=float(exp.min_degree))
+            zen = np.abs(tilts) < 1e-12
+            zen_heading = zenith_heading(angle[zen], sun_azimuth=sun.azimuth) - pans[zen]
+            zen_err = np.abs(wrap_axial(zen_heading - session.scene.mount_heading))
+            rows.append({
+                "sun_elevation_deg": elevation_deg,
+                "cloud_cover": cover,
+                "clear_fraction": clear,
+                "trial": trial,
+                "mount_heading_deg": float(np.degrees(session.scene.mount_heading)),
+                "scan_error_deg": float(np.degrees(abs(wrap_angle(fit.heading - session.scene.mount_heading)))) if np.isfinite(fit.heading) else float("nan"),
+                "scan_resolved": bool(fit.resolved),
+                "scan_points_used": int(fit.n_used),
+                "zenith_error_deg": float(np.degrees(np.sqrt(np.mean(zen_err**2)))) if zen.any() else float("nan"),
+            })
+    errs = np.array([r["scan_error_deg"] for r in rows])
+    failed = ~np.isfinite(errs)
+    errs_f = np.where(failed, 180.0, errs)  # no usable patch at all: count as a half-turn error
+    metrics = {
+        "heading_rmse_deg": float(np.sqrt(np.mean(errs_f**2))),
+        "heading_mae_deg": float(np.mean(errs_f)),
+        "n_samples": len(rows),
+        "axial": False,
+        "resolved_fraction": float(np.mean([r["scan_resolved"] for r in rows])),
+        "zenith_rmse_deg": float(np.sqrt(np.nanmean(np.array([r["zenith_error_deg"] for r in rows]) ** 2))),
+    }
+    if out_dir is not None:
+        with open(out_dir / "partial_sky.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    if plots is not None:
+        plots_mod.plot_partial_sky(plots / "partial_sky.png", rows)
+    return metrics
+
+
+# ---------------------------------------------------------------------------
+# glue
+# ---------------------------------------------------------------------------
+def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_dir=None, progress=None) -> dict:
+    """Run one mode with opened devices; everything is recorded through ``write``.
+
+    Parameters
+    ----------
+    exp : DictConfig
+        ``cfg.experiment``.
+    devices : dict
+        ``sensor``, ``pantilt``, ``reference`` plugin instances (opened).
+    write : callable
+        ``write(topic, message, *, schema_name, schema)``.
+    rng : numpy.random.Generator
+        The scene's generator (cloud fields, random mount headings).
+    scene : CompassScene, optional
+        The simulated world (if anything is simulated).
+    plots, out_dir : Path, optional
+        Where figures and tables go (``None``: none written).
+    progress : callable, optional
+    """
+    mode = str(exp.mode)
+    if mode not in MODES:
+        raise UserError(f"mode {mode!r} is unknown; choose one of {', '.join(MODES)} (mode=<name>).")
+    sensor = devices["sensor"]
+    recorded = None
+    if hasattr(sensor, "recorded"):
+        messages = sensor.recorded(SESSION_TOPIC)
+        recorded = messages[0] if messages else None
+    sun, time_utc = resolve_sun(exp.sky, recorded_session=recorded)
+    if recorded is not None:
+        true_mount = recorded.get("true_mount_heading")
+    else:
+        true_mount = None if scene is None or mode == "partial_sky" else float(scene.mount_heading)
+    session = Session(
+        sensor, devices.get("pantilt"), devices.get("reference"), write, scene, sun,
+        progress or (lambda it, desc="", total=None: it), true_mount,
+    )
+    write(
+        SESSION_TOPIC,
+        {
+            "mode": mode,
+            "time_utc": time_utc,
+            "sun_azimuth": float(sun.azimuth),
+            "sun_elevation": float(sun.elevation),
+            "true_mount_heading": true_mount,
+        },
+        schema_name="bionav.PolCompassSession",
+        schema=SESSION_SCHEMA,
+    )
+    session.record_pantilt_info()
+    unit_angles = np.deg2rad(np.asarray(list(exp.unit_angles_deg), float))
+    if scene is not None and mode != "partial_sky":
+        from bionav.sky import PolarizerLamp
+
+        if mode == "filter_test":
+            scene.source = PolarizerLamp(np.deg2rad(float(exp.filter.axis_deg)), float(exp.filter.efficiency))
+        else:
+            scene.source = sky_model(exp.sky, sun, clouds=cloud_field(exp.sky, rng))
+    kwargs = {"unit_angles": unit_angles, "plots": plots, "out_dir": out_dir}
+    if mode in ("filter_test", "rotation"):
+        return rotation_mode(session, exp, filter_test=mode == "filter_test", **kwargs)
+    if mode == "vs_em_compass":
+        return vs_em_mode(session, exp, **kwargs)
+    if mode == "evector_scan":
+        return evector_scan_mode(session, exp, **kwargs)
+    return partial_sky_mode(session, exp, rng_scene=rng, **kwargs)
+
+
+def _node_dict(node) -> dict | None:
+    if node is None:
+        return None
+    return OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    """Entry point called by :func:`bionav.experiments.runner.run_experiment`."""
+    from bionav.polcompass import CompassScene
+
+    exp = cfg.experiment
+    if cfg.get("sensor") is None or not cfg.sensor.get("name"):
+        raise UserError("experiment=pol_compass needs a compass: sensor=polcompass_sim, polcompass_serial or replay.")
+    nodes = {
+        "sensor": _node_dict(cfg.sensor),
+        "pantilt": _node_dict(cfg.get("pantilt")) if cfg.get("pantilt") and cfg.pantilt.get("name") else None,
+        "reference": _node_dict(exp.reference) if str(exp.mode) == "vs_em_compass" else None,
+    }
+    rng_scene, rng_sensor, rng_reference, rng_fakes = ctx.rng.spawn(4)
+    from bionav import registry
+
+    classes = {role: registry.load_plugin("sensor", node["name"]) for role, node in nodes.items() if node is not None}
+    simulated = any(getattr(c, "simulated", False) for c in classes.values())
+    fake_devices = bool(exp.get("fake_devices", False))
+    needs_scene = simulated or fake_devices or str(exp.mode) == "partial_sky"
+    scene = None
+    if needs_scene:
+        from bionav.sky import SkyModel, SunPosition
+
+        scene = CompassScene(
+            SkyModel(SunPosition(0.0, np.pi / 4)),  # replaced by the mode's source
+            mount_heading=np.deg2rad(float(exp.sky.mount_heading_deg)),
+            magnetic_declination=np.deg2rad(float(exp.sky.magnetic_declination_deg)),
+        )
+    with ExitStack() as stack:
+        if fake_devices:
+            start_fakes(stack, nodes, scene, rng_fakes)
+        devices = {}
+        streams = {"sensor": rng_sensor, "pantilt": None, "reference": rng_reference}
+        for role, node in nodes.items():
+            if node is None:
+                devices[role] = None
+                continue
+            plugin = ctx.plugin("sensor", node)
+            if role == "reference":
+                plugin.config_prefix = "experiment.reference"
+            if getattr(plugin, "simulated", False):
+                plugin.attach_simulation(scene, streams[role])
+            plugin.open()
+            stack.callback(plugin.close)
+            devices[role] = plugin
+        metrics = run_session(
+            exp, devices, write=ctx.log.write, rng=rng_scene, scene=scene, plots=ctx.plots, out_dir=ctx.dir,
+            progress=ctx.progress,
+        )
+    return metrics

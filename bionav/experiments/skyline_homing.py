@@ -1,0 +1,323 @@
+"""``experiment=skyline_homing``: outdoor homing from five-channel images under changing light (beyond thesis 6.5).
+
+The thesis' own outdoor homing test failed for lack of good data (6.5.3). Here
+a synthetic five-channel outdoor world (a garden: shrubs, trees, buildings,
+a distant tree line; spectral daylight of :mod:`bionav.spectral.sky`) is
+rendered on a full grid under several conditions (sun position and cloud
+state). Every *representation* — single channels, dual-channel contrasts,
+binary skylines from the ``J_sigma`` lines learned on natural samples — is fed
+to the configured homing method (``homing=<any plugin>``, default ``mfdid``)
+with snapshots under one condition and current views under another (all pairs,
+the diagonal being "no light change"). AAE*, MAE* and RR* per representation
+and condition pair go to ``skyline_homing.csv``; metrics.json holds ``rr``,
+``aae`` (mean over changed-light pairs) and ``rr_same``, ``aae_same`` (same
+light), each keyed by representation, and ``best_representation`` (highest
+``rr`` under changed light). The thesis' 2 m square test (6.5.2: four corners
+of a 2 m square, home vectors between all of them) gives ``square_aae`` per
+representation.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+
+import numpy as np
+
+from bionav.errors import UserError
+from bionav.experiments.contrast_lda import _get
+from bionav.experiments.contrast_scan import learn_discriminants
+
+CELL_TOPIC = "/skyline_homing/cell"
+
+
+def _conditions(exp):
+    out = []
+    for k, c in enumerate(_get(exp, "conditions", [])):
+        name = str(_get(c, "name", f"c{k}"))
+        try:
+            t = _dt.datetime.fromisoformat(str(_get(c, "time", "")))
+        except ValueError:
+            raise UserError(f"experiment.conditions[{k}].time {_get(c, 'time')!r} is not an ISO 8601 time "
+                            f"(e.g. 2009-06-17T16:00:00+02:00).") from None
+        if t.tzinfo is None:
+            raise UserError(f"experiment.conditions[{k}].time has no time zone; append e.g. +02:00.")
+        out.append((name, t, float(_get(c, "cloud_cover", 0.0)), float(_get(c, "cloud_optical_depth", 20.0))))
+    if not out:
+        raise UserError("experiment.conditions is empty; give at least one {name, time, cloud_cover, "
+                        "cloud_optical_depth}.")
+    return out
+
+
+def render_condition_counts(scene, geometry, world_positions, *, sensor_model, rng, progress=None):
+    """Five-channel counts ``(N, H, W, 5)`` and true sky masks ``(N, H, W)`` at world positions."""
+    from bionav.spectral.scene import render_spectral_panorama
+
+    counts, skies = [], []
+    it = world_positions if progress is None else progress(world_positions, desc="render", total=len(world_positions))
+    for p in it:
+        rad, sky = render_spectral_panorama(scene, geometry, position=tuple(p))
+        counts.append(sensor_model.read(rad, rng=rng)[0, ..., :5].astype(np.float32))
+        skies.append(sky)
+    return np.stack(counts), np.stack(skies)
+
+
+#: bionav.spectral material used for each material kind of the campus world (bionav.world.worlds.outdoor).
+CAMPUS_MATERIALS = {
+    "concrete": "concrete", "brick": "brick", "glass": "glass", "foliage": "tree", "bark": "dead_wood",
+    "grass": "grass", "paving": "concrete", "asphalt": "tar", "metal": "metal_bare", "paint": "lacquered_metal",
+    "wood": "dead_wood", "soil": "soil",
+}
+
+
+def campus_world(sky, *, seed: int):
+    """The outdoor campus of :mod:`bionav.world.worlds.outdoor` in five bands under a spectral sky.
+
+    Per-kind albedos come from :data:`bionav.spectral.materials.MATERIALS` (via
+    :data:`CAMPUS_MATERIALS`), the sun and the hemispherical ambient light from
+    :func:`bionav.spectral.sky.illumination` (``E/pi``, so that pixel values are
+    band radiances in the unit of the sensor model), rays that hit nothing from
+    :func:`bionav.spectral.sky.band_sky_radiance`.
+    """
+    try:
+        from bionav.world.worlds.outdoor import build_campus
+    except ImportError:
+        raise UserError("experiment.world=campus needs bionav's outdoor campus world (bionav.world.worlds.outdoor), "
+                        "which this installation lacks; use experiment.world=garden.") from None
+    from bionav.spectral.bands import CHANNELS, band_integrate
+    from bionav.spectral.materials import MATERIALS
+    from bionav.spectral.sky import band_sky_radiance, illumination
+
+    ill = illumination(sky)
+    e_dir = band_integrate(ill.direct_normal) / np.pi
+    e_dif = band_integrate(ill.diffuse_horizontal) / np.pi
+    albedos = {k: np.asarray(MATERIALS[m].reflectance) for k, m in CAMPUS_MATERIALS.items()}
+    world = build_campus(seed, channels=CHANNELS, albedos=albedos, sky=lambda d: band_sky_radiance(sky, d),
+                         sun_elevation=float(sky.sun_elevation), sun_azimuth=float(sky.sun_azimuth),
+                         sun_irradiance=e_dir, sky_irradiance=e_dif, exposure=1.0)
+    return world
+
+
+def render_campus_counts(world, geometry, cells, *, sensor_model, rng, progress=None):
+    """Counts ``(N, H, W, 5)`` and true sky masks of the campus at grid cells ``(N, 2)`` (may be fractional)."""
+    from bionav.world.render import render_depth, render_panorama
+
+    counts, skies = [], []
+    it = cells if progress is None else progress(cells, desc="render", total=len(cells))
+    for i, j in it:
+        pos = world.cell_position(float(i), float(j))
+        rad = render_panorama(world.scene, position=pos, geometry=geometry, clip=False, exposure=1.0)
+        depth, _, _ = render_depth(world.scene, position=pos, geometry=geometry)
+        counts.append(sensor_model.read(np.asarray(rad, float), rng=rng)[0, ..., :5].astype(np.float32))
+        skies.append(~np.isfinite(depth))
+    return np.stack(counts), np.stack(skies)
+
+
+def run(cfg, ctx) -> dict:
+    """Entry point called by bionav's experiment runner."""
+    from bionav.db.database import ImageDatabase
+    from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
+    from bionav.evaluation.pairs import home_vector_matrix, prepare_images
+    from bionav.experiments.common import make_homing
+    from bionav.experiments.grid_homing import evaluate_agents
+    from bionav.geometry import PanoramaGeometry
+    from bionav.spectral.representations import check_representation, representation_image
+    from bionav.spectral.scene import garden_scene
+    from bionav.spectral.sensor_model import LogSensorModel
+    from bionav.spectral.sky import CloudField, SkyState
+
+    exp = cfg.experiment
+    conditions = _conditions(exp)
+    reps = [str(r) for r in _get(exp, "representations", [])]
+    for r in reps:
+        try:
+            check_representation(r)
+        except ValueError as exc:
+            raise UserError(f"experiment.representations: {exc}.") from None
+    world_name = str(_get(exp, "world", "garden"))
+    if world_name not in ("garden", "campus"):
+        raise UserError(f"experiment.world={world_name!r} is unknown; choose garden or campus.")
+    nx, ny = (int(v) for v in _get(exp, "grid", [9, 9]))
+    spacing = float(_get(exp, "spacing_m", 0.5))
+    if world_name == "campus":
+        from bionav.world.worlds.outdoor import GRID_SHAPE, SPACING
+
+        (nx, ny), spacing = GRID_SHAPE, SPACING
+    width, height = int(_get(exp, "image_width", 120)), int(_get(exp, "image_height", 20))
+    top = np.deg2rad(float(_get(exp, "elevation_top_deg", 45.0)))
+    rad_per_row = 2 * np.pi / width
+    geometry = PanoramaGeometry(width, height, top / rad_per_row, rad_per_row)
+    seed = int(_get(exp, "world_seed", 0))
+    extent = max(nx - 1, ny - 1) * spacing
+    sensor_model = LogSensorModel(noise_counts=float(_get(exp, "noise_counts", 4.0)))
+    disc = learn_discriminants(_get(exp, "learn", None) or {"name": "sim_natural", "seed": int(_get(cfg, "seed", 0))},
+                               sigma=float(_get(exp, "sigma", 30.0)))
+
+    gx, gy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    positions = np.c_[gx.ravel(), gy.ravel()]
+    world_pos = positions * spacing
+    side = float(_get(exp, "square_side_m", 2.0))
+    square_cells = np.array([[0, 0], [1, 0], [0, 1], [1, 1]])
+    centre = np.array([nx - 1, ny - 1]) * spacing / 2
+    square_pos = centre - side / 2 + square_cells * side
+    do_square = bool(_get(exp, "square_test", True))
+
+    counts, squares, truths = [], [], []
+    for k, (name, t, cover, tau) in enumerate(conditions):
+        sky = SkyState.from_time(t, clouds=CloudField(cover=cover, optical_depth=tau, seed=seed + 1),
+                                 turbidity=float(_get(exp, "turbidity", 0.1)))
+        if world_name == "campus":
+            world = campus_world(sky, seed=seed)
+            c, truth = render_campus_counts(world, geometry, positions, sensor_model=sensor_model, rng=ctx.rng,
+                                            progress=ctx.progress)
+            if do_square:
+                squares.append(render_campus_counts(world, geometry, square_pos / spacing,
+                                                    sensor_model=sensor_model, rng=ctx.rng)[0])
+        else:
+            scene = garden_scene(sky, seed=seed, grid_extent=extent)
+            c, truth = render_condition_counts(scene, geometry, world_pos, sensor_model=sensor_model, rng=ctx.rng,
+                                               progress=ctx.progress)
+            if do_square:
+                squares.append(render_condition_counts(scene, geometry, square_pos, sensor_model=sensor_model,
+                                                       rng=ctx.rng)[0])
+        counts.append(c)
+        truths.append(truth)
+    np.savez_compressed(ctx.dir / "panoramas.npz", counts=np.stack(counts), sky=np.stack(truths),
+                        positions=positions, conditions=np.array([c[0] for c in conditions]))
+
+    method = make_homing(cfg, ctx, geometry)
+    stride = max(1, int(_get(exp, "snapshot_stride", 2)))
+    snap_idx = np.flatnonzero((positions[:, 0] % stride == 0) & (positions[:, 1] % stride == 0))
+    step, radius = float(_get(exp, "step_length", 0.5)), float(_get(exp, "success_radius", 1.0))
+    names = [c[0] for c in conditions]
+    n = len(conditions)
+    rows, square_rows, ms = [], [], []
+    results = {r: {k: np.full((n, n), np.nan) for k in ("aae", "mae", "rr")} for r in reps}
+    square = {r: np.full((n, n), np.nan) for r in reps}
+    for rep in ctx.progress(reps, desc="representations"):
+        dbs, prepared = [], []
+        for c in counts:
+            imgs = representation_image(c, rep, discriminants=disc)
+            db = ImageDatabase(name=rep, images=imgs, positions=positions, grid_shape=(nx, ny), geometry=geometry,
+                               spacing_m=spacing)
+            dbs.append(db)
+            prepared.append(prepare_images(method, list(imgs), workers=int(_get(cfg, "workers", 1))))
+        for i in range(n):
+            for j in range(n):
+                hv = home_vector_matrix(method, dbs[i], dbs[j], snapshot_index=snap_idx,
+                                        workers=int(_get(cfg, "workers", 1)), prepared=(prepared[i], prepared[j]))
+                ae = angular_errors(hv.angles, ideal_home_angles(positions[snap_idx], positions))
+                success, _ = evaluate_agents(dbs[j], hv, step_length=step, success_radius=radius)
+                q = quality_measures(ae, success)
+                results[rep]["aae"][i, j], results[rep]["mae"][i, j], results[rep]["rr"][i, j] = q.aae, q.mae, q.rr
+                ms.append(hv.ms_per_home_vector)
+                rows.append({"representation": rep, "snapshot_condition": names[i], "current_condition": names[j],
+                             "aae": q.aae, "mae": q.mae, "rr": q.rr})
+                ctx.log.write(CELL_TOPIC, rows[-1], schema_name="bionav.SkylineHomingCell")
+        if do_square:
+            sq_dbs = [ImageDatabase(name=rep, images=representation_image(s, rep, discriminants=disc),
+                                    positions=square_cells, grid_shape=(2, 2), geometry=geometry, spacing_m=side)
+                      for s in squares]
+            for i in range(n):
+                for j in range(n):
+                    hv = home_vector_matrix(method, sq_dbs[i], sq_dbs[j])
+                    ae = angular_errors(hv.angles, ideal_home_angles(square_cells, square_cells))
+                    square[rep][i, j] = float(np.nanmean(ae))
+                    square_rows.append({"representation": rep, "snapshot_condition": names[i],
+                                        "current_condition": names[j], "aae": square[rep][i, j]})
+
+    _write_csv(ctx.dir / "skyline_homing.csv", rows, ["representation", "snapshot_condition", "current_condition",
+                                                       "aae", "mae", "rr"])
+    if do_square:
+        _write_csv(ctx.dir / "square_test.csv", square_rows, ["representation", "snapshot_condition",
+                                                               "current_condition", "aae"])
+    off = ~np.eye(n, dtype=bool)
+    diag = np.eye(n, dtype=bool)
+
+    def mean(m, mask):
+        return float(np.mean(m[mask])) if mask.any() else float("nan")
+
+    metrics = {
+        "homing": str(cfg.homing.name) if _get(cfg, "homing") else "",
+        "n_conditions": n,
+        "n_positions": int(len(positions)),
+        "n_snapshots": int(len(snap_idx)),
+        "rr": {r: mean(results[r]["rr"], off) for r in reps},
+        "aae": {r: mean(results[r]["aae"], off) for r in reps},
+        "rr_same": {r: mean(results[r]["rr"], diag) for r in reps},
+        "aae_same": {r: mean(results[r]["aae"], diag) for r in reps},
+        "ms_per_home_vector": float(np.mean(ms)) if ms else float("nan"),
+    }
+    ranked = [r for r in reps if np.isfinite(metrics["rr" if n > 1 else "rr_same"][r])]
+    key = "rr" if n > 1 else "rr_same"
+    if ranked:
+        metrics["best_representation"] = max(ranked, key=lambda r: (metrics[key][r], -metrics["aae" if n > 1 else "aae_same"][r]))
+    if do_square:
+        metrics["square_aae"] = {r: mean(square[r], diag) for r in reps}
+        if n > 1:
+            metrics["square_aae_changed"] = {r: mean(square[r], off) for r in reps}
+    if bool(_get(exp, "plots", True)):
+        _plots(ctx.plots, counts, disc, reps, names, metrics, results, geometry)
+    return metrics
+
+
+def _write_csv(path, rows, fields):
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6f}" if isinstance(v, float) else v) for k, v in r.items()})
+
+
+def _plots(plots, counts, disc, reps, names, metrics, results, geometry):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bionav.spectral.representations import representation_image
+
+    # RR* per representation: same light vs changed light
+    x = np.arange(len(reps))
+    fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(reps) + 2), 3.8))
+    ax.bar(x - 0.2, [metrics["rr_same"][r] for r in reps], 0.4, label="same light")
+    if len(names) > 1:
+        ax.bar(x + 0.2, [metrics["rr"][r] for r in reps], 0.4, label="changed light")
+    ax.set_xticks(x, reps, rotation=60, ha="right", fontsize=8)
+    ax.set_ylabel("RR*")
+    ax.set_ylim(0, 1.05)
+    ax.legend()
+    ax.set_title(f"return ratio per representation (homing={metrics['homing']})")
+    fig.tight_layout()
+    fig.savefig(plots / "rr_per_representation.png", dpi=100)
+    plt.close(fig)
+    # RR* matrices per representation
+    cols = min(5, len(reps))
+    rws = int(np.ceil(len(reps) / cols))
+    fig, axes = plt.subplots(rws, cols, figsize=(2.6 * cols, 2.4 * rws), squeeze=False)
+    for ax, r in zip(axes.ravel(), reps):
+        ax.imshow(results[r]["rr"], vmin=0, vmax=1, cmap="viridis")
+        ax.set_title(r, fontsize=8)
+        ax.set_xticks(range(len(names)), names, rotation=90, fontsize=5)
+        ax.set_yticks(range(len(names)), names, fontsize=5)
+    for ax in axes.ravel()[len(reps):]:
+        ax.axis("off")
+    fig.suptitle("RR*: rows snapshot condition, columns current condition", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(plots / "rr_matrices.png", dpi=90)
+    plt.close(fig)
+    # the representations of the first position under every condition
+    fig, axes = plt.subplots(len(reps), len(names), figsize=(3.2 * len(names), 0.9 * len(reps) + 0.5), squeeze=False)
+    for i, r in enumerate(reps):
+        for j, nm in enumerate(names):
+            axes[i, j].imshow(representation_image(counts[j][0], r, discriminants=disc), cmap="gray", vmin=0, vmax=1,
+                              aspect="auto", interpolation="nearest")
+            axes[i, j].set_xticks([])
+            axes[i, j].set_yticks([])
+            if j == 0:
+                axes[i, j].set_ylabel(r, fontsize=7, rotation=0, ha="right")
+            if i == 0:
+                axes[i, j].set_title(nm, fontsize=8)
+    fig.tight_layout()
+    fig.savefig(plots / "representations.png", dpi=80)
+    plt.close(fig)

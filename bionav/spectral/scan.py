@@ -1,0 +1,227 @@
+"""2-D scans of the five-channel sensor on a pan-tilt unit, contrast images and their stability (thesis 6.4).
+
+The sensor on the pan-tilt unit samples a grid of pan and tilt angles column by
+column (for each pan angle all tilt angles, "tilt-pan" order). Every reading
+becomes one pixel of five channel images (row 0 = highest tilt; column index
+grows with the pan angle, i.e. counter-clockwise, as in bionav's canonical
+panoramas). Contrast images are differences of two channel images (log
+signals); separation images classify every pixel as sky or object with a
+linear discriminant learned on labelled samples (thesis: ``J_sigma`` lines of
+the natural samples).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from bionav.spectral.bands import CHANNELS, dual_contrasts, feature_subsets
+from bionav.spectral.stability import stability_measures
+
+#: The 14 scan times of the thesis' one-day dataset (Wed 17 June 2009, appendix D.3), local time.
+ONE_DAY_TIMES = (
+    "2009-06-17T11:27:04+02:00", "2009-06-17T12:06:19+02:00", "2009-06-17T12:46:02+02:00",
+    "2009-06-17T13:25:05+02:00", "2009-06-17T14:07:52+02:00", "2009-06-17T14:47:21+02:00",
+    "2009-06-17T15:26:36+02:00", "2009-06-17T16:07:15+02:00", "2009-06-17T16:46:10+02:00",
+    "2009-06-17T17:26:10+02:00", "2009-06-17T18:44:09+02:00", "2009-06-17T19:24:41+02:00",
+    "2009-06-17T20:03:57+02:00", "2009-06-17T20:43:36+02:00",
+)
+
+
+@dataclass(frozen=True)
+class ScanGrid:
+    """Pan and tilt angles of a scan (radians, ascending).
+
+    Attributes
+    ----------
+    pans : ndarray, shape (W,)
+        Pan angles, radians counter-clockwise; image column ``j`` is ``pans[j]``.
+    tilts : ndarray, shape (H,)
+        Tilt angles (elevation of the optical axis), radians; image row ``r`` is
+        ``tilts[H - 1 - r]`` (row 0 on top).
+    """
+
+    pans: np.ndarray
+    tilts: np.ndarray
+
+    @classmethod
+    def from_steps(cls, *, n_pan: int = 113, pan_step: float = np.deg2rad(2.0), n_tilt: int = 26,
+                   tilt_step: float = np.deg2rad(3.0), tilt_start: float = np.deg2rad(-45.0),
+                   pan_centre: float = 0.0) -> "ScanGrid":
+        """Regular grid: ``n_pan`` pan steps centred on ``pan_centre``, ``n_tilt`` tilt steps upwards
+        from ``tilt_start`` (thesis 6.4.1: 113 x 26 steps of 2 and 3 degrees)."""
+        pans = pan_centre + (np.arange(n_pan) - (n_pan - 1) / 2) * pan_step
+        tilts = tilt_start + np.arange(n_tilt) * tilt_step
+        return cls(pans, tilts)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Image shape ``(H, W)``."""
+        return len(self.tilts), len(self.pans)
+
+    def angles(self) -> tuple[np.ndarray, np.ndarray]:
+        """Pan and tilt of every pixel, each of shape ``(H, W)``."""
+        p, t = np.meshgrid(self.pans, self.tilts[::-1])
+        return p, t
+
+
+class DirectPanTilt:
+    """An ideal pan-tilt unit for simulations without ``pantilt=``: moves exactly and instantly
+    and aims the attached scene (``scene.set_pose``)."""
+
+    schema_name = "bionav.PanTiltState"
+
+    def __init__(self, scene=None) -> None:
+        self.scene = scene
+
+    def attach_simulation(self, scene, rng) -> None:
+        self.scene = scene
+
+    def open(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self) -> "DirectPanTilt":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+    def move_to(self, pan: float, tilt: float) -> dict:
+        if self.scene is not None:
+            self.scene.set_pose(pan, tilt)
+        return {"pan_pos": 0, "tilt_pos": 0, "pan": float(pan), "tilt": float(tilt),
+                "pan_cmd": float(pan), "tilt_cmd": float(tilt)}
+
+
+def run_scan(sensor, pantilt, grid: ScanGrid, *, before_column: Callable[[int], None] | None = None,
+             on_move: Callable[[dict], None] | None = None, on_reading: Callable[[dict], None] | None = None,
+             progress=None) -> np.ndarray:
+    """Scan the grid column by column and assemble the channel images.
+
+    Parameters
+    ----------
+    sensor : object
+        ``read() -> {"counts": [[uv, b, g, r, ir, ref], ...]}`` (a spectral5 plugin or a replay).
+    pantilt : object
+        ``move_to(pan, tilt) -> state dict`` (radians).
+    grid : ScanGrid
+    before_column : callable, optional
+        ``before_column(j)`` before the unit turns to column ``j`` (simulations
+        advance their clock here).
+    on_move, on_reading : callable, optional
+        Receive every pan-tilt state and raw reading as they happen (recording).
+    progress : callable, optional
+        ``progress(iterable, desc=..., total=...)`` wrapper for the column loop.
+
+    Returns
+    -------
+    ndarray, shape (H, W, 6), float
+        Mean counts (over the readings of one measure command) per pixel:
+        ``uv, b, g, r, ir, ref``.
+    """
+    from bionav.plugins.sensors.spectral5 import reading_counts
+
+    h, w = grid.shape
+    out = np.empty((h, w, 6))
+    columns = range(w)
+    if progress is not None:
+        columns = progress(columns, desc="scan columns", total=w)
+    for j in columns:
+        if before_column is not None:
+            before_column(j)
+        for i, tilt in enumerate(grid.tilts):
+            state = pantilt.move_to(float(grid.pans[j]), float(tilt))
+            if on_move is not None:
+                on_move(state)
+            msg = sensor.read()
+            if on_reading is not None:
+                on_reading(msg)
+            out[h - 1 - i, j] = reading_counts(msg).mean(axis=0)
+    return out
+
+
+def feature_images(counts) -> dict[str, np.ndarray]:
+    """Single-channel images and dual-channel contrast images of a scan.
+
+    Parameters
+    ----------
+    counts : array_like, shape (H, W, >=5)
+        Channel counts (log signals) UV, B, G, R, IR.
+
+    Returns
+    -------
+    dict
+        ``"UV"`` .. ``"IR"``: the channel images; ``"UV-B"`` .. ``"R-IR"``: the
+        contrasts ``X - Y`` (counts), each of shape ``(H, W)``.
+    """
+    c = np.asarray(counts, dtype=float)
+    out = {name: c[..., i] for i, name in enumerate(CHANNELS)}
+    for name, (i, j) in dual_contrasts().items():
+        out[name] = c[..., i] - c[..., j]
+    return out
+
+
+def separation_images(counts, discriminants: dict) -> dict[str, np.ndarray]:
+    """Sky/object classification of every pixel per feature.
+
+    Parameters
+    ----------
+    counts : array_like, shape (H, W, >=5)
+    discriminants : dict
+        Feature name -> fitted :class:`bionav.stats.LinearDiscriminant` (sky =
+        class 1) on that feature's channels (see
+        :func:`bionav.spectral.bands.feature_subsets`).
+
+    Returns
+    -------
+    dict
+        Feature name -> bool image ``(H, W)``, True where classified as sky.
+    """
+    c = np.asarray(counts, dtype=float)
+    subsets = feature_subsets()
+    out = {}
+    for name, lda in discriminants.items():
+        x = c[..., list(subsets[name])].reshape(-1, len(subsets[name]))
+        out[name] = lda.predict(x).reshape(c.shape[:2])
+    return out
+
+
+def stability_series(scans, discriminants: dict | None = None, *, names=None) -> list[dict]:
+    """Stability measures of every feature of every scan against the first scan (thesis 6.4.2/6.4.3).
+
+    Parameters
+    ----------
+    scans : array_like, shape (T, H, W, >=5)
+        Channel counts of T scans of one scene, the first is the reference.
+    discriminants : dict, optional
+        Feature -> discriminant (sky = class 1); when given, the measures are
+        also computed on the separation images (sky 0, object 1).
+    names : sequence of str, optional
+        Features to evaluate; default the 5 channels and 10 dual contrasts.
+
+    Returns
+    -------
+    list of dict
+        One row per (scan k >= 1, feature, separated): ``scan``, ``feature``,
+        ``separated`` and the seven measures of :func:`~bionav.spectral.stability.stability_measures`.
+    """
+    scans = np.asarray(scans, dtype=float)
+    ref = feature_images(scans[0])
+    names = list(names or ref)
+    ref_sep = separation_images(scans[0], {n: discriminants[n] for n in names}) if discriminants else None
+    rows = []
+    for k in range(1, len(scans)):
+        cur = feature_images(scans[k])
+        cur_sep = separation_images(scans[k], {n: discriminants[n] for n in names}) if discriminants else None
+        for n in names:
+            rows.append({"scan": k, "feature": n, "separated": False, **stability_measures(ref[n], cur[n])})
+            if discriminants:
+                a = (~ref_sep[n]).astype(float)
+                b = (~cur_sep[n]).astype(float)
+                rows.append({"scan": k, "feature": n, "separated": True, **stability_measures(a, b)})
+    return rows

@@ -1,0 +1,179 @@
+"""A large, dim, achromatic hall with pillars and galleries (stand-in for *hall1*/*hall2*).
+
+The hall is about 22 m wide, 44 m long and 10 m high: stone floor, a dark
+coffered ceiling, galleries at 4.5 m along both long walls carried by rows of
+square pillars, shop fronts and notice boards on the walls, stairs, benches,
+planters and a few fluorescent lamps. The 10 x 20 capture grid (0.5 m,
+4.5 m x 9.5 m) lies in the middle of the floor; a few obstacles (a round
+pillar, a kiosk, planters, a bench) stand inside the grid area and the 30
+cells closest to them are missing, leaving 170 images as in table 3.1.
+``part`` selects which part of the hall the grid covers (hall1, hall2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bionav.world import textures as tx
+from bionav.world.lights import Ambient, PointLight
+from bionav.world.scene import Scene
+from bionav.world.worlds.common import World, stream
+from bionav.world.worlds.furniture import potted_plant, wall_picture
+
+GRID_SHAPE = (10, 20)
+SPACING = 0.5
+CAMERA_HEIGHT = 0.6
+N_MISSING = 30
+
+
+def _missing_cells(origin, obstacles, n_missing: int) -> np.ndarray:
+    """Cells mask with the ``n_missing`` cells of smallest clearance to the obstacles removed.
+
+    ``obstacles`` is a list of ``(x, y, radius)`` footprints in metres.
+    """
+    ii, jj = np.meshgrid(np.arange(GRID_SHAPE[0]), np.arange(GRID_SHAPE[1]), indexing="ij")
+    x = origin[0] + SPACING * ii
+    y = origin[1] + SPACING * jj
+    clearance = np.full(GRID_SHAPE, np.inf)
+    for ox, oy, rad in obstacles:
+        clearance = np.minimum(clearance, np.hypot(x - ox, y - oy) - rad)
+    order = np.lexsort((jj.ravel(), ii.ravel(), clearance.ravel()))
+    cells = np.ones(GRID_SHAPE, bool)
+    cells.ravel()[order[:n_missing]] = False
+    return cells
+
+
+def build_hall(seed: int = 0, *, part: int = 1) -> World:
+    """Build the hall world with the capture grid in part ``part`` (1 or 2).
+
+    Returns
+    -------
+    World
+        10 x 20 grid at 0.5 m spacing with 170 existing cells, camera 0.6 m high.
+    """
+    g = stream(seed, "hall/layout")
+    lx = 22.0 + g.uniform(-1, 1)
+    ly = 44.0 + g.uniform(-2, 2)
+    lz = 10.0
+    gal_z = 4.5
+    gal_d = 3.5
+    pitch = 6.0 + g.uniform(-0.5, 0.5)
+    scene = Scene(name="hall")
+
+    r = stream(seed, "hall/shell")
+    floor = scene.material(texture=tx.tiles(r, n=4, lo=0.25, hi=0.65, grout_level=0.2), albedo=0.6, scale=2.4)
+    wall = scene.material(texture=tx.value_noise(r, lo=0.45, hi=0.7, base_cells=2), albedo=0.6, scale=4.0)
+    ceiling = scene.material(texture=tx.tiles(r, n=3, lo=0.15, hi=0.35, grout_level=0.05), albedo=0.5,
+                             scale=3.0)
+    scene.box((0, 0, 0), (lx, ly, lz), [wall, wall, wall, wall, floor, ceiling], inside=True, shadow=False)
+
+    # galleries along both long walls, railings and pillar rows
+    slab = scene.material(texture=tx.stripes(r, n=3, lo=0.3, hi=0.6), albedo=0.55, scale=(4.0, 0.6))
+    railing = scene.material(texture=tx.stripes(r, n=10, lo=0.15, hi=0.7), albedo=0.6, scale=(0.4, 1.0))
+    concrete = scene.material(texture=tx.value_noise(r, lo=0.4, hi=0.75, base_cells=3), albedo=0.6, scale=1.5)
+    for x0, x1, edge in ((0.0, gal_d, gal_d), (lx - gal_d, lx, lx - gal_d)):
+        scene.box((x0, 0.0, gal_z - 0.5), (x1, ly, gal_z), slab)
+        ex = edge - 0.05 if edge < lx / 2 else edge
+        scene.box((ex, 0.0, gal_z), (ex + 0.05, ly, gal_z + 1.0), railing, shadow=False)
+        px = edge - 0.35 if edge < lx / 2 else edge + 0.35
+        y = 1.5
+        while y < ly - 1.0:
+            scene.box((px - 0.35, y - 0.35, 0.0), (px + 0.35, y + 0.35, gal_z - 0.5), concrete)
+            y += pitch
+
+    # shop fronts and notice boards under the galleries, doors at the ends
+    r = stream(seed, "hall/shops")
+    glass = scene.material(texture=tx.facade(r, floors=1, windows=3), albedo=0.4, scale=(6.0, 3.5))
+    y = 0.5
+    while y < ly - 3.0:
+        w = r.uniform(3.0, 5.5)
+        if r.random() < 0.6:
+            scene.box((0.0, y, 0.0), (0.1, y + w, 3.5), glass, shadow=False)
+            scene.box((lx - 0.1, ly - y - w, 0.0), (lx, ly - y, 3.5), glass, shadow=False)
+        sign = scene.material(texture=tx.poster(r, n_shapes=8), fit=True, albedo=0.8)
+        scene.box((0.0, y + 0.3, 3.6), (0.12, y + w - 0.3, 4.0), sign, shadow=False)
+        y += w + r.uniform(0.5, 2.0)
+    for wall_name, length in (("south", lx), ("north", lx)):
+        for k in range(4):
+            wall_picture(scene, r, wall=wall_name, position=length * (k + 0.5) / 4, z0=1.0, z1=2.6,
+                         width=r.uniform(1.5, 3.0), room=(lx, ly))
+    door = scene.material(texture=tx.panel(r, nx=4, ny=1), fit=True, albedo=0.35)
+    scene.box((lx / 2 - 2.5, 0.0, 0.0), (lx / 2 + 2.5, 0.12, 3.0), door, shadow=False)
+    scene.box((lx / 2 - 2.5, ly - 0.12, 0.0), (lx / 2 + 2.5, ly, 3.0), door, shadow=False)
+    # upper-level windows/openings above the galleries
+    upper = scene.material(texture=tx.facade(r, floors=1, windows=6), albedo=0.35, scale=(12.0, 3.0))
+    scene.box((0.0, 0.0, gal_z + 1.2), (0.1, ly, gal_z + 4.2), upper, shadow=False)
+    scene.box((lx - 0.1, 0.0, gal_z + 1.2), (lx, ly, gal_z + 4.2), upper, shadow=False)
+
+    # stairs to the west gallery
+    r = stream(seed, "hall/stairs")
+    step = scene.material(texture=tx.stripes(r, n=2, lo=0.35, hi=0.6), albedo=0.6, scale=(1.0, 0.3))
+    sy = ly * r.uniform(0.55, 0.65)
+    n_steps = 18
+    for k in range(n_steps):
+        scene.box((gal_d, sy + k * 0.3, 0.0), (gal_d + 1.8, sy + (k + 1) * 0.3, (k + 1) * gal_z / n_steps), step)
+
+    # the capture grid and the obstacles standing in it
+    r = stream(seed, f"hall/part{part}")
+    gx0 = lx / 2 - 2.25 + r.uniform(-0.5, 0.5)
+    gy0 = (ly * 0.18 if part == 1 else ly * 0.55) + r.uniform(-1.0, 1.0)
+    obstacles = []
+    pillar = scene.material(texture=tx.value_noise(r, lo=0.45, hi=0.75, base_cells=2), albedo=0.65, scale=1.2)
+    px, py = gx0 + r.uniform(1.4, 3.1), gy0 + r.uniform(2.5, 4.0)
+    scene.cylinder((px, py), 0.0, lz, 0.45, material=pillar)
+    obstacles.append((px, py, 0.45))
+    kx, ky = gx0 + r.uniform(0.0, 4.5), gy0 + r.uniform(6.5, 8.5)
+    kiosk = scene.material(texture=tx.poster(r, n_shapes=12), fit=True, albedo=0.7)
+    scene.box((kx - 0.5, ky - 0.5, 0.0), (kx + 0.5, ky + 0.5, 2.2), kiosk)
+    scene.box((kx - 0.6, ky - 0.6, 2.2), (kx + 0.6, ky + 0.6, 2.3), concrete)
+    obstacles.append((kx, ky, 0.6))
+    planter_mat = scene.material(texture=tx.value_noise(r, lo=0.3, hi=0.5), albedo=0.5, scale=0.8)
+    for k in range(2):
+        qx = gx0 + (0.0 if k == 0 else 4.5) + r.uniform(-0.2, 0.2)
+        qy = gy0 + r.uniform(0.5, 9.0)
+        scene.cylinder((qx, qy), 0.0, 0.5, 0.35, material=planter_mat)
+        potted_plant(scene, stream(seed, f"hall/part{part}/plant{k}"), x=qx, y=qy, height=1.6, crown=0.45,
+                     min_leaf_z=0.9)
+        obstacles.append((qx, qy, 0.4))
+    bench = scene.material(texture=tx.wood(r), albedo=0.45, scale=1.0)
+    bx, by = gx0 + r.uniform(0.5, 4.0), gy0 + r.uniform(0.0, 1.5)
+    scene.box((bx - 0.9, by - 0.2, 0.4), (bx + 0.9, by + 0.2, 0.46), bench)
+    for sx in (-0.8, 0.75):
+        scene.box((bx + sx, by - 0.2, 0.0), (bx + sx + 0.05, by + 0.2, 0.4), bench)
+    obstacles.append((bx, by, 0.6))
+    cells = _missing_cells((gx0, gy0), obstacles, N_MISSING)
+
+    # more benches, bins and planters elsewhere in the hall
+    r = stream(seed, "hall/props")
+    for k in range(10):
+        x = r.uniform(gal_d + 1.5, lx - gal_d - 1.5)
+        y = r.uniform(1.0, ly - 1.0)
+        if gx0 - 1.0 < x < gx0 + 5.5 and gy0 - 1.0 < y < gy0 + 10.5:
+            continue
+        if k % 3 == 0:
+            scene.cylinder((x, y), 0.0, 0.5, 0.35, material=planter_mat)
+            potted_plant(scene, stream(seed, f"hall/props/plant{k}"), x=x, y=y, height=1.8, crown=0.5,
+                         min_leaf_z=0.9)
+        elif k % 3 == 1:
+            scene.box((x - 0.9, y - 0.2, 0.4), (x + 0.9, y + 0.2, 0.46), bench)
+            scene.box((x - 0.85, y - 0.2, 0.0), (x - 0.8, y + 0.2, 0.4), bench)
+            scene.box((x + 0.8, y - 0.2, 0.0), (x + 0.85, y + 0.2, 0.4), bench)
+        else:
+            board = scene.material(texture=tx.poster(r, n_shapes=16), fit=True, albedo=0.75)
+            scene.box((x - 0.6, y - 0.03, 0.5), (x + 0.6, y + 0.03, 2.0), board)
+            scene.box((x - 0.55, y - 0.02, 0.0), (x - 0.5, y + 0.02, 0.5), concrete)
+            scene.box((x + 0.5, y - 0.02, 0.0), (x + 0.55, y + 0.02, 0.5), concrete)
+
+    # few fluorescent lamps: dim
+    r = stream(seed, "hall/lights")
+    lamp = scene.material(albedo=0.7, emission=2.5)
+    for k in range(6):
+        y = ly * (k + 0.5) / 6 + r.uniform(-1, 1)
+        for x in (gal_d + 0.8, lx - gal_d - 0.8):
+            if r.random() < 0.75:
+                scene.box((x - 0.6, y - 0.08, gal_z - 0.56), (x + 0.6, y + 0.08, gal_z - 0.5), lamp, shadow=False)
+                scene.add_light(PointLight((x, y, gal_z - 0.6), 9.0, downward=True))
+    scene.ambient = Ambient(up=0.22, down=0.14)
+    scene.exposure = 3.2
+    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
+                 camera_height=CAMERA_HEIGHT, cells=cells, info={"room": (lx, ly, lz), "part": part})

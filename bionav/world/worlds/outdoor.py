@@ -1,0 +1,182 @@
+"""Outdoor campus world (stand-in for *uni*, thesis 3.1): buildings, trees, sky and sun.
+
+The 10 x 17 grid (1 m spacing, 9 m x 16 m) lies north of a large university
+building's entrance (``+y`` is north), in the building's shadow as in the
+thesis; other buildings, trees (deciduous and conifers), hedges, lamp posts,
+bike racks, benches and bollards stand around it at 2-80 m.
+
+Channels are pluggable: pass band names plus per-kind albedos and a sky
+callable to render multi-band (e.g. UV, B, G, R, IR) images; the defaults of
+:mod:`bionav.world.sky` are used otherwise.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from bionav.world import textures as tx
+from bionav.world.lights import Ambient, DirectionalLight, sun_direction
+from bionav.world.scene import Scene, SkyFunction
+from bionav.world.sky import SUN_GAIN, SKY_GAIN, SimpleSky, band_albedos
+from bionav.world.worlds.common import World, stream
+from bionav.world.worlds.furniture import tree
+
+GRID_SHAPE = (10, 17)
+SPACING = 1.0
+CAMERA_HEIGHT = 0.8
+
+
+def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
+                 albedos: Mapping[str, Sequence[float]] | None = None, sky: SkyFunction | None = None,
+                 sun_elevation: float = np.deg2rad(35.0), sun_azimuth: float = -np.pi / 2,
+                 sun_irradiance: Sequence[float] | float | None = None,
+                 sky_irradiance: Sequence[float] | float | None = None, exposure: float = 1.1) -> World:
+    """Build the outdoor campus world.
+
+    Parameters
+    ----------
+    seed : int
+        Which campus (building sizes, tree placement, textures).
+    channels : sequence of str
+        Band names, e.g. ``("grey",)`` or ``("UV", "B", "G", "R", "IR")``.
+    albedos : mapping, optional
+        Material kind -> per-band albedo (length ``len(channels)``). Kinds used:
+        ``concrete brick glass foliage bark grass paving asphalt metal paint
+        wood soil``. Default :func:`bionav.world.sky.band_albedos`.
+    sky : callable, optional
+        ``sky(directions (N, 3)) -> radiance (N, C)``; default
+        :class:`~bionav.world.sky.SimpleSky` for the sun position.
+    sun_elevation, sun_azimuth : float
+        Sun position in radians (azimuth CCW from world ``+x``; ``-pi/2`` is
+        south, so the grid north of the main building lies in its shadow).
+    sun_irradiance, sky_irradiance : float or sequence, optional
+        Per-band direct-sun irradiance and diffuse sky irradiance (ambient on
+        upward faces); defaults scale :data:`~bionav.world.sky.SUN_GAIN` /
+        :data:`~bionav.world.sky.SKY_GAIN`.
+    exposure : float
+        Camera gain.
+
+    Returns
+    -------
+    World
+        10 x 17 grid at 1.0 m, camera 0.8 m above the ground.
+    """
+    channels = tuple(channels)
+    c = len(channels)
+    table = band_albedos(channels) if albedos is None else {k: np.asarray(v, float) for k, v in albedos.items()}
+    for k, v in table.items():
+        if np.asarray(v).reshape(-1).size not in (1, c):
+            raise ValueError(f"albedo of {k!r} must have 1 or {c} values")
+    sun = sun_direction(sun_elevation, sun_azimuth)
+    if sky is None:
+        sky = SimpleSky(sun_direction=sun, channels=channels, seed=int(seed))
+    if sun_irradiance is None:
+        sun_irradiance = [2.2 * SUN_GAIN.get(ch, 1.0) for ch in channels]
+    if sky_irradiance is None:
+        sky_irradiance = [1.2 * SKY_GAIN.get(ch, 1.0) for ch in channels]
+    scene = Scene(channels=channels, sky=sky, name="campus")
+
+    def alb(kind: str):
+        if kind not in table:
+            raise ValueError(f"albedos has no entry for material kind {kind!r}")
+        return table[kind]
+
+    def mat(kind: str, texture=None, **kw) -> int:
+        return scene.material(texture=texture, albedo=alb(kind), kind=kind, **kw)
+
+    g = stream(seed, "campus/layout")
+    gx0, gy0 = 0.0, 0.0
+    # ground: paving slab with grass areas and an asphalt road
+    r = stream(seed, "campus/ground")
+    paving = mat("paving", tx.tiles(r, n=4, lo=0.35, hi=0.65, grout_level=0.25), scale=2.0)
+    grass = mat("grass", tx.foliage(r), scale=1.5)
+    asphalt = mat("asphalt", tx.carpet(r, lo=0.3, hi=0.6), scale=3.0)
+    scene.box((-300, -300, -1.0), (300, 300, 0.0), paving, shadow=False)
+    for x0, y0, x1, y1 in ((-30, 20, -4, 45), (14, -6, 24, 30), (-22, -6, -6, 16), (-60, 50, 80, 58)):
+        scene.box((x0, y0, 0.0), (x1, y1, 0.02), grass, shadow=False)
+    scene.box((-300, 60, 0.0), (300, 68, 0.01), asphalt, shadow=False)
+
+    # the main building south of the grid with its north entrance
+    r = stream(seed, "campus/main")
+    main_h = 20.0 + g.uniform(-2, 2)
+    facade = mat("concrete", tx.facade(r, floors=4, windows=4), scale=(10.4, 15.2))
+    roof = mat("concrete")
+    scene.box((-45, -26, 0.0), (55, -9, main_h), [facade, facade, facade, facade, roof, roof])
+    canopy = mat("concrete", tx.stripes(r, n=3, lo=0.5, hi=0.8), scale=(4.0, 0.5))
+    scene.box((-3, -9, 3.6), (12, -4.5, 4.0), canopy)
+    pillar = mat("concrete", tx.value_noise(r, lo=0.5, hi=0.75), scale=1.0)
+    for px in (-2.5, 3.5, 9.5):
+        scene.cylinder((px, -5.0), 0.0, 3.6, 0.25, material=pillar)
+    glass = mat("glass", tx.facade(r, floors=1, windows=6), scale=(15.0, 3.5))
+    scene.box((-3, -9.1, 0.0), (12, -8.9, 3.5), glass, shadow=False)
+
+    # other buildings around
+    r = stream(seed, "campus/buildings")
+    for x0, y0, x1, y1, h, kind in ((38, 4, 58, 34, 12.0, "brick"), (-62, -4, -36, 22, 15.0, "concrete"),
+                                    (-40, 75, 10, 95, 22.0, "concrete"), (20, 72, 60, 90, 9.0, "brick"),
+                                    (60, -20, 85, 20, 25.0, "concrete")):
+        jx, jy = r.uniform(-2, 2, size=2)
+        hh = h + r.uniform(-2, 2)
+        fac = mat(kind, tx.facade(r, floors=4, windows=int(r.integers(3, 6))) if kind == "concrete"
+                  else tx.bricks(r), scale=(10.0, 14.0) if kind == "concrete" else (2.0, 1.2))
+        top = mat(kind)
+        scene.box((x0 + jx, y0 + jy, 0.0), (x1 + jx, y1 + jy, hh), [fac, fac, fac, fac, top, top])
+
+    # trees, hedges, lamps, racks, benches, bollards -- none within 1.5 m of the grid
+    r = stream(seed, "campus/trees")
+    bark_mat = mat("bark", tx.bark(r), scale=0.8)
+    leaf_mats = [mat("foliage", tx.foliage(r), scale=1.5) for _ in range(3)]
+
+    def free(x, y, margin):
+        return not (gx0 - margin < x < gx0 + 9 + margin and gy0 - margin < y < gy0 + 16 + margin)
+
+    placed = 0
+    while placed < 22:
+        x, y = r.uniform(-40, 50), r.uniform(-4, 60)
+        if not free(x, y, 3.0) or (-64 < x < -34 and -6 < y < 24) or (36 < x < 60 and 2 < y < 36):
+            continue
+        conifer = r.random() < 0.3
+        h = r.uniform(6, 14)
+        tree(scene, r, x=x, y=y, height=h, crown=r.uniform(1.8, 3.5) if not conifer else r.uniform(1.5, 2.5),
+             conifer=conifer, bark_mat=bark_mat, leaf_mat=leaf_mats[placed % 3])
+        placed += 1
+    hedge = mat("foliage", tx.foliage(r), scale=1.0)
+    scene.box((-6, 18.5, 0.0), (16, 19.5, 1.1), hedge)
+    scene.box((13.5, -3, 0.0), (14.3, 12, 0.9), hedge)
+    r = stream(seed, "campus/props")
+    metal = mat("metal", tx.value_noise(r, lo=0.4, hi=0.7), scale=0.5)
+    paint = mat("paint", tx.poster(r, n_shapes=10), fit=True)
+    for k in range(6):  # lamp posts along the path
+        lx_, ly_ = -2.5 if k % 2 == 0 else 11.5, -2.0 + 4.5 * k
+        scene.cylinder((lx_, ly_), 0.0, 4.5, 0.07, material=metal)
+        scene.box((lx_ - 0.3, ly_ - 0.12, 4.5), (lx_ + 0.3, ly_ + 0.12, 4.7), metal)
+    for k in range(8):  # bike rack
+        bx = 1.0 + 0.8 * k
+        scene.box((bx, -3.2, 0.0), (bx + 0.05, -2.4, 0.8), metal)
+    scene.box((0.8, -3.0, 0.7), (7.4, -2.95, 0.75), metal)
+    wood = mat("wood", tx.wood(r), scale=1.0)
+    for bx, by in ((-3.5, 6.0), (12.5, 9.0), (-3.5, 12.0)):
+        scene.box((bx - 0.25, by - 0.9, 0.42), (bx + 0.25, by + 0.9, 0.47), wood)
+        scene.box((bx - 0.25, by - 0.85, 0.0), (bx + 0.25, by - 0.8, 0.42), metal)
+        scene.box((bx - 0.25, by + 0.8, 0.0), (bx + 0.25, by + 0.85, 0.42), metal)
+    for k in range(5):  # bollards
+        scene.cylinder((-1.5 + 3.0 * k, 17.5), 0.0, 0.9, 0.1, material=metal)
+    scene.box((16.5, 2.0, 0.0), (16.6, 4.0, 2.2), paint)  # notice board
+    scene.box((16.5, 1.9, 0.0), (16.6, 2.0, 2.3), metal)
+    scene.box((16.5, 4.0, 0.0), (16.6, 4.1, 2.3), metal)
+    car = mat("paint", tx.value_noise(r, lo=0.3, hi=0.8), scale=1.5)
+    for k in range(4):  # parked cars along the road
+        cx = -12 + 6.5 * k + r.uniform(-0.5, 0.5)
+        scene.box((cx, 58.5, 0.3), (cx + 4.3, 60.3, 1.0), car)
+        scene.box((cx + 1.0, 58.6, 1.0), (cx + 3.2, 60.2, 1.45), glass)
+
+    scene.add_light(DirectionalLight(sun, tuple(np.broadcast_to(np.asarray(sun_irradiance, float), (c,)))))
+    up = np.broadcast_to(np.asarray(sky_irradiance, float), (c,))
+    scene.ambient = Ambient(up=tuple(up), down=tuple(0.4 * up))
+    scene.exposure = exposure
+    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
+                 camera_height=CAMERA_HEIGHT,
+                 info={"sun_elevation": float(sun_elevation), "sun_azimuth": float(sun_azimuth),
+                       "channels": channels})
