@@ -140,3 +140,44 @@ def test_thesis_presets_fit_the_typed_config(preset, cls):
     assert cfg.scales == pytest.approx([0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8])
     method = cls(cfg, geometry=PanoramaGeometry.square_pixels(692, 100))
     assert method.prepare(np.zeros((100, 692), np.float32))["snap"].shape == (9, 49, 346)
+
+
+# pairs in the world renderer's laboratory (bionav.world): snapshot at cell (3, 5), heading 0
+LAB_CASES = [((5, 8), 0.7), ((1, 3), -2.0), ((7, 4), 2.8), ((2, 9), -0.4)]
+
+
+@pytest.fixture(scope="module")
+def lab_views():
+    from bionav.world.render import render_panorama
+    from bionav.world.worlds.lab import build_lab
+
+    world = build_lab(0)
+    geometry = PanoramaGeometry.square_pixels(561, 81)  # sim_original's native size
+
+    def view(cell, heading):
+        img = render_panorama(world.scene, position=world.cell_position(*cell), heading=heading, geometry=geometry)
+        return img.mean(axis=2) if img.ndim == 3 else img
+
+    return geometry, view((3, 5), 0.0), [view(c, h) for c, h in LAB_CASES]
+
+
+@pytest.mark.parametrize(
+    "cls, max_home_deg, mean_home_deg, psi_tol_deg",
+    [
+        (MinWarping, 5.0, 3.0, 3.0),
+        (Warping2D, 5.0, 3.0, 3.0),
+        (Warping1D, 40.0, 20.0, 10.0),  # equal-distance assumption on a 1-D strip: the weakest
+        (HissHoming, 60.0, 25.0, None),
+    ],
+)
+def test_methods_home_in_the_rendered_lab(lab_views, cls, max_home_deg, mean_home_deg, psi_tol_deg):
+    geometry, snap, currents = lab_views
+    method = cls(cls.Config(), geometry=geometry)
+    s = method.prepare(snap)
+    errors = []
+    for ((cx, cy), heading), cur in zip(LAB_CASES, currents):
+        hv = method.home_vector(s, method.prepare(cur))
+        errors.append(np.degrees(angular_difference(hv.angle, np.arctan2(5 - cy, 3 - cx) - heading)))
+        if psi_tol_deg is not None:
+            assert np.degrees(angular_difference(hv.compass, heading)) < psi_tol_deg
+    assert max(errors) < max_home_deg and np.mean(errors) < mean_home_deg
