@@ -68,6 +68,10 @@ def register_configs() -> dict[str, list[str]]:
     """
     Plugins.instance().register(BionavSearchPathPlugin)
     store = ConfigStore.instance()
+    from bionav.db.config import DatabaseConfig
+
+    # every db preset is merged onto this schema: all db.* keys exist and are typed
+    store.store(name="db_schema", node=DatabaseConfig, provider="bionav")
     names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
     for kind in registry.GROUPS:
         with warnings.catch_warnings():

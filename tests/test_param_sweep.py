@@ -91,7 +91,7 @@ def test_sweep_levels_and_thesis_grid_size():
     for grid in ("full", "ci"):
         cfg.experiment.grid = grid
         params = OmegaConf.to_container(cfg.hydra.sweeper.params, resolve=True)
-        assert set(params) == {"signature", "db.image_size", "preprocess"}
+        assert set(params) == {"signature", "++db.image_size", "preprocess"}
         assert list(cfg.experiment.rings) == list(exp.grids[grid].rings)
 
 
@@ -164,3 +164,50 @@ def test_run_writes_rows_and_report_builds_ranking(small_db, tmp_path, monkeypat
     assert (tmp_path / "sweep" / "plots" / "ranking_scene.png").is_file()
     table = ranking.ranking_table(ranking.load_sweep_rows(tmp_path / "sweep"))
     assert table[0]["parameter"] == "[mffc_phase]" and table[0]["rr"] > 0.9
+
+
+def test_rotated_current_views_give_grid_frame_angles(small_db):
+    """Rotation-invariant signatures on a database of rotated views: the same grid-frame
+    home vectors as on the aligned database, for both gradient estimators; and per-pair calls
+    with neighbour offsets in the current view's frame agree."""
+    rng = np.random.default_rng(4)
+    rolls = rng.integers(0, GEOM.width, len(small_db))
+    headings = -2 * np.pi * rolls / GEOM.width
+    rotated = ImageDatabase(
+        name="rotated", images=np.stack([np.roll(im, m, axis=1) for im, m in zip(small_db.images, rolls)]),
+        positions=small_db.positions, grid_shape=small_db.grid_shape, geometry=GEOM, headings=headings,
+    )  # fmt: skip
+    for name, gradient in (("mffc_abs", "matched_filter"), ("fc_abs", "test_steps"), ("hist", "test_steps")):
+        homing = ParameterHoming(Config(signature=name, gradient=gradient, rings=3, bins=8), geometry=GEOM)
+        aligned = param_sweep.parameter_home_vector_matrix(homing, small_db, [homing.prepare(i) for i in small_db.images])
+        prep = [homing.prepare(i) for i in rotated.images]
+        turned = param_sweep.parameter_home_vector_matrix(homing, rotated, prep)
+        ok = np.isfinite(aligned.angles)
+        np.testing.assert_array_equal(ok, np.isfinite(turned.angles))
+        diff = np.abs(np.angle(np.exp(1j * (aligned.angles[ok] - turned.angles[ok]))))
+        assert diff.max() < 1e-6, (name, diff.max())
+        if gradient == "test_steps":
+            nb = param_sweep.neighbour_table(rotated)
+            s, c = 0, rotated.index_of(2, 2)
+            offsets = {}
+            for (dx, dy), j in zip(((1, 0), (-1, 0), (0, 1), (0, -1)), nb[c]):
+                if j >= 0:  # grid offset expressed in the current view's own frame
+                    h = headings[c]
+                    own = (dx * np.cos(h) + dy * np.sin(h), -dx * np.sin(h) + dy * np.cos(h))
+                    offsets[own] = prep[j]
+            hv = homing.home_vector(prep[s], prep[c], neighbours=offsets)
+            assert abs(np.angle(np.exp(1j * (hv.angle + headings[c] - turned.angles[s, c])))) < 1e-9
+
+
+def test_thesis_tables_attached_to_thesis_databases():
+    for db, table in ranking.THESIS_RANKINGS.items():
+        assert sorted(table) == sorted(SIGNATURE_NAMES), db
+        by_rank = sorted(table.values())
+        assert [r for r, _, _ in by_rank] == list(range(1, 20))
+        assert all(a[1] >= b[1] for a, b in zip(by_rank, by_rank[1:])), db  # ranked by RR*
+    rows = [_row("sim_original", "fc", 0.5, 0.9, k=4), _row("sim_original", "mean", 0.6, 0.8, rings=5)]
+    table = ranking.ranking_table(rows)
+    assert (table[1]["thesis_rank"], table[1]["thesis_rr"], table[1]["thesis_aae"]) == (2, 0.9460, 0.4437)
+    assert table[0]["thesis_rank"] == 10
+    assert "thesis_rr" in ranking.ranking_markdown(table, db="sim_original")
+    assert "thesis_rank" not in ranking.ranking_table([_row("scene", "fc", 0.5, 0.9, k=4)])[0]

@@ -69,6 +69,21 @@ def test_mffc_phase_with_all_coefficients_equals_mfdid_parseval():
         np.testing.assert_allclose(ph.mffc_phase_home_vector(*spec), GEOM.width * mfdid, rtol=1e-9)
 
 
+def test_mffc_phase_all_coefficients_matches_bionav_mfdid_on_the_horizon():
+    """bionav.homing.mfdid uses horizontal flow only; on horizon rows (elevation 0) the
+    equal-distance templates coincide with it, so [mffc_phase] with K = W points the same way."""
+    from bionav.homing.mfdid import mfdid_home_vector
+
+    geom = PanoramaGeometry(width=64, height=1, horizon_row=0.0, rad_per_row=2 * np.pi / 64)
+    homing = ParameterHoming(Config(gradient="matched_filter", n_coeffs=64), geometry=geom)
+    rng = np.random.default_rng(12)
+    for _ in range(5):
+        s, c = (smooth_random_image(rng, shape=(1, 64)) for _ in range(2))
+        ref = mfdid_home_vector(s, c, geometry=geom)
+        hv = homing.home_vector(homing.prepare(s), homing.prepare(c))
+        assert angular_difference(hv.angle, math.atan2(ref[1], ref[0])) < 1e-9
+
+
 def test_closed_forms_c9_c11_equal_plugin_path_and_finite_differences():
     rng = np.random.default_rng(5)
     s, c = smooth_random_image(rng), smooth_random_image(rng)
@@ -183,3 +198,36 @@ def test_config_handling_and_errors():
     prep = ts.prepare(rng.random((18, 72)))
     assert np.isnan(ts.home_vector(prep, prep).angle)  # no test steps available
     assert np.isnan(ts.home_vector(prep, prep, neighbours={(1, 0): prep}).angle)  # flat potential
+
+
+def test_duck_typed_third_party_signature():
+    """A plugin signature that only has Config, rotation_invariant and compute works with both gradients."""
+    from dataclasses import dataclass
+
+    class RowMeans:
+        @dataclass
+        class Config:
+            scale: float = 1.0
+
+        rotation_invariant = True
+
+        def __init__(self, config=None):
+            self.config = config or self.Config()
+
+        def compute(self, image, *, raw=None):
+            return self.config.scale * np.asarray(image, dtype=np.float64).mean(axis=1)
+
+    rng = np.random.default_rng(2)
+    s, c = smooth_random_image(rng), smooth_random_image(rng)
+    mf = ParameterHoming(Config(gradient="matched_filter"), geometry=GEOM, signature=RowMeans())
+    assert mf.signature_name == "RowMeans" and mf.gradient == "matched_filter"
+    assert ParameterHoming(Config(), geometry=GEOM, signature=RowMeans()).gradient == "test_steps"  # auto
+    assert not mf.requires_alignment
+    hv = mf.home_vector(mf.prepare(s), mf.prepare(c))
+    # row means are linear: the finite difference equals the row means of the flow derivatives
+    phi, psi = translation_derivatives(c, geometry=GEOM)
+    d = c.mean(axis=1) - s.mean(axis=1)
+    want = -np.array([d @ phi.mean(axis=1), d @ psi.mean(axis=1)])
+    assert angular_difference(hv.angle, math.atan2(want[1], want[0])) < 1e-6
+    ts = ParameterHoming(Config(gradient="test_steps"), geometry=GEOM, signature=RowMeans())
+    assert ts.uses_test_steps and np.isfinite(ts.home_vector(ts.prepare(s), ts.prepare(c), neighbours={(1, 0): ts.prepare(s)}).angle)

@@ -69,6 +69,11 @@ def test_histogram_and_entropy_hand_computed():
     # out-of-range values fall into the end bins; one-bin histograms have zero entropy
     np.testing.assert_allclose(histogram.ring_histogram(np.array([[-0.5, 1.0, 2.0, 0.3]]), bins=4), [[0.25, 0.25, 0, 0.5]])
     np.testing.assert_allclose(histogram.ring_entropy(np.full((2, 4), 0.7), bins=8), [0.0])
+    # the image's own range: [0.01, 0.03] split into two bins at 0.02
+    low = np.array([[0.01, 0.015, 0.02, 0.03]])
+    np.testing.assert_allclose(histogram.ring_histogram(low, bins=2, value_range=None), [[0.5, 0.5]])
+    np.testing.assert_allclose(histogram.ring_histogram(low, bins=2), [[1.0, 0.0]])
+    np.testing.assert_allclose(histogram.ring_histogram(np.full((1, 4), 0.3), bins=3, value_range=None), [[1, 0, 0]])
 
 
 def test_synthetic_mirror_cog_hand_computed():
@@ -144,6 +149,19 @@ def test_statistics_plugins_match_functions():
     np.testing.assert_allclose(make_signature("mean", r2).compute(TINY), [0.5, P])
     np.testing.assert_allclose(make_signature("std", r2).compute(TINY), [math.sqrt(0.125), math.sqrt(P * (1 - P))])
     np.testing.assert_allclose(make_signature("hist", r2).compute(TINY), [0.25, 0.75, 11 / 16, 5 / 16])
+    q = P * (1 - P)
+    np.testing.assert_allclose(make_signature("skew", r2).compute(TINY), [0.0, (1 - 2 * P) / math.sqrt(q)], atol=1e-12)
+    np.testing.assert_allclose(make_signature("kurt", r2).compute(TINY), [-1.0, (1 - 6 * q) / q])
+    np.testing.assert_allclose(
+        make_signature("ent", r2).compute(TINY),
+        [-(0.25 * math.log(0.25) + 0.75 * math.log(0.75)), -(11 / 16 * math.log(11 / 16) + P * math.log(P))],
+    )
+    unit = {"rings": 1, "bins": 2, "bin_range": "unit"}
+    np.testing.assert_allclose(make_signature("hist", unit).compute(0.1 * TINY), [1.0, 0.0])
+    np.testing.assert_allclose(make_signature("hist", {**unit, "bin_range": "image"}).compute(0.1 * TINY),
+                               [(4 + 11) / 32, (12 + 5) / 32])  # fmt: skip
+    with pytest.raises(UserError, match="bin_range"):
+        make_signature("ent", {"bin_range": "bogus"}).compute(TINY)
     np.testing.assert_allclose(make_signature("image").compute(TINY), TINY.ravel())
     img = np.zeros((2, 4))
     img[0, 0] = img[1, 2] = 1.0

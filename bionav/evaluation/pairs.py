@@ -131,12 +131,15 @@ def home_vector_matrix(
     lut = currents.cell_index_map()
     nx, ny = currents.grid_shape
 
-    def neighbours_of(ci: int) -> dict[tuple[int, int], Any]:
+    def neighbours_of(ci: int) -> dict[tuple[float, float], Any]:
+        """Prepared grid neighbours keyed by their offset in the current view's frame."""
         x, y = currents.positions[ci]
+        c, s = np.cos(currents.headings[ci]), np.sin(currents.headings[ci])
         out = {}
         for dx, dy in NEIGHBOUR_OFFSETS:
             if 0 <= x + dx < nx and 0 <= y + dy < ny and lut[x + dx, y + dy] >= 0:
-                out[(dx, dy)] = cur_prep[lut[x + dx, y + dy]]
+                key = (dx, dy) if s == 0 and c == 1 else (round(c * dx + s * dy, 12), round(-s * dx + c * dy, 12))
+                out[key] = cur_prep[lut[x + dx, y + dy]]
         return out
 
     def row(si: int) -> tuple[np.ndarray, np.ndarray]:

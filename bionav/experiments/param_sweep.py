@@ -96,11 +96,15 @@ def neighbour_table(db: ImageDatabase) -> np.ndarray:
 def parameter_home_vector_matrix(homing, db: ImageDatabase, prepared: Sequence[dict]) -> HomeVectorMatrix:
     """Home vectors of all pairs of a database for a :class:`ParameterHoming` (vectorised).
 
-    The same angles as the all-pairs runner
-    (:func:`bionav.evaluation.pairs.home_vector_matrix`) calling
-    ``homing.home_vector`` pair by pair -- grid-frame angles (own angle plus the
-    current view's heading), NaN on the snapshot's own cell and where the
-    gradient vanishes -- computed with matrix operations on the prepared signatures.
+    The same angles as calling ``homing.home_vector`` pair by pair (as
+    :func:`bionav.evaluation.pairs.home_vector_matrix` does) -- grid-frame
+    angles, NaN on the snapshot's own cell and where the gradient vanishes --
+    computed with matrix operations on the prepared signatures. The test steps
+    are the four grid neighbours, so their gradient is in the grid frame; the
+    matched filter's gradient is in the current view's frame and is turned by
+    the current view's heading. (For rotated current views this equals the
+    per-pair call with the neighbour offsets expressed in the current view's
+    frame, as :meth:`HomingMethod.home_vector` specifies.)
 
     Parameters
     ----------
@@ -130,7 +134,11 @@ def parameter_home_vector_matrix(homing, db: ImageDatabase, prepared: Sequence[d
         angles = np.arctan2(hy, hx)
     angles[(hx == 0) & (hy == 0)] = np.nan
     angles[~(np.isfinite(hx) & np.isfinite(hy))] = np.nan
-    angles = wrap_angle(angles + db.headings[None, :])
+    if homing.gradient != "test_steps":
+        # flow templates live in the current view's own frame; test steps are taken along the
+        # grid axes, so their gradient is already in the grid frame
+        angles = angles + db.headings[None, :]
+    angles = wrap_angle(angles)
     same = np.all(db.positions[:, None, :] == db.positions[None, :, :], axis=2)
     angles[same] = np.nan
     return HomeVectorMatrix(
@@ -159,7 +167,7 @@ def evaluate_configuration(homing, db: ImageDatabase, *, step_length: float = 0.
     from bionav.experiments.grid_homing import evaluate_agents
 
     t0 = time.perf_counter()
-    use_raw = db.raw is not None and homing.signature.uses_raw
+    use_raw = db.raw is not None and getattr(homing.signature, "uses_raw", False)
     prepared = [homing.prepare(img, raw=db.raw(i) if use_raw else None) for i, img in enumerate(db.images)]
     prepare_s = time.perf_counter() - t0
     hv = parameter_home_vector_matrix(homing, db, prepared)
@@ -182,15 +190,17 @@ def _signature_setup(cfg: DictConfig, ctx):
     _, homing_cfg = plugin_config("homing", cfg.homing)
     if cfg.get("signature"):
         sig_cls, sig_cfg = plugin_config("signature", cfg.signature)
+        sig_name = str(cfg.signature.name)
     else:
         sig_cls = signature_class(homing_cfg.signature)
         sig_cfg = sig_cls.Config()
+        sig_name = str(homing_cfg.signature)
     # homing.rings/n_coeffs/bins pass through to the signature's base config; the sweep varies R or K on top
     names = {f.name for f in dataclasses.fields(sig_cfg)}
     passed = {k: getattr(homing_cfg, k) for k in ("rings", "n_coeffs", "bins") if getattr(homing_cfg, k) is not None}
     sig_cfg = dataclasses.replace(sig_cfg, **{k: v for k, v in passed.items() if k in names})
-    homing_cfg = dataclasses.replace(homing_cfg, signature=sig_cls.name, rings=None, n_coeffs=None, bins=None)
-    return ParameterHoming, homing_cfg, sig_cls, sig_cfg
+    homing_cfg = dataclasses.replace(homing_cfg, signature=sig_name, rings=None, n_coeffs=None, bins=None)
+    return ParameterHoming, homing_cfg, sig_name, sig_cls, sig_cfg
 
 
 def _finite(x: float) -> float | None:
@@ -201,13 +211,13 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.common import load_configured_database
 
     exp = cfg.experiment
-    homing_cls, homing_cfg, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
+    homing_cls, homing_cfg, sig_name, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
     db = load_configured_database(cfg)
     levels = sweep_levels(sig_cls, rings=list(exp.rings), n_coeffs=list(exp.n_coeffs))
     preprocess = str(OmegaConf.select(cfg, "preprocess.name", default="none"))
     size = f"{db.geometry.width}x{db.geometry.height}"
     rows: list[dict[str, Any]] = []
-    for level in ctx.progress(levels, desc=f"{sig_cls.name} configurations", total=len(levels)):
+    for level in ctx.progress(levels, desc=f"{sig_name} configurations", total=len(levels)):
         sig = sig_cls(dataclasses.replace(sig_cfg, **level))
         homing = homing_cls(homing_cfg, geometry=db.geometry, signature=sig)
         q, hv = evaluate_configuration(
@@ -215,14 +225,14 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         )
         row = {
             "db": db.name,
-            "signature": sig.name,
+            "signature": sig_name,
             "rings": getattr(sig.config, "rings", None),
             "n_coeffs": getattr(sig.config, "n_coeffs", None),
             "bins": getattr(sig.config, "bins", None),
             "image_size": size,
             "preprocess": preprocess,
             "gradient": homing.gradient,
-            "rotation_invariant": bool(sig.rotation_invariant),
+            "rotation_invariant": bool(getattr(sig, "rotation_invariant", False)),
             "rr": float(q.rr),
             "aae": float(q.aae),
             "mae": float(q.mae),
@@ -239,12 +249,12 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     with open(ctx.dir / ROWS_FILE, "w") as f:
         for row in rows:
             f.write(json.dumps(row) + "\n")
-    _plot_levels(ctx.plots / "levels.png", rows, title=f"[{sig_cls.name}] on {db.name}, {size}, {preprocess}")
+    _plot_levels(ctx.plots / "levels.png", rows, title=f"[{sig_name}] on {db.name}, {size}, {preprocess}")
 
     best = max(rows, key=lambda r: (r["rr"], -r["aae"]))
     metrics: dict[str, Any] = {
         "db": db.name,
-        "signature": sig_cls.name,
+        "signature": sig_name,
         "gradient": best["gradient"],
         "rotation_invariant": best["rotation_invariant"],
         "image_size": size,

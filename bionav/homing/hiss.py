@@ -71,7 +71,7 @@ def sift_features(
     dict of ndarray
         ``x`` (N,) float32: column of each keypoint (azimuth ``2 pi x / W``
         CCW); ``y`` (N,) float32: row; ``size`` (N,) float32: keypoint diameter
-        in pixels; ``desc`` (N, 128) float32; ``width`` () int64: ``W``.
+        in pixels; ``desc`` (N, 128) float32; ``width`` 0-d int64 array: ``W``.
     """
     import cv2
 
@@ -97,7 +97,7 @@ def sift_features(
             "y": np.zeros(0, np.float32),
             "size": np.zeros(0, np.float32),
             "desc": np.zeros((0, 128), np.float32),
-            "width": np.int64(width),
+            "width": np.array(width, dtype=np.int64),
         }
     pts = np.array([kp.pt for kp in keypoints], dtype=np.float32).reshape(-1, 2)
     size = np.array([kp.size for kp in keypoints], dtype=np.float32)
@@ -108,7 +108,7 @@ def sift_features(
         "y": np.ascontiguousarray(pts[keep, 1], dtype=np.float32),
         "size": np.ascontiguousarray(size[keep]),
         "desc": np.ascontiguousarray(desc[keep], dtype=np.float32),
-        "width": np.int64(width),
+        "width": np.array(width, dtype=np.int64),
     }
 
 

@@ -22,6 +22,11 @@ class SweepSummary(Callback):
         if not sweep_dir.is_dir():
             return
         csv_path, md_path, rows = write_summary(sweep_dir)
+        from bionav.report.sections import extra_sections
+
+        sections = extra_sections(sweep_dir, rows)  # comparisons, parameter-homing rankings
+        if sections:
+            md_path.write_text(md_path.read_text() + "\n" + "\n\n".join(sections) + "\n")
         failed = [r["job"] for r in rows if r.get("status") != "completed"]
         log.info("summary of %d jobs written to %s and %s", len(rows), csv_path, md_path)
         if failed:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any, Iterable, Mapping, Sequence
 
 from bionav.report.table import markdown_table
@@ -26,6 +27,49 @@ ROWS_FILE = "param_sweep.jsonl"
 RANKING_COLUMNS = (
     "rank", "parameter", "rr", "aae", "rings", "n_coeffs", "image_size", "preprocess", "rot_invariant",
 )  # fmt: skip
+#: extra columns when the database is one of the thesis' (or its ``sim_`` stand-in)
+THESIS_COLUMNS = ("thesis_rank", "thesis_rr", "thesis_aae")
+
+#: thesis tables 5.5-5.7 (after Fischer 2006): signature -> (rank, RR*, AAE*) per database
+THESIS_RANKINGS: Mapping[str, Mapping[str, tuple[int, float, float]]] = MappingProxyType(
+    {
+        db: MappingProxyType({name: (i + 1, rr, aae) for i, (name, rr, aae) in enumerate(table)})
+        for db, table in {
+            "original": (
+                ("image", 0.9483, 0.4626), ("fc", 0.9460, 0.4437), ("mffc_phase", 0.9120, 0.4403),
+                ("mean_fft", 0.8405, 0.5966), ("cog", 0.8195, 0.6935), ("std_fft", 0.8108, 0.6497),
+                ("mffc_abs", 0.7748, 0.7763), ("cog_fft", 0.7473, 0.7650), ("fc_abs", 0.6611, 0.8033),
+                ("mean", 0.5411, 0.8343), ("std_fft_abs", 0.5161, 0.9967), ("hist", 0.5102, 0.9740),
+                ("std", 0.4574, 0.9970), ("cog_fft_abs", 0.4201, 1.2405), ("cog_l", 0.4131, 1.1323),
+                ("mean_fft_abs", 0.4062, 1.1046), ("skew", 0.3565, 1.2477), ("kurt", 0.3197, 1.0319),
+                ("ent", 0.2994, 1.3158),
+            ),
+            "hall1": (
+                ("mffc_phase", 0.9988, 0.2420), ("mffc_abs", 0.8793, 0.4956), ("fc", 0.8367, 0.5468),
+                ("image", 0.7880, 0.6446), ("cog", 0.6792, 0.7060), ("std_fft", 0.6216, 0.8101),
+                ("mean_fft", 0.6075, 0.7862), ("cog_fft", 0.5857, 0.8938), ("fc_abs", 0.5511, 0.7890),
+                ("hist", 0.4347, 1.0096), ("mean_fft_abs", 0.4271, 0.8894), ("std_fft_abs", 0.4157, 0.9723),
+                ("mean", 0.3850, 1.0238), ("std", 0.3695, 1.0255), ("cog_l", 0.3592, 1.3129),
+                ("skew", 0.2936, 1.2260), ("cog_fft_abs", 0.2902, 1.3268), ("ent", 0.2689, 1.1081),
+                ("kurt", 0.2598, 1.2821),
+            ),
+            "uni": (
+                ("mffc_phase", 0.7989, 0.5143), ("mffc_abs", 0.4852, 0.8952), ("fc", 0.4381, 0.8564),
+                ("image", 0.4251, 0.8538), ("mean_fft", 0.3474, 1.0714), ("fc_abs", 0.3370, 1.1633),
+                ("std_fft", 0.2858, 1.1519), ("cog_fft", 0.2508, 1.3073), ("cog", 0.2448, 1.0606),
+                ("mean_fft_abs", 0.2222, 1.2833), ("kurt", 0.2141, 1.2318), ("std", 0.2040, 1.2167),
+                ("mean", 0.1953, 1.1981), ("std_fft_abs", 0.1843, 1.3328), ("skew", 0.1763, 1.2603),
+                ("hist", 0.1750, 1.2461), ("ent", 0.1704, 1.2485), ("cog_l", 0.1684, 1.2235),
+                ("cog_fft_abs", 0.1664, 1.3743),
+            ),
+        }.items()
+    }
+)  # fmt: skip
+
+
+def thesis_ranking(db: str) -> Mapping[str, tuple[int, float, float]] | None:
+    """The thesis' ranking (tables 5.5-5.7) for ``db`` or its ``sim_`` stand-in, else ``None``."""
+    return THESIS_RANKINGS.get(db.removeprefix("sim_"))
 
 
 def load_sweep_rows(root: Path) -> list[dict[str, Any]]:
@@ -86,13 +130,16 @@ def ranking_table(rows: Iterable[Mapping[str, Any]], *, db: str | None = None) -
         One row per signature with :data:`RANKING_COLUMNS`: ``rank`` (1 = best),
         ``parameter`` (``[name]``), ``rr`` (RR*), ``aae`` (AAE*, radians),
         ``rings`` / ``n_coeffs`` (``-`` when not a parameter of the signature),
-        ``image_size`` (``WxH``), ``preprocess``, ``rot_invariant`` (``y``/``n``).
+        ``image_size`` (``WxH``), ``preprocess``, ``rot_invariant`` (``y``/``n``);
+        plus :data:`THESIS_COLUMNS` (the thesis' rank, RR*, AAE* of the same
+        signature) when ``db`` is a thesis database or its ``sim_`` stand-in.
     """
     ranked = best_configurations(rows)
     if db is None:
         if len(ranked) > 1:
             raise ValueError(f"rows hold several databases ({', '.join(ranked)}); pass db=")
         db = next(iter(ranked), None)
+    thesis = thesis_ranking(str(db)) if db is not None else None
     out = []
     for i, row in enumerate(ranked.get(db, []), start=1):
         out.append(
@@ -108,13 +155,20 @@ def ranking_table(rows: Iterable[Mapping[str, Any]], *, db: str | None = None) -
                 "rot_invariant": "y" if row.get("rotation_invariant") else "n",
             }
         )
+        if thesis is not None:
+            rank, rr, aae = thesis.get(str(row["signature"]), ("-", "-", "-"))
+            out[-1].update({"thesis_rank": rank, "thesis_rr": rr, "thesis_aae": aae})
     return out
 
 
 def ranking_markdown(table: Sequence[Mapping[str, Any]], *, db: str) -> str:
     """A ranking table as a Markdown section (heading, table)."""
-    head = f"## Parameter homing ranking: {db}\n\nBest configuration per signature by RR* (AAE* in radians).\n"
-    return head + "\n" + markdown_table(table, RANKING_COLUMNS)
+    head = f"## Parameter homing ranking: {db}\n\nBest configuration per signature by RR* (AAE* in radians)"
+    columns = list(RANKING_COLUMNS)
+    if table and "thesis_rank" in table[0]:
+        columns += THESIS_COLUMNS
+        head += f"; thesis_*: the thesis' table for {db.removeprefix('sim_')} (tables 5.5-5.7)"
+    return head + ".\n\n" + markdown_table(table, columns)
 
 
 def plot_per_snapshot(path: Path, ranked: Sequence[Mapping[str, Any]], *, db: str, top: int = 8) -> None:
@@ -186,7 +240,7 @@ def write_parameter_report(root: Path, *, top: int = 8) -> list[str]:
     for db, ranked in best_configurations(rows).items():
         table = ranking_table(rows, db=db)
         with open(root / f"ranking_{db}.csv", "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=list(RANKING_COLUMNS))
+            writer = csv.DictWriter(f, fieldnames=list(table[0]) if table else list(RANKING_COLUMNS))
             writer.writeheader()
             writer.writerows(table)
         text = ranking_markdown(table, db=db)

@@ -112,3 +112,15 @@ class Signature:
         img = np.asarray(image, dtype=np.float64)
         d = np.asarray(direction, dtype=np.float64)
         return (self.compute(img + step * d) - self.compute(img - step * d)) / (2.0 * step)
+
+
+def signature_derivative(signature: Any, image: np.ndarray, direction: np.ndarray, *, step: float = 0.05) -> np.ndarray:
+    """``signature.derivative`` when it has one, else the central difference on predicted images.
+
+    Lets third-party signatures that only implement ``compute`` (duck-typed, not
+    subclasses of :class:`Signature`) take part in the matched filter.
+    """
+    method = getattr(signature, "derivative", None)
+    if method is not None:
+        return method(image, direction, step=step)
+    return Signature.derivative(signature, image, direction, step=step)

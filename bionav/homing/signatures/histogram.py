@@ -4,10 +4,14 @@ Both are rotation invariant (a column roll does not change a ring's pixel values
 
 Choices the thesis leaves open (documented here):
 
-* Bins: ``B`` equal bins over the fixed intensity range ``[0, 1]`` (bionav's
-  image range), so that histograms of different images share their bins; bin
-  ``b`` holds ``b / B <= I < (b + 1) / B``, the last bin includes 1, and values
-  outside ``[0, 1]`` (possible after edge filtering) fall into the end bins.
+* Bins: ``B`` equal bins over an intensity range ``[lo, hi]``: bin ``b`` holds
+  ``lo + b (hi - lo) / B <= I < lo + (b + 1) (hi - lo) / B``, the last bin
+  includes ``hi``, values outside fall into the end bins. The range is either
+  fixed (``value_range=(0, 1)``, bionav's image range, so all images share
+  their bins) or each image's own ``[min, max]`` (``value_range=None``). The
+  latter keeps the histogram informative after preprocessing that compresses
+  the range (an edge-filtered, low-passed panorama may lie entirely in
+  ``[0, 0.02]``); a constant image puts every pixel into bin 0.
 * [hist] holds *relative* frequencies (counts divided by the ring's pixel
   count) instead of the raw counts of eq. 3.53, so that rings of unequal row
   counts (``H`` not a multiple of ``R``) and different image sizes weigh alike.
@@ -24,7 +28,9 @@ import numpy as np
 from bionav.homing.signatures.rings import ring_edges, ring_index
 
 
-def ring_histogram(image: np.ndarray, *, rings: int = 1, bins: int = 16) -> np.ndarray:
+def ring_histogram(
+    image: np.ndarray, *, rings: int = 1, bins: int = 16, value_range: tuple[float, float] | None = (0.0, 1.0)
+) -> np.ndarray:
     """Relative intensity histogram of each ring, [hist].
 
     Parameters
@@ -34,7 +40,9 @@ def ring_histogram(image: np.ndarray, *, rings: int = 1, bins: int = 16) -> np.n
     rings : int
         Number of rings ``R``.
     bins : int
-        Number of bins ``B`` over ``[0, 1]``.
+        Number of bins ``B``.
+    value_range : (float, float) or None
+        Intensity range ``(lo, hi)`` the bins span; ``None`` = the image's own ``(min, max)``.
 
     Returns
     -------
@@ -48,13 +56,19 @@ def ring_histogram(image: np.ndarray, *, rings: int = 1, bins: int = 16) -> np.n
     if bins < 1:
         raise ValueError(f"bins must be >= 1, got {bins}")
     h, w = img.shape
-    b = np.clip(np.floor(img * bins), 0, bins - 1).astype(np.int64)
+    lo, hi = (float(img.min()), float(img.max())) if value_range is None else map(float, value_range)
+    if not hi >= lo:
+        raise ValueError(f"value_range must have lo <= hi, got {value_range}")
+    scale = bins / (hi - lo) if hi > lo else 0.0
+    b = np.clip(np.floor((img - lo) * scale), 0, bins - 1).astype(np.int64)
     ring = np.broadcast_to(ring_index(h, rings)[:, None], (h, w))
     counts = np.bincount((ring * bins + b).ravel(), minlength=rings * bins).reshape(rings, bins)
     return counts / (np.diff(ring_edges(h, rings)) * w)[:, None]
 
 
-def ring_entropy(image: np.ndarray, *, rings: int = 1, bins: int = 16) -> np.ndarray:
+def ring_entropy(
+    image: np.ndarray, *, rings: int = 1, bins: int = 16, value_range: tuple[float, float] | None = (0.0, 1.0)
+) -> np.ndarray:
     """Shannon entropy (nats) of each ring's intensity histogram, [ent].
 
     Parameters
@@ -62,6 +76,8 @@ def ring_entropy(image: np.ndarray, *, rings: int = 1, bins: int = 16) -> np.nda
     image : ndarray, shape (H, W)
     rings : int
     bins : int
+    value_range : (float, float) or None
+        As in :func:`ring_histogram`.
 
     Returns
     -------
@@ -69,6 +85,6 @@ def ring_entropy(image: np.ndarray, *, rings: int = 1, bins: int = 16) -> np.nda
         ``-sum_b p_b ln p_b`` with ``p`` from :func:`ring_histogram`; between 0
         (one bin) and ``ln B`` (uniform).
     """
-    p = ring_histogram(image, rings=rings, bins=bins)
+    p = ring_histogram(image, rings=rings, bins=bins, value_range=value_range)
     logp = np.log(p, out=np.zeros_like(p), where=p > 0)
     return -(p * logp).sum(axis=1)

@@ -23,7 +23,12 @@ def _ring_moments(image: np.ndarray, rings: int, order: int):
     if order == 1:
         return mean, None, None
     dev = img - mean[ring_index(h, rings)][:, None]
-    central = [np.add.reduceat((dev**p).sum(axis=1), edges[:-1]) / counts for p in range(2, order + 1)]
+    powers = [dev * dev]
+    if order >= 3:
+        powers.append(powers[0] * dev)
+    if order >= 4:
+        powers.append(powers[0] * powers[0])
+    central = [np.add.reduceat(pw.sum(axis=1), edges[:-1]) / counts for pw in powers]
     return mean, np.sqrt(central[0]), central
 
 

@@ -16,6 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from bionav.homing.warping.kernels import PARALLEL_LOCK
+
 
 def column_distance_matrix(snapshot, current):
     """Reference column distances, plain numpy.
@@ -104,12 +106,13 @@ def diagonal_distances(snapshot, current, *, step: int = 1):
         raise ValueError(f"width {width} is not a multiple of the alpha step {step}")
     out = np.empty((n_planes, width, step, 2 * (width // step)), dtype=np.float32)
     cur_norm = np.asarray(current["cur_norm"], dtype=np.float32)
-    _diagonal_distances(
-        snap,
-        np.concatenate([cur, cur], axis=2),
-        np.ascontiguousarray(snapshot["snap_norm"], dtype=np.float32),
-        np.concatenate([cur_norm, cur_norm], axis=1),
-        int(step),
-        out,
-    )
+    with PARALLEL_LOCK:
+        _diagonal_distances(
+            snap,
+            np.concatenate([cur, cur], axis=2),
+            np.ascontiguousarray(snapshot["snap_norm"], dtype=np.float32),
+            np.concatenate([cur_norm, cur_norm], axis=1),
+            int(step),
+            out,
+        )
     return out

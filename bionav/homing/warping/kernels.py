@@ -17,8 +17,17 @@ alpha. The plain, loop-by-loop equivalents are in
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from numba import njit, prange
+
+#: Serialises launches of the parallel kernels. Callers on several Python
+#: threads (the grid runner's workers) would otherwise start one team of
+#: numba threads each, which oversubscribes the cores and aborts with numba's
+#: ``workqueue`` threading layer (the only one available where neither OpenMP
+#: nor TBB is installed). The kernels themselves use every core.
+PARALLEL_LOCK = threading.Lock()
 
 
 @njit(parallel=True, fastmath=True, cache=True)

@@ -29,6 +29,7 @@ from numba import get_num_threads
 from bionav.geometry import wrap_angle
 from bionav.homing.warping.distance import diagonal_distances
 from bionav.homing.warping.kernels import (
+    PARALLEL_LOCK,
     compass_measure,
     minwarp_scores,
     minwarp_scores_at,
@@ -147,7 +148,8 @@ def minwarping_scores(snapshot, current, *, n_alpha=96, n_psi=96, thresholds=Non
     step = _layout_step(width, n_alpha, p_cols, False)
     dist = diagonal_distances(snapshot, current, step=step)
     tmpl = minwarp_template(width, scales, tau)
-    scores = minwarp_scores(dist, width // step, p_cols, *tmpl, get_num_threads())
+    with PARALLEL_LOCK:
+        scores = minwarp_scores(dist, width // step, p_cols, *tmpl, get_num_threads())
     return a_cols, p_cols, scores[:, a_cols // step]
 
 
@@ -219,11 +221,13 @@ def minwarping(
     tmpl = minwarp_template(width, scales, tau) if template is None else template
     dist = diagonal_distances(snapshot, current, step=step)
     p_cols = _select_psi(dist, p_all, compass_fraction)
-    scores = minwarp_scores(dist, n_a_eff, p_cols, *tmpl, get_num_threads()).astype(np.float64)
+    with PARALLEL_LOCK:
+        scores = minwarp_scores(dist, n_a_eff, p_cols, *tmpl, get_num_threads()).astype(np.float64)
     dist2 = None
     if double_search:
         dist2 = diagonal_distances(current, snapshot, step=step)
-        scores2 = minwarp_scores(dist2, n_a_eff, (-p_cols) % width, *tmpl, get_num_threads())
+        with PARALLEL_LOCK:
+            scores2 = minwarp_scores(dist2, n_a_eff, (-p_cols) % width, *tmpl, get_num_threads())
         # hypothesis (a, p) of the pair corresponds to (a + W/2 - p, -p) of the swapped pair
         a_eff = np.arange(n_a_eff) * step
         idx = ((a_eff[None, :] + width // 2 - p_cols[:, None]) % width) // step
@@ -298,7 +302,8 @@ def warping2d_scores(
     rhos = rho_grid(n_rho, rho_max)
     v_tab, k_tab = warp2d_template(width, rhos, tau)
     dist = diagonal_distances(snapshot, current, step=step)
-    scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)
+    with PARALLEL_LOCK:
+        scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)
     return a_cols, p_cols, rhos, scores[:, :, a_cols // step]
 
 
@@ -359,7 +364,8 @@ def warping2d(
     v_tab, k_tab = warp2d_template(width, rhos, tau) if template is None else template
     dist = diagonal_distances(snapshot, current, step=step)
     p_cols = _select_psi(dist, p_all, compass_fraction)
-    scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)[:, :, a_cols // step]
+    with PARALLEL_LOCK:
+        scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)[:, :, a_cols // step]
     il, ip, ia = np.unravel_index(int(np.argmin(scores)), scores.shape)
     best_a, best_p, best = int(a_cols[ia]), int(p_cols[ip]), float(scores[il, ip, ia])
     if fine_search:

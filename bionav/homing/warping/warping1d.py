@@ -18,12 +18,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from bionav.homing.warping.kernels import PARALLEL_LOCK
 from bionav.homing.warping.search import WarpingResult, rho_grid
 from bionav.geometry import wrap_angle
 
 
 @njit(parallel=True, fastmath=True, cache=True)
-def _warp1d_scores(snap, cur, alphas, psis, rhos):
+def _warp1d_scores(snap, cur4, alphas, psis, rhos):
+    """``cur4`` is the current strip tiled four times plus one sample (no wrap needed)."""
     width = snap.shape[0]
     n_a, n_r, n_p = alphas.shape[0], rhos.shape[0], psis.shape[0]
     out = np.empty((n_a, n_r, n_p))
@@ -36,21 +38,16 @@ def _warp1d_scores(snap, cur, alphas, psis, rhos):
         pos = np.empty(width)
         for i in range(width):
             theta = 2.0 * np.pi * i / width - alpha
-            pos[i] = (np.arctan2(np.sin(theta), np.cos(theta) - rho) + alpha) * scale
+            # in (-W/2, 3W/2) columns; shifted by 2W so that it stays positive below
+            pos[i] = (np.arctan2(np.sin(theta), np.cos(theta) - rho) + alpha) * scale + 2.0 * width
         for ip in range(n_p):
-            shift = psis[ip] * scale
+            shift = (psis[ip] * scale) % width
             total = 0.0
             for i in range(width):
                 x = pos[i] - shift
-                x = x - np.floor(x / width) * width
-                j0 = int(np.floor(x))
+                j0 = int(x)
                 f = x - j0
-                if j0 >= width:
-                    j0 -= width
-                j1 = j0 + 1
-                if j1 >= width:
-                    j1 -= width
-                diff = snap[i] - ((1.0 - f) * cur[j0] + f * cur[j1])
+                diff = snap[i] - (cur4[j0] + f * (cur4[j0 + 1] - cur4[j0]))
                 total += diff * diff
             out[ia, il, ip] = total
     return out
@@ -76,13 +73,14 @@ def warping1d_scores(snapshot, current, *, alphas, psis, rhos):
     c = np.ascontiguousarray(current, dtype=np.float64)
     if s.ndim != 1 or s.shape != c.shape:
         raise ValueError(f"need two horizon strips of equal length, got shapes {s.shape} and {c.shape}")
-    return _warp1d_scores(
-        s,
-        c,
-        np.asarray(alphas, dtype=np.float64),
-        np.asarray(psis, dtype=np.float64),
-        np.asarray(rhos, dtype=np.float64),
-    )
+    with PARALLEL_LOCK:
+        return _warp1d_scores(
+            s,
+            np.concatenate([c, c, c, c, c[:1]]),
+            np.asarray(alphas, dtype=np.float64),
+            np.asarray(psis, dtype=np.float64),
+            np.asarray(rhos, dtype=np.float64),
+        )
 
 
 def warping1d(

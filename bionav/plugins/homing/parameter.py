@@ -67,7 +67,9 @@ class ParameterHoming(HomingMethod):
         Geometry of the images passed to :meth:`prepare` (the matched filter's
         flow templates need azimuth and elevation of every pixel).
     signature : Signature or mapping, optional
-        A signature instance (e.g. built from the ``signature=`` config group);
+        A signature instance (e.g. built from the ``signature=`` config group;
+        anything with ``compute(image, *, raw=None)``, ``rotation_invariant``
+        and a ``config`` dataclass);
         or a mapping of parameters for the signature named by ``config.signature``;
         or ``None`` for that signature with its defaults. The signature class is
         resolved by :func:`bionav.plugins.signatures.signature_class`.
@@ -92,7 +94,7 @@ class ParameterHoming(HomingMethod):
     uses_test_steps = True
 
     def __init__(self, config: Any = None, *, geometry: PanoramaGeometry, signature: Any = None) -> None:
-        from bionav.homing.signatures.base import Signature, coerce_config
+        from bionav.homing.signatures.base import coerce_config
         from bionav.plugins.signatures import signature_class
 
         config = coerce_config(Config, config)
@@ -102,7 +104,7 @@ class ParameterHoming(HomingMethod):
                 f"homing.gradient={config.gradient!r} is not a gradient estimator of homing=parameter. "
                 f"Choose one of: {', '.join(GRADIENTS)}."
             )
-        if not isinstance(signature, Signature):
+        if not hasattr(signature, "compute"):  # a mapping of parameters, or None
             signature = signature_class(config.signature)(signature)
         names = {f.name for f in dataclasses.fields(signature.config)}
         overrides = {
@@ -113,12 +115,13 @@ class ParameterHoming(HomingMethod):
         if not config.mf_step > 0:
             raise UserError(f"homing.mf_step={config.mf_step} must be positive; the default is 0.05.")
         self.signature = signature
+        self.signature_name = str(getattr(signature, "name", "") or type(signature).__name__)
         gradient = config.gradient
         if gradient == "auto":
-            gradient = "matched_filter" if signature.name.startswith("mffc") else "test_steps"
+            gradient = "matched_filter" if self.signature_name.startswith("mffc") else "test_steps"
         self.gradient = gradient
         self.uses_test_steps = gradient == "test_steps"
-        self.requires_alignment = not signature.rotation_invariant
+        self.requires_alignment = not bool(getattr(signature, "rotation_invariant", False))
 
     def prepare(self, image: np.ndarray, *, raw: Any = None) -> dict[str, np.ndarray]:
         """Signature of one image (and, for the matched filter, its derivatives).
@@ -142,6 +145,7 @@ class ParameterHoming(HomingMethod):
         if self.gradient == "test_steps":
             return {"f": self.signature.compute(img, raw=raw)}
         from bionav.homing.flow_templates import translation_derivatives
+        from bionav.homing.signatures.base import signature_derivative
 
         geometry = self.geometry
         if (geometry.height, geometry.width) != img.shape:
@@ -150,8 +154,8 @@ class ParameterHoming(HomingMethod):
         step = self.config.mf_step
         return {
             "f": self.signature.compute(img),
-            "df_dx": self.signature.derivative(img, phi, step=step),
-            "df_dy": self.signature.derivative(img, psi, step=step),
+            "df_dx": signature_derivative(self.signature, img, phi, step=step),
+            "df_dy": signature_derivative(self.signature, img, psi, step=step),
         }
 
     def home_vector(

@@ -1,8 +1,9 @@
 """Histogram signatures [hist] and [ent] (thesis 3.5.2, eqs. 3.53-3.54).
 
-Both rotation invariant. Bins are fixed over ``[0, 1]``; [hist] holds relative
-frequencies and [ent] the Shannon entropy of them (see
-:mod:`bionav.homing.signatures.histogram` for these documented choices).
+Both rotation invariant. [hist] holds relative frequencies and [ent] the
+Shannon entropy of them; the bins span the fixed range ``[0, 1]`` by default,
+or each image's own range (see :mod:`bionav.homing.signatures.histogram` for
+these documented choices).
 """
 
 from __future__ import annotations
@@ -19,12 +20,28 @@ class HistogramConfig:
     """Parameters of the histogram signatures.
 
     rings : number of rings ``R`` (thesis sweep: 1, 5, 10, 15, 20, 25).
-    bins : number of histogram bins ``B`` over the intensity range ``[0, 1]``
-        (the thesis does not state ``B``; 16 is bionav's choice).
+    bins : number of histogram bins ``B`` (the thesis does not state ``B``;
+        16 is bionav's choice).
+    bin_range : ``unit`` -- the fixed range ``[0, 1]`` shared by all images
+        (like the fixed grey levels of 8-bit images); ``image`` -- each image's
+        own ``[min, max]``, which keeps the histogram informative after
+        preprocessing that compresses the range (a low-passed, edge-filtered
+        panorama may lie within ``[0, 0.02]`` and fill only the first bin),
+        at the price of depending on two extreme pixels.
     """
 
     rings: int = 20
     bins: int = 16
+    bin_range: str = "unit"
+
+
+def _value_range(signature):
+    mode = signature.config.bin_range
+    if mode not in ("image", "unit"):
+        from bionav.errors import UserError
+
+        raise UserError(f"signature.bin_range={mode!r} is not valid; choose image or unit.")
+    return None if mode == "image" else (0.0, 1.0)
 
 
 class Hist(Signature):
@@ -37,7 +54,9 @@ class Hist(Signature):
     def compute(self, image, *, raw=None) -> np.ndarray:
         from bionav.homing.signatures.histogram import ring_histogram
 
-        return ring_histogram(image, rings=self.config.rings, bins=self.config.bins).ravel()
+        return ring_histogram(
+            image, rings=self.config.rings, bins=self.config.bins, value_range=_value_range(self)
+        ).ravel()
 
 
 class Ent(Signature):
@@ -50,4 +69,4 @@ class Ent(Signature):
     def compute(self, image, *, raw=None) -> np.ndarray:
         from bionav.homing.signatures.histogram import ring_entropy
 
-        return ring_entropy(image, rings=self.config.rings, bins=self.config.bins)
+        return ring_entropy(image, rings=self.config.rings, bins=self.config.bins, value_range=_value_range(self))

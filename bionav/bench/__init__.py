@@ -1,0 +1,1 @@
+"""Benchmarks of bionav's homing methods (``python -m bionav.bench --help``)."""
