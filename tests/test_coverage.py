@@ -77,7 +77,6 @@ def test_kernel_equals_reference():
 
 
 def test_fractions_and_ideal_meander():
-    raster = Raster((0.0, 0.0), 1.0, (2, 2))
     counts = np.array([[0, 1], [2, 3]])
     f = coverage_fractions(counts, np.ones((2, 2), bool))
     assert f == {"coverage": 0.25, "overlap": 0.5, "uncovered": 0.25}

@@ -122,7 +122,7 @@ def floorplan_from_scene(scene, *, max_height: float = 0.35, min_height: float =
     max_height, min_height : float
         Height band (m) in which parts of the world block the robot.
     """
-    rooms, boxes, discs = [], [], []
+    boxes, discs = [], []
     wall_segments = []
     for b in scene.boxes:
         cx, cy, cz, hx, hy, hz, c, s, inside = (float(v) for v in b[:9])
