@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import warnings
+from pathlib import Path
 from typing import Any, Sequence
 
 from hydra.core.config_search_path import ConfigSearchPath
@@ -29,12 +30,41 @@ from bionav import registry
 PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller")
 
 
+def config_dirs() -> list[tuple[str, Path]]:
+    """Folders of YAML configs, one per ``bionav.configs`` entry point: ``(name, folder)``.
+
+    A package is located with ``importlib.resources``. bionav's own
+    ``bionav.conf`` is the top-level ``conf/`` folder of the source tree,
+    installed inside the package; when the source tree itself is imported
+    (running from a checkout with a regular install, where ``bionav/conf``
+    does not exist) it is found next to the package instead.
+    """
+    import importlib.util
+    from importlib.resources import files
+
+    import bionav
+
+    out = []
+    for name, package, _dist in registry.config_packages():
+        folder = None
+        try:
+            if importlib.util.find_spec(package) is not None:
+                folder = Path(str(files(package)))
+        except ModuleNotFoundError:
+            folder = None
+        if folder is None and package == "bionav.conf":
+            folder = Path(bionav.__file__).resolve().parent.parent / "conf"
+        if folder is not None and folder.is_dir():
+            out.append((name, folder))
+    return out
+
+
 class BionavSearchPathPlugin(SearchPathPlugin):
-    """Adds every ``bionav.configs`` package to Hydra's config search path."""
+    """Adds every ``bionav.configs`` folder to Hydra's config search path."""
 
     def manipulate_search_path(self, search_path: ConfigSearchPath) -> None:
-        for name, package, _dist in registry.config_packages():
-            search_path.append(provider=f"bionav-{name}", path=f"pkg://{package}")
+        for name, folder in config_dirs():
+            search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
 
 
 def plugin_node_class(name: str, config_cls: type) -> type:
@@ -90,15 +120,10 @@ def register_configs() -> dict[str, list[str]]:
 
 def config_options(group: str) -> list[str]:
     """YAML options of a config group across every ``bionav.configs`` package (sorted)."""
-    from importlib.resources import files
-
     options: set[str] = set()
-    for _name, package, _dist in registry.config_packages():
-        try:
-            folder = files(package) / group
-            options |= {p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml")}
-        except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError):
-            continue
+    for _name, folder in config_dirs():
+        if (folder / group).is_dir():
+            options |= {p.stem for p in (folder / group).glob("*.yaml")}
     return sorted(options)
 
 
@@ -111,12 +136,13 @@ def compose(overrides: Sequence[str] = (), *, config_name: str = "config") -> Di
         Hydra overrides such as ``["homing=mfdid", "db.seed=3"]``.
     """
     from hydra import compose as hydra_compose
-    from hydra import initialize_config_module
+    from hydra import initialize_config_dir
     from hydra.core.global_hydra import GlobalHydra
 
     register_configs()
     GlobalHydra.instance().clear()
-    with initialize_config_module(config_module="bionav.conf", version_base="1.3"):
+    own = dict(config_dirs())["bionav"]
+    with initialize_config_dir(config_dir=str(own), version_base="1.3"):
         return hydra_compose(config_name=config_name, overrides=list(overrides))
 
 

@@ -46,6 +46,16 @@ def test_wheel_install_runs_from_outside_the_checkout(wheel, tmp_path):
     assert "sim_original" in proc.stdout and "grid_homing" in proc.stdout
 
 
+def test_regular_install_runs_from_the_checkout_root(wheel, tmp_path):
+    """`pip install . && python -m bionav` from the clone's root imports the source tree, which has
+    no bionav/conf: the configs must still be found (the README's first Quickstart command)."""
+    target = tmp_path / "site"
+    assert _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path).returncode == 0
+    proc = run_bionav("--help", cwd=ROOT, env={"PYTHONPATH": str(target), "BIONAV_CACHE": str(tmp_path / "c")})
+    assert proc.returncode == 0, proc.stderr
+    assert "grid_homing" in proc.stdout and "sim_original" in proc.stdout
+
+
 def test_example_plugin_selected_from_the_cli(tmp_path):
     target = tmp_path / "site"
     example = ROOT / "examples" / "bionav-plugin-example"

@@ -8,7 +8,6 @@ AAE*, MAE*, RR* averaged over all off-diagonal database pairs.
 from __future__ import annotations
 
 import csv
-from importlib.resources import files
 from typing import Any
 
 import numpy as np
@@ -27,16 +26,13 @@ MEASURES = ("aae", "mae", "rr")
 
 
 def db_preset(name: str) -> dict:
-    """The ``conf/db/<name>.yaml`` preset from any config package."""
-    from bionav import registry
+    """The ``conf/db/<name>.yaml`` preset from any config folder."""
+    from bionav.config import config_dirs
 
-    for _n, package, _d in registry.config_packages():
-        try:
-            path = files(package) / "db" / f"{name}.yaml"
-            if path.is_file():
-                return yaml.safe_load(path.read_text()) or {}
-        except ModuleNotFoundError:
-            continue
+    for _n, folder in config_dirs():
+        path = folder / "db" / f"{name}.yaml"
+        if path.is_file():
+            return yaml.safe_load(path.read_text()) or {}
     raise UserError(f"the cross_db family names the database {name!r}, which has no preset (conf/db/{name}.yaml).")
 
 
