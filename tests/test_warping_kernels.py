@@ -12,12 +12,14 @@ from bionav.homing.warping import (
     warping2d_scores,
 )
 from bionav.homing.warping.distance import column_distance_matrix, diagonal_distances
+from bionav.homing.warping.kernels import fill_window_minima
 from bionav.homing.warping.reference import (
     minwarping_scores_reference,
     warping1d_scores_reference,
     warping2d_scores_reference,
 )
-from bionav.homing.warping.scaleplanes import default_thresholds
+from bionav.homing.warping.scaleplanes import default_scales, default_thresholds
+from bionav.homing.warping.templates import minwarp_template, minwarp_windows
 
 W, H = 24, 8
 SCALES = np.array([0.5, 0.75, 1.0, 1.4, 2.0])
@@ -56,11 +58,45 @@ def test_nsad_of_identical_and_zero_columns():
     assert np.all(column_distance_matrix(zero, zero) == 0.0)
 
 
+def test_window_minima_match_brute_force():
+    rng = np.random.default_rng(11)
+    n_levels, k, w, step, m2 = 4, 2, 10, 2, 10
+    levels = np.zeros((n_levels, k, w, step, m2), np.float32)
+    levels[0] = rng.random((k, w, step, m2), dtype=np.float32)
+    fill_window_minima(levels)
+    for j in range(n_levels):
+        for d in range(w):
+            window = [(d + t) % w for t in range(2**j)]
+            np.testing.assert_array_equal(levels[j, :, d], levels[0][:, window].min(axis=1))
+
+
+@pytest.mark.parametrize("max_level", [0, 1, 2, 4])
+@pytest.mark.parametrize("width", [24, 288])
+def test_minwarp_windows_cover_exactly_the_allowed_columns(max_level, width):
+    scales = default_scales() if width == 288 else SCALES
+    tmpl = minwarp_template(width, scales, default_thresholds(scales))
+    vlo, vhi, klo, khi = tmpl
+    start, plane, level, first = minwarp_windows(tmpl, max_level=max_level)
+    assert level.max() <= max_level
+    for u in range(width):
+        covered = {}
+        for e in range(start[u], start[u + 1]):
+            covered.setdefault(int(plane[e]), set()).update(range(first[e], first[e] + 2 ** int(level[e])))
+        allowed = {}
+        for v in range(vlo[u], vhi[u] + 1):
+            for k in range(klo[u, v], khi[u, v] + 1):
+                allowed.setdefault(k, set()).add(v)
+        assert covered == allowed, f"u={u}"
+
+
 @pytest.mark.parametrize("thresholds", THRESHOLD_SETS)
 @pytest.mark.parametrize("n_alpha", [12, 8, 24, 7])
-def test_minwarping_scores_fast_equals_reference(thresholds, n_alpha):
+@pytest.mark.parametrize("window_level", [0, 1, 4])
+def test_minwarping_scores_fast_equals_reference(thresholds, n_alpha, window_level):
     snap, cur = _pair(n_alpha)
-    a_cols, p_cols, fast = minwarping_scores(snap, cur, n_alpha=n_alpha, n_psi=6, thresholds=thresholds)
+    a_cols, p_cols, fast = minwarping_scores(
+        snap, cur, n_alpha=n_alpha, n_psi=6, thresholds=thresholds, window_level=window_level
+    )
     tau = default_thresholds(SCALES) if thresholds is None else thresholds
     ref = minwarping_scores_reference(snap, cur, a_cols=a_cols, p_cols=p_cols, thresholds=tau)
     np.testing.assert_allclose(fast, ref, rtol=1e-5, atol=1e-5)

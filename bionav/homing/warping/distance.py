@@ -68,18 +68,20 @@ def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
                 acc[i] += abs(a[i] - b[i])
         na = snap_norm[k]
         nb = cur_norm2[k, d:d + width]
-        for i in range(width):
-            den = na[i] + nb[i]
-            val = np.float32(0.0)
-            if den > 0:
-                val = acc[i] / den
-            m = i // step
-            rr = i - m * step
-            out[k, d, rr, m] = val
-            out[k, d, rr, m + n] = val
+        # loop over (i % step, i // step) rather than dividing: an integer
+        # division by a run-time step costs more than the whole row sum
+        for rr in range(step):
+            for m in range(n):
+                i = m * step + rr
+                den = na[i] + nb[i]
+                val = np.float32(0.0)
+                if den > 0:
+                    val = acc[i] / den
+                out[k, d, rr, m] = val
+                out[k, d, rr, m + n] = val
 
 
-def diagonal_distances(snapshot, current, *, step: int = 1):
+def diagonal_distances(snapshot, current, *, step: int = 1, out=None):
     """Fast column distances in the layout the search kernels read.
 
     Parameters
@@ -88,6 +90,9 @@ def diagonal_distances(snapshot, current, *, step: int = 1):
         Scale-plane stacks (see :func:`column_distance_matrix`).
     step : int
         Alpha step in columns (``W`` must be a multiple of it).
+    out : ndarray, shape (K, W, step, 2 * W // step), float32, optional
+        Array to fill (C-contiguous), e.g. the first level of the search's
+        window minima; a new one by default.
 
     Returns
     -------
@@ -104,7 +109,11 @@ def diagonal_distances(snapshot, current, *, step: int = 1):
     n_planes, _, width = snap.shape
     if width % step:
         raise ValueError(f"width {width} is not a multiple of the alpha step {step}")
-    out = np.empty((n_planes, width, step, 2 * (width // step)), dtype=np.float32)
+    shape = (n_planes, width, step, 2 * (width // step))
+    if out is None:
+        out = np.empty(shape, dtype=np.float32)
+    elif out.shape != shape or out.dtype != np.float32 or not out.flags.c_contiguous:
+        raise ValueError(f"out must be a C-contiguous float32 array of shape {shape}")
     cur_norm = np.asarray(current["cur_norm"], dtype=np.float32)
     with PARALLEL_LOCK:
         _diagonal_distances(

@@ -11,7 +11,9 @@ steps (``a * step`` columns) and rotation ``p`` columns,
 
 so ``d`` does not depend on ``a`` and the distances of all alpha steps of one
 template entry are ``n_alpha`` consecutive floats: the kernels vectorise over
-alpha. The plain, loop-by-loop equivalents are in
+alpha. Consecutive ``v`` are consecutive ``d`` as well, so min-warping reads
+the minimum over a run of allowed current columns from sliding minima over
+``d`` (:func:`fill_window_minima`). The plain, loop-by-loop equivalents are in
 :mod:`~bionav.homing.warping.reference`.
 """
 
@@ -30,20 +32,68 @@ from numba import njit, prange
 PARALLEL_LOCK = threading.Lock()
 
 
+@njit(inline="always")
+def _wrap(d, width):
+    """``d mod width`` for ``-2 width <= d < 2 width`` without an integer division."""
+    if d < 0:
+        d += width
+        if d < 0:
+            d += width
+    elif d >= width:
+        d -= width
+        if d >= width:
+            d -= width
+    return d
+
+
 @njit(parallel=True, fastmath=True, cache=True)
-def minwarp_scores(dist, n_alpha, p_cols, vlo, vhi, klo, khi, n_chunks):
+def fill_window_minima(levels):
+    """Sliding minima over ``d`` of the column distances, in place.
+
+    ``levels[j, k, d] = min(levels[0, k, d'] for d' in d .. d + 2**j - 1)``
+    (``d'`` modulo ``W``), built level by level from ``levels[0]``, the column
+    distances in diagonal layout. A run of ``L`` consecutive current columns
+    ``v`` (one snapshot column, one plane) is a run of ``L`` consecutive ``d``,
+    so its minimum is the minimum of at most two entries of one level
+    (a sparse table: Bender & Farach-Colton 2000, "The LCA problem revisited").
+
+    Parameters
+    ----------
+    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32
+        ``levels[0]`` filled; levels ``1 .. J`` are overwritten.
+    """
+    n_levels, n_planes, width, step, m2 = levels.shape
+    for j in range(1, n_levels):
+        h = 1 << (j - 1)
+        for t in prange(n_planes * width):
+            k = t // width
+            d = t - k * width
+            d2 = _wrap(d + h, width)
+            for rr in range(step):
+                a = levels[j - 1, k, d, rr]
+                b = levels[j - 1, k, d2, rr]
+                o = levels[j, k, d, rr]
+                for m in range(m2):
+                    o[m] = min(a[m], b[m])
+
+
+@njit(parallel=True, fastmath=True, cache=True)
+def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, n_chunks):
     """Min-warping match values for every alpha step and the given rotations.
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step), float32
-        Column distances (diagonal layout).
+    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32
+        Column distances (diagonal layout) and their sliding minima
+        (:func:`fill_window_minima`).
     n_alpha : int
         Number of alpha steps (``W // step``).
     p_cols : ndarray, shape (P,), int64
-        Rotations ``psi`` to search, in columns.
-    vlo, vhi, klo, khi : ndarray
-        Min-warping template (:func:`~bionav.homing.warping.templates.minwarp_template`).
+        Rotations ``psi`` to search, in columns (``0 <= p < W``).
+    start, w_plane, w_level, w_v : ndarray
+        Min-warping windows (:func:`~bionav.homing.warping.templates.minwarp_windows`):
+        the entries ``start[u] .. start[u + 1] - 1`` of snapshot column ``u``
+        each cover ``2**w_level`` current columns from ``w_v`` in plane ``w_plane``.
     n_chunks : int
         Number of independent partial sums (one per thread).
 
@@ -52,7 +102,7 @@ def minwarp_scores(dist, n_alpha, p_cols, vlo, vhi, klo, khi, n_chunks):
     ndarray, shape (P, n_alpha), float32
         ``sum_u min_{v, k allowed} dist`` for each (psi, alpha); lower is better.
     """
-    n_planes, width, step, _ = dist.shape
+    _, n_planes, width, step, _ = levels.shape
     n_p = p_cols.shape[0]
     partial = np.zeros((n_chunks, n_p, n_alpha), dtype=np.float32)
     for c in prange(n_chunks):
@@ -64,14 +114,11 @@ def minwarp_scores(dist, n_alpha, p_cols, vlo, vhi, klo, khi, n_chunks):
                 for a in range(n_alpha):
                     best[a] = np.inf
                 pc = p_cols[ip]
-                for v in range(vlo[u], vhi[u] + 1):
-                    d = (v - u - pc) % width
-                    for k in range(klo[u, v], khi[u, v] + 1):
-                        row = dist[k, d, rr, m0:m0 + n_alpha]
-                        for a in range(n_alpha):
-                            x = row[a]
-                            if x < best[a]:
-                                best[a] = x
+                for e in range(start[u], start[u + 1]):
+                    d = _wrap(w_v[e] - u - pc, width)
+                    row = levels[w_level[e], w_plane[e], d, rr, m0:m0 + n_alpha]
+                    for a in range(n_alpha):
+                        best[a] = min(best[a], row[a])
                 for a in range(n_alpha):
                     partial[c, ip, a] += best[a]
     out = np.zeros((n_p, n_alpha), dtype=np.float32)
@@ -110,7 +157,7 @@ def minwarp_scores_at(dist, a_cols, p_cols, vlo, vhi, klo, khi):
             rr = i - m * step
             best = np.inf
             for v in range(vlo[u], vhi[u] + 1):
-                d = (v - u - pc) % width
+                d = _wrap(v - u - pc, width)
                 for k in range(klo[u, v], khi[u, v] + 1):
                     x = dist[k, d, rr, m]
                     if x < best:
@@ -142,19 +189,21 @@ def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
     n_rho = v_tab.shape[0]
     n_p = p_cols.shape[0]
     out = np.zeros((n_rho, n_p, n_alpha), dtype=np.float32)
+    col_m = np.arange(width) // step
+    col_r = np.arange(width) - col_m * step
     for t in prange(n_rho * n_p):
-        l = t // n_p
-        ip = t - l * n_p
+        ir = t // n_p
+        ip = t - ir * n_p
         pc = p_cols[ip]
         acc = np.zeros(n_alpha, dtype=np.float32)
         for u in range(width):
-            m0 = u // step
-            rr = u - m0 * step
-            d = (v_tab[l, u] - u - pc) % width
-            row = dist[k_tab[l, u], d, rr, m0:m0 + n_alpha]
+            m0 = col_m[u]
+            rr = col_r[u]
+            d = _wrap(v_tab[ir, u] - u - pc, width)
+            row = dist[k_tab[ir, u], d, rr, m0:m0 + n_alpha]
             for a in range(n_alpha):
                 acc[a] += row[a]
-        out[l, ip] = acc
+        out[ir, ip] = acc
     return out
 
 
@@ -166,7 +215,7 @@ def warp2d_scores_at(dist, a_cols, p_cols, rho_idx, v_tab, k_tab):
     for t in range(a_cols.shape[0]):
         ac = a_cols[t] % width
         pc = p_cols[t]
-        l = rho_idx[t]
+        ir = rho_idx[t]
         total = 0.0
         for u in range(width):
             i = u + ac
@@ -174,8 +223,8 @@ def warp2d_scores_at(dist, a_cols, p_cols, rho_idx, v_tab, k_tab):
                 i -= width
             m = i // step
             rr = i - m * step
-            d = (v_tab[l, u] - u - pc) % width
-            total += dist[k_tab[l, u], d, rr, m]
+            d = _wrap(v_tab[ir, u] - u - pc, width)
+            total += dist[k_tab[ir, u], d, rr, m]
         out[t] = total
     return out
 

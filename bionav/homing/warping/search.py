@@ -31,13 +31,14 @@ from bionav.homing.warping.distance import diagonal_distances
 from bionav.homing.warping.kernels import (
     PARALLEL_LOCK,
     compass_measure,
+    fill_window_minima,
     minwarp_scores,
     minwarp_scores_at,
     warp2d_scores,
     warp2d_scores_at,
 )
 from bionav.homing.warping.scaleplanes import check_scales
-from bionav.homing.warping.templates import minwarp_template, warp2d_template
+from bionav.homing.warping.templates import minwarp_template, minwarp_windows, warp2d_template
 
 
 @dataclass(frozen=True)
@@ -92,6 +93,22 @@ def _layout_step(width: int, n_alpha: int, p_cols, double_search: bool) -> int:
     return step
 
 
+#: Largest window level of the min-warping search (windows of up to 16 columns).
+WINDOW_LEVEL = 4
+
+
+def _window_minima(snapshot, current, step, windows):
+    """Column distances (level 0) and the sliding minima the windows read."""
+    n_levels = int(windows[2].max(initial=0)) + 1
+    n_planes, _, width = np.shape(snapshot["snap"])
+    levels = np.empty((n_levels, n_planes, width, step, 2 * (width // step)), dtype=np.float32)
+    diagonal_distances(snapshot, current, step=step, out=levels[0])
+    if n_levels > 1:
+        with PARALLEL_LOCK:
+            fill_window_minima(levels)
+    return levels
+
+
 def _select_psi(dist, p_cols, compass_fraction):
     if compass_fraction is None or compass_fraction >= 1.0:
         return p_cols
@@ -116,7 +133,9 @@ def _check_pair(snapshot, current):
     return s1
 
 
-def minwarping_scores(snapshot, current, *, n_alpha=96, n_psi=96, thresholds=None, psi_cols=None):
+def minwarping_scores(
+    snapshot, current, *, n_alpha=96, n_psi=96, thresholds=None, psi_cols=None, window_level=WINDOW_LEVEL
+):
     """Min-warping match values on the full (psi, alpha) grid (fast kernels).
 
     Parameters
@@ -129,6 +148,10 @@ def minwarping_scores(snapshot, current, *, n_alpha=96, n_psi=96, thresholds=Non
         Scale thresholds; default geometric midpoints.
     psi_cols : array_like of int, optional
         Rotations (columns) to search instead of the ``n_psi`` grid.
+    window_level : int
+        Largest window level of the sliding minima
+        (:func:`~bionav.homing.warping.templates.minwarp_windows`); changes the
+        speed, not the result.
 
     Returns
     -------
@@ -146,10 +169,10 @@ def minwarping_scores(snapshot, current, *, n_alpha=96, n_psi=96, thresholds=Non
     a_cols = _column_grid(n_alpha, width)
     p_cols = _column_grid(n_psi, width) if psi_cols is None else np.asarray(psi_cols, np.int64) % width
     step = _layout_step(width, n_alpha, p_cols, False)
-    dist = diagonal_distances(snapshot, current, step=step)
-    tmpl = minwarp_template(width, scales, tau)
+    windows = minwarp_windows(minwarp_template(width, scales, tau), max_level=window_level)
+    levels = _window_minima(snapshot, current, step, windows)
     with PARALLEL_LOCK:
-        scores = minwarp_scores(dist, width // step, p_cols, *tmpl, get_num_threads())
+        scores = minwarp_scores(levels, width // step, p_cols, *windows, get_num_threads())
     return a_cols, p_cols, scores[:, a_cols // step]
 
 
@@ -164,6 +187,7 @@ def minwarping(
     fine_search: bool = False,
     double_search: bool = False,
     template=None,
+    windows=None,
 ) -> WarpingResult:
     """Min-warping home direction and visual compass of one image pair.
 
@@ -204,6 +228,9 @@ def minwarping(
     template : tuple, optional
         Precomputed ``minwarp_template(W, scales, thresholds)`` (saves about a
         millisecond per call when many pairs share it).
+    windows : tuple, optional
+        Precomputed ``minwarp_windows(template)`` (the search reads the
+        minimum over runs of allowed current columns from sliding minima).
 
     Returns
     -------
@@ -219,15 +246,18 @@ def minwarping(
     step = _layout_step(width, n_alpha, p_all, double_search)
     n_a_eff = width // step
     tmpl = minwarp_template(width, scales, tau) if template is None else template
-    dist = diagonal_distances(snapshot, current, step=step)
+    windows = minwarp_windows(tmpl, max_level=WINDOW_LEVEL) if windows is None else windows
+    levels = _window_minima(snapshot, current, step, windows)
+    dist = levels[0]
     p_cols = _select_psi(dist, p_all, compass_fraction)
     with PARALLEL_LOCK:
-        scores = minwarp_scores(dist, n_a_eff, p_cols, *tmpl, get_num_threads()).astype(np.float64)
+        scores = minwarp_scores(levels, n_a_eff, p_cols, *windows, get_num_threads()).astype(np.float64)
     dist2 = None
     if double_search:
-        dist2 = diagonal_distances(current, snapshot, step=step)
+        levels2 = _window_minima(current, snapshot, step, windows)
+        dist2 = levels2[0]
         with PARALLEL_LOCK:
-            scores2 = minwarp_scores(dist2, n_a_eff, (-p_cols) % width, *tmpl, get_num_threads())
+            scores2 = minwarp_scores(levels2, n_a_eff, (-p_cols) % width, *windows, get_num_threads())
         # hypothesis (a, p) of the pair corresponds to (a + W/2 - p, -p) of the swapped pair
         a_eff = np.arange(n_a_eff) * step
         idx = ((a_eff[None, :] + width // 2 - p_cols[:, None]) % width) // step

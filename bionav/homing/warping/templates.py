@@ -22,6 +22,7 @@ current position, landmark, the distance ratio is
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 
 def plane_of_scale(sigma, thresholds):
@@ -94,6 +95,80 @@ def minwarp_template(width: int, scales, thresholds):
     klo[~reach] = 1
     khi[~reach] = 0
     return vlo, vhi, klo, khi
+
+
+def minwarp_windows(template, *, max_level: int = 4):
+    """Cover the min-warping template with power-of-two windows of current columns.
+
+    For each snapshot column ``u`` and plane ``k`` the allowed current columns
+    ``v`` form runs; the minimum over a run of length ``L`` is the minimum over
+    a few windows of ``2**j`` columns, read from the sliding minima of
+    :func:`~bionav.homing.warping.kernels.fill_window_minima`: two overlapping
+    windows of level ``floor(log2 L)`` (one if ``L`` is a power of two) for
+    ``L <= 2**(max_level + 1)``, else ``ceil(L / 2**max_level)`` windows of
+    level ``max_level``, the last one overlapping.
+
+    Parameters
+    ----------
+    template : tuple
+        ``(vlo, vhi, klo, khi)`` of :func:`minwarp_template`.
+    max_level : int
+        Largest window level ``J`` (windows of up to ``2**J`` columns); the
+        search needs ``J + 1`` copies of the column distances.
+
+    Returns
+    -------
+    start : ndarray, shape (W + 1,), int64
+        Windows of snapshot column ``u`` are entries ``start[u] .. start[u + 1] - 1``.
+    plane, level, v : ndarray, shape (N,), int64
+        Plane, level and first current column (relative to ``alpha``) of each window.
+    """
+    if max_level < 0:
+        raise ValueError(f"max_level must be >= 0, got {max_level}")
+    vlo, vhi, klo, khi = (np.ascontiguousarray(t, dtype=np.int64) for t in template)
+    n_planes = int(max(khi.max(initial=-1), klo.max(initial=-1))) + 1
+    bound = int(np.maximum(khi - klo + 1, 0).sum())
+    start = np.zeros(vlo.size + 1, np.int64)
+    out = np.empty((3, bound), np.int64)
+    n = _fill_windows(vlo, vhi, klo, khi, n_planes, int(max_level), start, out)
+    return start, out[0, :n].copy(), out[1, :n].copy(), out[2, :n].copy()
+
+
+@njit(cache=True)
+def _fill_windows(vlo, vhi, klo, khi, n_planes, max_level, start, out):
+    block = 1 << max_level
+    n = 0
+    for u in range(vlo.size):
+        for k in range(n_planes):
+            v = vlo[u]
+            while v <= vhi[u]:
+                if not (klo[u, v] <= k <= khi[u, v]):
+                    v += 1
+                    continue
+                v0 = v
+                while v <= vhi[u] and klo[u, v] <= k <= khi[u, v]:
+                    v += 1
+                length = v - v0
+                if length <= 2 * block:
+                    j = 0
+                    while (2 << j) <= length and j < max_level:
+                        j += 1
+                    w = 1 << j
+                    out[0, n], out[1, n], out[2, n] = k, j, v0
+                    n += 1
+                    if length > w:
+                        out[0, n], out[1, n], out[2, n] = k, j, v0 + length - w
+                        n += 1
+                else:
+                    off = 0
+                    while off < length - block:
+                        out[0, n], out[1, n], out[2, n] = k, max_level, v0 + off
+                        n += 1
+                        off += block
+                    out[0, n], out[1, n], out[2, n] = k, max_level, v0 + length - block
+                    n += 1
+        start[u + 1] = n
+    return n
 
 
 def warp2d_template(width: int, rhos, thresholds):

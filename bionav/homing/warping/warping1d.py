@@ -18,9 +18,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from bionav.geometry import wrap_angle
 from bionav.homing.warping.kernels import PARALLEL_LOCK
 from bionav.homing.warping.search import WarpingResult, rho_grid
-from bionav.geometry import wrap_angle
 
 
 @njit(parallel=True, fastmath=True, cache=True)

@@ -189,15 +189,18 @@ class MinWarping(_PlaneWarping):
     def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
         """Min-warping search; ``angle`` in the current view's frame, ``compass = psi``."""
         from bionav.homing.warping import minwarping
-        from bionav.homing.warping.templates import minwarp_template
+        from bionav.homing.warping.search import WINDOW_LEVEL
+        from bionav.homing.warping.templates import minwarp_template, minwarp_windows
 
         cfg = self.config
         width = int(np.shape(snapshot["snap"])[-1])
 
         def build():
             scales, tau = self._scales()
-            return minwarp_template(width, scales, tau)
+            template = minwarp_template(width, scales, tau)
+            return template, minwarp_windows(template, max_level=WINDOW_LEVEL)
 
+        template, windows = self._cached_template(width, build)
         result = minwarping(
             snapshot,
             current,
@@ -207,7 +210,8 @@ class MinWarping(_PlaneWarping):
             compass_fraction=self._compass_fraction(),
             fine_search=cfg.fine_search,
             double_search=cfg.double_search,
-            template=self._cached_template(width, build),
+            template=template,
+            windows=windows,
         )
         return self._to_home_vector(result)
 
