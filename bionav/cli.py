@@ -109,7 +109,12 @@ def _task(cfg) -> float | None:
             EXIT_INTERNAL_ERROR,
         )
     if multirun:
-        log.info("job %s: %s", hc.job.num, ", ".join(f"{k}={metrics[k]:.4g}" for k in ("aae", "mae", "rr") if isinstance(metrics.get(k), float)) or metrics.get("status"))
+        log.info(
+            "job %s: %s",
+            hc.job.num,
+            ", ".join(f"{k}={metrics[k]:.4g}" for k in ("aae", "mae", "rr") if isinstance(metrics.get(k), float))
+            or metrics.get("status"),
+        )
     else:
         _print_result(metrics)
     return None

@@ -6,12 +6,11 @@ import json
 import numpy as np
 import pytest
 from omegaconf import OmegaConf
+from spectral_ctx import FakeContext
 
 from bionav.errors import UserError
 from bionav.experiments import contrast_lda
 from bionav.spectral.bands import feature_subsets
-
-from spectral_ctx import FakeContext
 
 
 def test_contrast_lda_small_simulated_run(tmp_path):

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 from omegaconf import OmegaConf
+from spectral_ctx import FakeContext
 
 from bionav.plugins.sensors.spectral5 import Spectral5Serial, Spectral5Sim
 from bionav.spectral.fake_device import FakeSpectral5
@@ -11,8 +12,6 @@ from bionav.spectral.scene import backyard_scene
 from bionav.spectral.sensor_model import LogSensorModel
 from bionav.spectral.sky import CloudField, SkyState
 from bionav.spectral.stability import stability_measures
-
-from spectral_ctx import FakeContext
 
 
 def test_stability_measures_hand_computed():

@@ -68,12 +68,15 @@ def test_logs_cli_info_and_recover(tmp_path):
     _write(path).close()
     info = subprocess.run([sys.executable, "-m", "bionav.logs", "info", str(path)], capture_output=True, text=True)
     assert info.returncode == 0 and "/test/values" in info.stdout and "500" in info.stdout
-    bad = subprocess.run([sys.executable, "-m", "bionav.logs", "info", str(tmp_path / "nope.mcap")], capture_output=True, text=True)
+    bad = subprocess.run(
+        [sys.executable, "-m", "bionav.logs", "info", str(tmp_path / "nope.mcap")], capture_output=True, text=True
+    )
     assert bad.returncode == 2 and "does not exist" in bad.stderr and "Traceback" not in bad.stderr
     (tmp_path / "half.mcap").write_bytes(path.read_bytes()[:3000])
     rec = subprocess.run(
         [sys.executable, "-m", "bionav.logs", "recover", str(tmp_path / "half.mcap"), str(tmp_path / "ok.mcap")],
-        capture_output=True, text=True,
+        capture_output=True,
+        text=True,
     )
     assert rec.returncode == 0 and "truncated input" in rec.stdout
     assert subprocess.run([sys.executable, "-m", "bionav.logs", "info", str(tmp_path / "ok.mcap")]).returncode == 0

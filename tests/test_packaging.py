@@ -7,7 +7,6 @@ import zipfile
 from pathlib import Path
 
 import pytest
-
 from helpers import run_bionav
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -125,10 +125,9 @@ def test_ranking_table_best_configuration_per_signature():
 
 
 def test_run_writes_rows_and_report_builds_ranking(small_db, tmp_path, monkeypatch):
+    import bionav.experiments.common as common
     from bionav.experiments.context import RunContext
     from bionav.logs.writer import McapLog
-
-    import bionav.experiments.common as common
 
     monkeypatch.setattr(common, "load_configured_database", lambda cfg, node=None: small_db)
     for sig, levels in (("mffc_phase", {"n_coeffs": [2, 5, 9]}), ("mean", {"rings": [1, 3, 6]})):

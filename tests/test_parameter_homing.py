@@ -230,4 +230,5 @@ def test_duck_typed_third_party_signature():
     want = -np.array([d @ phi.mean(axis=1), d @ psi.mean(axis=1)])
     assert angular_difference(hv.angle, math.atan2(want[1], want[0])) < 1e-6
     ts = ParameterHoming(Config(gradient="test_steps"), geometry=GEOM, signature=RowMeans())
-    assert ts.uses_test_steps and np.isfinite(ts.home_vector(ts.prepare(s), ts.prepare(c), neighbours={(1, 0): ts.prepare(s)}).angle)
+    hv = ts.home_vector(ts.prepare(s), ts.prepare(c), neighbours={(1, 0): ts.prepare(s)})
+    assert ts.uses_test_steps and np.isfinite(hv.angle)

@@ -13,7 +13,9 @@ def _metrics(run_dir):
 
 def test_rotation_then_replay_from_the_command_line(tmp_path):
     rec = tmp_path / "rec"
-    proc = run_bionav("experiment=pol_compass", "mode=rotation", "experiment.samples_per_step=2", f"hydra.run.dir={rec}", cwd=tmp_path)
+    proc = run_bionav(
+        "experiment=pol_compass", "mode=rotation", "experiment.samples_per_step=2", f"hydra.run.dir={rec}", cwd=tmp_path
+    )
     assert proc.returncode == 0, proc.stderr
     assert "heading_rmse_deg" in proc.stdout
     recorded = _metrics(rec)
@@ -21,8 +23,14 @@ def test_rotation_then_replay_from_the_command_line(tmp_path):
     log = rec / "run.mcap"
     rep = tmp_path / "rep"
     proc = run_bionav(
-        "experiment=pol_compass", "mode=rotation", "experiment.samples_per_step=2",
-        "sensor=replay", f"sensor.path={log}", "pantilt=replay", f"pantilt.path={log}", f"hydra.run.dir={rep}",
+        "experiment=pol_compass",
+        "mode=rotation",
+        "experiment.samples_per_step=2",
+        "sensor=replay",
+        f"sensor.path={log}",
+        "pantilt=replay",
+        f"pantilt.path={log}",
+        f"hydra.run.dir={rep}",
         cwd=tmp_path,
     )
     assert proc.returncode == 0, proc.stderr
@@ -34,8 +42,11 @@ def test_unknown_mode_and_missing_port_are_clean_errors(tmp_path):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert "unknown mode 'spin'" in proc.stderr and "rotation" in proc.stderr
     proc = run_bionav(
-        "experiment=pol_compass", "sensor=polcompass_serial", "sensor.port=/dev/no-such-compass",
-        f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path,
+        "experiment=pol_compass",
+        "sensor=polcompass_serial",
+        "sensor.port=/dev/no-such-compass",
+        f"hydra.run.dir={tmp_path / 'run'}",
+        cwd=tmp_path,
     )
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert "/dev/no-such-compass does not exist" in proc.stderr and "sensor.port" in proc.stderr

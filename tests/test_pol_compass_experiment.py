@@ -170,7 +170,9 @@ def test_unplug_mid_scan_keeps_readings_in_the_log(tmp_path):
     exp = experiment_config("rotation", samples_per_step=2)
     log_path = tmp_path / "run.mcap"
     with FakeDLPIO8(CompassCounts(build_hardware(PolCompassSimConfig()), scene, rng)) as fake:
-        sensor = PolCompassSerial(PolCompassSerialConfig(port=fake.port, timeout_s=0.2, reconnect_attempts=1, reconnect_delay_s=0.01))
+        sensor = PolCompassSerial(
+            PolCompassSerialConfig(port=fake.port, timeout_s=0.2, reconnect_attempts=1, reconnect_delay_s=0.01)
+        )
         pantilt = PanTiltSim(PanTiltSimConfig())
         pantilt.attach_simulation(scene, None)
         sensor.open()

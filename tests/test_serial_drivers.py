@@ -154,7 +154,8 @@ def test_tcm2_checksum_hand_value_and_formats():
     assert checksum("GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,") == 0x47
     line = format_standard(heading_deg=328.3, pitch_deg=28.4, roll_deg=-12.4, temperature_c=22.3)
     assert line.startswith("$C328.3P28.4R-12.4T22.3*") and line.endswith("\r\n")
-    assert parse_line(line) == {"format": "standard", "heading_deg": 328.3, "pitch_deg": 28.4, "roll_deg": -12.4, "temperature_c": 22.3}
+    want = {"format": "standard", "heading_deg": 328.3, "pitch_deg": 28.4, "roll_deg": -12.4, "temperature_c": 22.3}
+    assert parse_line(line) == want
     assert parse_line(format_nmea(heading_deg=182.3)) == {"format": "nmea", "heading_deg": 182.3}
     with pytest.raises(TCM2FormatError) as err:
         parse_line(line.replace("*", "*0" if not line.split("*")[1].startswith("0") else "*1")[:-3] + "\r\n")
@@ -184,7 +185,11 @@ def test_tcm2_reads_and_switches_format(tcm2):
     assert reading["line"].startswith("$C123.4P1.0R-2.0")
     assert fake.received[:2] == [b"h", b"sdo=t"]
     fake.nmea = True
-    assert compass.read() == {"line": "$HCHDM,123.4,M*" + f"{checksum('HCHDM,123.4,M'):02X}", "format": "nmea", "heading_deg": 123.4}
+    assert compass.read() == {
+        "line": "$HCHDM,123.4,M*" + f"{checksum('HCHDM,123.4,M'):02X}",
+        "format": "nmea",
+        "heading_deg": 123.4,
+    }
 
 
 def test_tcm2_ignores_stale_streamed_words():

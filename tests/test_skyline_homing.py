@@ -3,11 +3,10 @@
 import numpy as np
 import pytest
 from omegaconf import OmegaConf
+from spectral_ctx import FakeContext
 
 from bionav.spectral.representations import representation_image, representation_names
 from bionav.stats import fisher_lda
-
-from spectral_ctx import FakeContext
 
 
 def test_representations():

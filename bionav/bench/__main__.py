@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from functools import partial
 
 import numpy as np
 
@@ -85,9 +86,9 @@ def main(argv=None) -> int:
             method, steps = _plugin(name, args.size, args.steps, compass, geometry)
             if compass:
                 method.config.compass_fraction = args.compass_fraction
-            prep_ms, _ = _time(lambda: method.prepare(snap), max(3, args.repeat // 5), warmup=1)
+            prep_ms, _ = _time(partial(method.prepare, snap), max(3, args.repeat // 5), warmup=1)
             s, c = method.prepare(snap), method.prepare(cur)
-            med, best = _time(lambda: method.home_vector(s, c), args.repeat)
+            med, best = _time(partial(method.home_vector, s, c), args.repeat)
             size = "x".join(map(str, args.size)) if name != "hiss" else "x".join(map(str, args.render_size))
             rows.append((name, size, steps, f"{args.compass_fraction:g}" if compass else "no",
                          f"{med:.2f}", f"{best:.2f}", f"{prep_ms:.2f}", str(numba.get_num_threads())))

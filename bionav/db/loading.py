@@ -5,7 +5,6 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-
 from bionav.db.config import DatabaseConfig
 from bionav.db.database import ImageDatabase
 from bionav.db.preprocess import preprocess_database, resize_database

@@ -253,7 +253,11 @@ def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) 
     pol_avg = np.array([np.angle(np.mean(np.exp(2j * pol[index == k]))) / 2 for k in steps])
     tcm2_avg = np.array([np.angle(np.mean(np.exp(1j * tcm2[index == k]))) for k in steps])
     avg_errors = heading_errors(pol_avg, tcm2_avg, axial=True)
-    metrics.update(heading_offset_deg=float(np.degrees(errors.offset)), averaged_rmse_deg=avg_errors.rmse_deg, n_positions=int(len(steps)))
+    metrics.update(
+        heading_offset_deg=float(np.degrees(errors.offset)),
+        averaged_rmse_deg=avg_errors.rmse_deg,
+        n_positions=int(len(steps)),
+    )
     if plots is not None:
         plots_mod.plot_vs_em(plots / "fig4_4_averaged.png", pol_avg - avg_errors.offset, tcm2_avg, averaged=True)
         plots_mod.plot_vs_em(plots / "fig4_5_raw.png", pol - errors.offset, tcm2, averaged=False)
@@ -303,8 +307,13 @@ def evector_scan_mode(session: Session, exp, *, unit_angles, plots=None, out_dir
         mean_angle = np.array([np.angle(np.mean(np.exp(2j * angle[index == k]))) / 2 for k in steps])
         mean_degree = np.array([degree[index == k].mean() for k in steps])
         plots_mod.plot_evector_field(
-            plots / "fig4_6_evector_field.png", pans[first], tilts[first], mean_angle, mean_degree,
-            model_angle[first], model_degree[first],
+            plots / "fig4_6_evector_field.png",
+            pans[first],
+            tilts[first],
+            mean_angle,
+            mean_degree,
+            model_angle[first],
+            model_degree[first],
         )
     return metrics
 
@@ -361,17 +370,21 @@ def partial_sky_mode(session: Session, exp, *, unit_angles, rng_scene, plots=Non
             zen = np.abs(tilts) < 1e-12
             zen_heading = zenith_heading(angle[zen], sun_azimuth=sun.azimuth) - pans[zen]
             zen_err = np.abs(wrap_axial(zen_heading - session.scene.mount_heading))
-            rows.append({
-                "sun_elevation_deg": elevation_deg,
-                "cloud_cover": cover,
-                "clear_fraction": clear,
-                "trial": trial,
-                "mount_heading_deg": float(np.degrees(session.scene.mount_heading)),
-                "scan_error_deg": float(np.degrees(abs(wrap_angle(fit.heading - session.scene.mount_heading)))) if np.isfinite(fit.heading) else float("nan"),
-                "scan_resolved": bool(fit.resolved),
-                "scan_points_used": int(fit.n_used),
-                "zenith_error_deg": float(np.degrees(np.sqrt(np.mean(zen_err**2)))) if zen.any() else float("nan"),
-            })
+            rows.append(
+                {
+                    "sun_elevation_deg": elevation_deg,
+                    "cloud_cover": cover,
+                    "clear_fraction": clear,
+                    "trial": trial,
+                    "mount_heading_deg": float(np.degrees(session.scene.mount_heading)),
+                    "scan_error_deg": float(np.degrees(abs(wrap_angle(fit.heading - session.scene.mount_heading))))
+                    if np.isfinite(fit.heading)
+                    else float("nan"),
+                    "scan_resolved": bool(fit.resolved),
+                    "scan_points_used": int(fit.n_used),
+                    "zenith_error_deg": float(np.degrees(np.sqrt(np.mean(zen_err**2)))) if zen.any() else float("nan"),
+                }
+            )
     errs = np.array([r["scan_error_deg"] for r in rows])
     failed = ~np.isfinite(errs)
     errs_f = np.where(failed, 180.0, errs)  # no usable patch at all: count as a half-turn error
@@ -429,8 +442,14 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
     else:
         true_mount = None if scene is None or mode == "partial_sky" else float(scene.mount_heading)
     session = Session(
-        sensor, devices.get("pantilt"), devices.get("reference"), write, scene, sun,
-        progress or (lambda it, desc="", total=None: it), true_mount,
+        sensor,
+        devices.get("pantilt"),
+        devices.get("reference"),
+        write,
+        scene,
+        sun,
+        progress or (lambda it, desc="", total=None: it),
+        true_mount,
     )
     write(
         SESSION_TOPIC,
@@ -515,7 +534,13 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             stack.callback(plugin.close)
             devices[role] = plugin
         metrics = run_session(
-            exp, devices, write=ctx.log.write, rng=rng_scene, scene=scene, plots=ctx.plots, out_dir=ctx.dir,
+            exp,
+            devices,
+            write=ctx.log.write,
+            rng=rng_scene,
+            scene=scene,
+            plots=ctx.plots,
+            out_dir=ctx.dir,
             progress=ctx.progress,
         )
     return metrics

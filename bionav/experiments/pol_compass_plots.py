@@ -60,7 +60,9 @@ def plot_vs_em(path: Path, pol, tcm2, *, averaged: bool) -> None:
     tcm2_deg = np.degrees(tcm2)
     pol_deg = (np.degrees(pol) - tcm2_deg + 90.0) % 180.0 - 90.0 + tcm2_deg  # show the candidate nearest the TCM2
     style = ".-" if averaged else "."
-    ax.plot(x, pol_deg, style, color="tab:blue", ms=4, label="polarized-light compass" + (" (mean of samples)" if averaged else ""))
+    ax.plot(
+        x, pol_deg, style, color="tab:blue", ms=4, label="polarized-light compass" + (" (mean of samples)" if averaged else "")
+    )
     ax.plot(x, tcm2_deg, style, color="tab:red", ms=4, label="TCM2")
     ax.set_xlabel("position" if averaged else "sample")
     ax.set_ylabel("heading (deg CCW from east)")

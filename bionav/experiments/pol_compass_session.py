@@ -119,7 +119,9 @@ def resolve_sun(sky, *, recorded_session: dict | None):
     from bionav.sky import SunPosition, sun_position
 
     if recorded_session is not None:
-        return SunPosition(float(recorded_session["sun_azimuth"]), float(recorded_session["sun_elevation"])), recorded_session.get("time_utc")
+        return SunPosition(
+            float(recorded_session["sun_azimuth"]), float(recorded_session["sun_elevation"])
+        ), recorded_session.get("time_utc")
     time = sky.get("time")
     if time is None:
         return SunPosition(np.deg2rad(float(sky.sun_azimuth_deg)), np.deg2rad(float(sky.sun_elevation_deg))), None

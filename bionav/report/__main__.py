@@ -10,7 +10,10 @@ from pathlib import Path
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m bionav.report",
-        description="Collect every run below DIR into summary.csv and summary.md (one row per run, failed ones included) and print the table.",
+        description=(
+            "Collect every run below DIR into summary.csv and summary.md "
+            "(one row per run, failed ones included) and print the table."
+        ),
     )
     parser.add_argument("dir", help="a sweep directory (multirun/...) or any directory holding runs")
     args = parser.parse_args(argv)

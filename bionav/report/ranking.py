@@ -199,7 +199,8 @@ def plot_per_snapshot(path: Path, ranked: Sequence[Mapping[str, Any]], *, db: st
     images = [None, None]
     for col, row in enumerate(shown):
         pos = np.asarray(row["positions"], dtype=int)
-        for r, (key, label, cmap, vmax) in enumerate((("rr_s", "RR$_s$", "viridis", 1.0), ("aae_s", "AAE$_s$ (rad)", "magma_r", np.pi / 2))):
+        panels = (("rr_s", "RR$_s$", "viridis", 1.0), ("aae_s", "AAE$_s$ (rad)", "magma_r", np.pi / 2))
+        for r, (key, label, cmap, vmax) in enumerate(panels):
             m = np.full((ny, nx), np.nan)
             m[pos[:, 1], pos[:, 0]] = [np.nan if v is None else v for v in row[key]]
             ax = axes[r, col]

@@ -172,6 +172,23 @@ def render_depth(scene: Scene | CompiledScene, *, position: Sequence[float], hea
     index = np.empty((el.size, az.size), np.int64)
     ox, oy, oz = (float(v) for v in position)
     pix = max(geometry.rad_per_column, geometry.rad_per_row)
-    _run_threads(threads, depth_kernel, ox, oy, oz, az, el, pix, cs.prim_kind, cs.prim_idx, cs.spheres, cs.boxes, cs.frusta, cs.ellipsoids,
-                 depth, kind, index)
+    _run_threads(
+        threads,
+        depth_kernel,
+        ox,
+        oy,
+        oz,
+        az,
+        el,
+        pix,
+        cs.prim_kind,
+        cs.prim_idx,
+        cs.spheres,
+        cs.boxes,
+        cs.frusta,
+        cs.ellipsoids,
+        depth,
+        kind,
+        index,
+    )
     return depth, kind, index

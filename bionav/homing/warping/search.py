@@ -199,7 +199,10 @@ def minwarping(
     matched with its best current-view column among those it can reach, with
     the scale plane their positions imply (:func:`~bionav.homing.warping.
     templates.minwarp_template`); the hypothesis with the smallest sum of these
-    minima wins.
+    minima wins. The minimum over a run of reachable columns that share a
+    plane is read from sliding minima of the column distances (at most two
+    reads per run; :func:`~bionav.homing.warping.templates.minwarp_windows`),
+    which gives the same match values as visiting every column.
 
     Parameters
     ----------

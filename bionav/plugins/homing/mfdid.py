@@ -49,7 +49,9 @@ class MfdidHoming(HomingMethod):
         super().__init__(config, geometry=geometry)
         from bionav.homing.imageops import resize_panorama
 
-        _, self.work_geometry = resize_panorama(np.zeros((geometry.height, geometry.width), np.float32), geometry, config.image_size)
+        _, self.work_geometry = resize_panorama(
+            np.zeros((geometry.height, geometry.width), np.float32), geometry, config.image_size
+        )
 
     def prepare(self, image: np.ndarray) -> dict:
         from bionav.homing.imageops import gaussian_lowpass, resize_panorama
@@ -70,7 +72,10 @@ class MfdidHoming(HomingMethod):
         from bionav.homing.mfdid import mfdid_home_vector
 
         v = mfdid_home_vector(
-            snapshot["image"], current["image"], geometry=self.work_geometry, current_derivative=current["d_theta"],
+            snapshot["image"],
+            current["image"],
+            geometry=self.work_geometry,
+            current_derivative=current["d_theta"],
             current_elevation_derivative=current.get("d_eps"),
         )
         if not np.any(v):

@@ -57,7 +57,9 @@ class SiftHoming(HomingMethod):
         super().__init__(config, geometry=geometry)
         from bionav.homing.imageops import resize_panorama
 
-        _, self.work_geometry = resize_panorama(np.zeros((geometry.height, geometry.width), np.float32), geometry, config.image_size)
+        _, self.work_geometry = resize_panorama(
+            np.zeros((geometry.height, geometry.width), np.float32), geometry, config.image_size
+        )
 
     def prepare(self, image: np.ndarray):
         from bionav.homing.imageops import resize_panorama

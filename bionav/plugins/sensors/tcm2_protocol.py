@@ -15,7 +15,16 @@ from __future__ import annotations
 import re
 
 _FIELD = re.compile(r"([CPRXYZTE])(-?\d+(?:\.\d*)?)")
-_FIELD_NAMES = {"C": "heading_deg", "P": "pitch_deg", "R": "roll_deg", "X": "bx_uT", "Y": "by_uT", "Z": "bz_uT", "T": "temperature_c", "E": "error_code"}
+_FIELD_NAMES = {
+    "C": "heading_deg",
+    "P": "pitch_deg",
+    "R": "roll_deg",
+    "X": "bx_uT",
+    "Y": "by_uT",
+    "Z": "bz_uT",
+    "T": "temperature_c",
+    "E": "error_code",
+}
 
 
 class TCM2FormatError(ValueError):

@@ -19,7 +19,7 @@ import numpy as np
 from bionav.world import textures as tx
 from bionav.world.lights import Ambient, DirectionalLight, sun_direction
 from bionav.world.scene import Scene, SkyFunction
-from bionav.world.sky import SUN_GAIN, SKY_GAIN, SimpleSky, band_albedos
+from bionav.world.sky import SKY_GAIN, SUN_GAIN, SimpleSky, band_albedos
 from bionav.world.worlds.common import World, stream
 from bionav.world.worlds.furniture import tree
 

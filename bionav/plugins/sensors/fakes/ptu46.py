@@ -101,7 +101,12 @@ class FakePTU46(FakeSerialDevice):
         if cmd in (b"PR", b"TR"):
             axis = "Pan" if cmd == b"PR" else "Tilt"
             return self._ok(f"{RESOLUTION_ARCSEC:.4f}", f"{axis} resolution is {RESOLUTION_ARCSEC:.4f} seconds arc per position")
-        limits = {b"PN": ("Minimum Pan", pn), b"PX": ("Maximum Pan", px), b"TN": ("Minimum Tilt", tn), b"TX": ("Maximum Tilt", tx)}
+        limits = {
+            b"PN": ("Minimum Pan", pn),
+            b"PX": ("Maximum Pan", px),
+            b"TN": ("Minimum Tilt", tn),
+            b"TX": ("Maximum Tilt", tx),
+        }
         if cmd in limits:
             label, value = limits[cmd]
             return self._ok(value, f"{label} position is {value}")
