@@ -1,11 +1,4 @@
-"""``python -m bionav.robot.replay RUN_DIR_OR_MCAP [--run K ...]``: replay logged cleaning runs.
-
-Rebuilds controller, homing method, layout and (for images that were not
-logged) the camera from the config attached to ``run.mcap``, feeds every
-logged observation back through the controller and checks that it emits the
-logged commands exactly. Exit status 0 when every run matches, 2 on the first
-mismatch (with a message saying where).
-"""
+"""Command line of :mod:`bionav.robot.replay`."""
 
 from __future__ import annotations
 
@@ -13,12 +6,14 @@ import argparse
 import sys
 from pathlib import Path
 
+_DESCRIPTION = "replay logged cleaning runs and check that the controller emits the logged commands"
+
 
 def main(argv: list[str] | None = None) -> int:
     from bionav.errors import UserError
     from bionav.experiments.cleaning import replay_log
 
-    parser = argparse.ArgumentParser(prog="python -m bionav.robot.replay", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m bionav.robot.replay", description=_DESCRIPTION)
     parser.add_argument("log", help="run.mcap of an experiment=cleaning run, or its run directory")
     parser.add_argument("--run", type=int, action="append", help="only this run (repeatable)")
     args = parser.parse_args(argv)
