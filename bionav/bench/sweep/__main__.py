@@ -1,9 +1,4 @@
-"""``python -m bionav.bench.sweep``: the same 4-job sweep with the basic and the joblib launcher.
-
-Each job is a grid-homing run (one worker thread per job, so the launcher is
-what parallelises); the sweep directories go to a temporary folder. Prints
-wall times and the speed-up. Needs ``pip install bionav[parallel]``.
-"""
+"""Command line of :mod:`bionav.bench.sweep`."""
 
 from __future__ import annotations
 
@@ -28,7 +23,10 @@ def _sweep(launcher_args: list[str], overrides: list[str], sweep_dir: Path) -> f
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m bionav.bench.sweep", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m bionav.bench.sweep",
+        description="time the same 4-job sweep with the basic and the joblib launcher",
+    )
     parser.add_argument("--homing", default="mfdid", help="homing method of the jobs (default: mfdid)")
     parser.add_argument("--db", default="sim_original", help="database (default: sim_original)")
     parser.add_argument("--sweep", default="homing.lowpass_sigma=0.02,0.03,0.04,0.05",
