@@ -6,14 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+from bionav.report.figures import pyplot, save_figure
 
 
 def plot_trajectories(path: Path, results, world, plan, *, title: str = "") -> None:
@@ -22,7 +15,7 @@ def plot_trajectories(path: Path, results, world, plan, *, title: str = "") -> N
 
     from bionav.robot.lanes import ideal_meander, to_plan_frame
 
-    plt = _plt()
+    plt = pyplot()
     (x0, y0), (x1, y1) = plan.target_rectangle()
     fig, ax = plt.subplots(figsize=(8, 8 * (y1 - y0 + 1.2) / (x1 - x0 + 1.2) + 0.8))
     segs = world.floor.segments
@@ -46,9 +39,7 @@ def plot_trajectories(path: Path, results, world, plan, *, title: str = "") -> N
     ax.set_ylabel("y (m)")
     ax.set_title(f"Trajectories of {len(results)} runs" + (f": {title}" if title else ""))
     ax.legend(fontsize=6, loc="upper right", ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)
 
 
 def _overlap_image(counts: np.ndarray) -> np.ndarray:
@@ -63,7 +54,7 @@ def plot_overlap_maps(path_one: Path, path_all: Path, results, raster, plan) -> 
     """Overlap map of the median run (fig. 7.3/7.4 bottom) and small maps of every run."""
     from matplotlib.patches import Rectangle
 
-    plt = _plt()
+    plt = pyplot()
     (x0, y0), (x1, y1) = plan.target_rectangle()
     cov = np.array([r.fractions["coverage"] for r in results])
     median = int(np.argsort(cov)[len(cov) // 2])
@@ -84,9 +75,7 @@ def plot_overlap_maps(path_one: Path, path_all: Path, results, raster, plan) -> 
     ax.set_ylabel("y (m)")
     fig.suptitle("Overlap analysis (white: uncleaned, light grey: cleaned once, dark grey: overlap); "
                  "coverage / overlap / uncovered", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path_one, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path_one, dpi=120)
 
     n = len(results)
     cols = min(5, n)
@@ -99,16 +88,14 @@ def plot_overlap_maps(path_one: Path, path_all: Path, results, raster, plan) -> 
         ax.axis("on")
         draw(ax, r)
         ax.tick_params(labelsize=6)
-    fig.tight_layout()
-    fig.savefig(path_all, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path_all, dpi=100)
 
 
 def plot_layout(path: Path, results, world, plan) -> None:
     """The layout in the world (fig. 7.2): obstacle outlines, target area, ideal meander, the median run."""
     from bionav.robot.lanes import ideal_meander, to_world_frame
 
-    plt = _plt()
+    plt = pyplot()
     segs = world.floor.segments
     fig, ax = plt.subplots(figsize=(7, 8))
     walls = world.floor.is_wall if world.floor.is_wall is not None else np.zeros(len(segs), bool)
@@ -128,6 +115,4 @@ def plot_layout(path: Path, results, world, plan) -> None:
     ax.set_ylabel("world y (m)")
     ax.set_title("Layout in the world" + (" (guide wall for the first lane)" if world.guide_wall else ""))
     ax.legend(fontsize=7, loc="upper right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)

@@ -19,6 +19,7 @@ from bionav.evaluation.measures import angular_errors, ideal_home_angles, qualit
 from bionav.evaluation.pairs import home_vector_matrix, prepare_images
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
 from bionav.experiments.grid_homing import evaluate_agents
+from bionav.report.figures import pyplot, save_figure
 
 #: settings of cfg.db that apply to every member of the family
 SHARED_DB_KEYS = ("image_size", "seed", "noise", "rotate_current", "rotation_seed")
@@ -49,10 +50,7 @@ def family_nodes(cfg: DictConfig) -> list[dict]:
 
 
 def _plot(path, matrices: dict[str, np.ndarray], names: list[str], title: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
     labels = {"aae": "AAE* (rad)", "mae": "MAE* (rad)", "rr": "RR*"}
@@ -71,9 +69,7 @@ def _plot(path, matrices: dict[str, np.ndarray], names: list[str], title: str) -
                 ax.text(j, i, f"{m[i, j]:.2f}", ha="center", va="center", fontsize=6, color="tab:red")
         fig.colorbar(im, ax=ax, shrink=0.8)
     fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:

@@ -7,14 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+from bionav.report.figures import pyplot, save_figure
 
 
 def plot_home_vector_field(
@@ -29,7 +22,7 @@ def plot_home_vector_field(
     success: np.ndarray | None = None,
 ) -> None:
     """Quiver plot of the home vectors towards one snapshot (grid frame, x right, y up)."""
-    plt = _pyplot()
+    plt = pyplot()
     nx, ny = grid_shape
     fig, ax = plt.subplots(figsize=(0.45 * nx + 2.0, 0.45 * ny + 1.2))
     ok = np.isfinite(angles)
@@ -50,9 +43,7 @@ def plot_home_vector_field(
     ax.set_xlabel("x (grid units)")
     ax.set_ylabel("y (grid units)")
     ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def plot_per_snapshot_maps(
@@ -65,7 +56,7 @@ def plot_per_snapshot_maps(
     title: str,
 ) -> None:
     """Heatmaps of AAE_s and RR_s over the grid, like thesis fig. 5.9 (missing cells blank)."""
-    plt = _pyplot()
+    plt = pyplot()
     nx, ny = grid_shape
     maps = []
     for values in (aae_s, rr_s):
@@ -80,6 +71,4 @@ def plot_per_snapshot_maps(
         ax.set_ylabel("y")
         fig.colorbar(im, ax=ax, shrink=0.8)
     fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)

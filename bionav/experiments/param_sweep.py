@@ -42,6 +42,7 @@ from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.evaluation.pairs import NEIGHBOUR_OFFSETS, HomeVectorMatrix
 from bionav.geometry import wrap_angle
+from bionav.report.figures import pyplot, save_figure
 
 ROWS_FILE = "param_sweep.jsonl"
 
@@ -273,10 +274,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
 
 
 def _plot_levels(path, rows: list[dict[str, Any]], *, title: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     key = "n_coeffs" if rows[0]["n_coeffs"] is not None and len(rows) > 1 else "rings"
     x = [r[key] if r[key] is not None else 0 for r in rows]
@@ -288,6 +286,4 @@ def _plot_levels(path, rows: list[dict[str, Any]], *, title: str) -> None:
     ax.legend()
     ax.grid(alpha=0.3)
     ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)

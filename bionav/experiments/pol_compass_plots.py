@@ -6,15 +6,13 @@ from pathlib import Path
 
 import numpy as np
 
+from bionav.report.figures import pyplot, save_figure
+
 UNIT_COLORS = ("tab:blue", "tab:green", "tab:red")  # the thesis' colours for POL-OP units 1-3
 
 
 def _figure(*args, **kwargs):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     return plt, *plt.subplots(*args, **kwargs)
 
 
@@ -28,9 +26,7 @@ def plot_unit_voltages(path: Path, angle_deg, mean_volts, *, xlabel: str) -> Non
     ax.set_ylabel("output voltage (V)")
     ax.legend()
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)
 
 
 def plot_rotation(path: Path, pans, heading, errors, *, axial: bool) -> None:
@@ -48,9 +44,7 @@ def plot_rotation(path: Path, pans, heading, errors, *, axial: bool) -> None:
     ax2.set_ylabel("heading error (deg)")
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)
 
 
 def plot_vs_em(path: Path, pol, tcm2, *, averaged: bool) -> None:
@@ -68,9 +62,7 @@ def plot_vs_em(path: Path, pol, tcm2, *, averaged: bool) -> None:
     ax.set_ylabel("heading (deg CCW from east)")
     ax.legend()
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)
 
 
 def plot_evector_field(path: Path, pans, tilts, angle, degree, model_angle, model_degree) -> None:
@@ -99,9 +91,7 @@ def plot_evector_field(path: Path, pans, tilts, angle, degree, model_angle, mode
         ax.set_aspect("equal")
         ax.set_title(f"e-vectors, {title} (bar length ~ degree)", fontsize=10)
         ax.set_xlabel("tilt (deg) along pan 0")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)
 
 
 def plot_partial_sky(path: Path, rows: list[dict]) -> None:
@@ -126,6 +116,4 @@ def plot_partial_sky(path: Path, rows: list[dict]) -> None:
     ax.set_yscale("log")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path, dpi=120)

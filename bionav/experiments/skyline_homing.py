@@ -27,6 +27,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.experiments.contrast_lda import _get
 from bionav.experiments.contrast_scan import learn_discriminants
+from bionav.report.figures import pyplot, save_figure
 
 CELL_TOPIC = "/skyline_homing/cell"
 
@@ -270,10 +271,7 @@ def _write_csv(path, rows, fields):
 
 
 def _plots(plots, counts, disc, reps, names, metrics, results, geometry):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from bionav.spectral.representations import representation_image
 
@@ -288,9 +286,7 @@ def _plots(plots, counts, disc, reps, names, metrics, results, geometry):
     ax.set_ylim(0, 1.05)
     ax.legend()
     ax.set_title(f"return ratio per representation (homing={metrics['homing']})")
-    fig.tight_layout()
-    fig.savefig(plots / "rr_per_representation.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, plots / "rr_per_representation.png", dpi=100)
     # RR* matrices per representation
     cols = min(5, len(reps))
     rws = int(np.ceil(len(reps) / cols))
@@ -303,9 +299,7 @@ def _plots(plots, counts, disc, reps, names, metrics, results, geometry):
     for ax in axes.ravel()[len(reps):]:
         ax.axis("off")
     fig.suptitle("RR*: rows snapshot condition, columns current condition", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(plots / "rr_matrices.png", dpi=90)
-    plt.close(fig)
+    save_figure(fig, plots / "rr_matrices.png", dpi=90)
     # the representations of the first position under every condition
     fig, axes = plt.subplots(len(reps), len(names), figsize=(3.2 * len(names), 0.9 * len(reps) + 0.5), squeeze=False)
     for i, r in enumerate(reps):
@@ -318,6 +312,4 @@ def _plots(plots, counts, disc, reps, names, metrics, results, geometry):
                 axes[i, j].set_ylabel(r, fontsize=7, rotation=0, ha="right")
             if i == 0:
                 axes[i, j].set_title(nm, fontsize=8)
-    fig.tight_layout()
-    fig.savefig(plots / "representations.png", dpi=80)
-    plt.close(fig)
+    save_figure(fig, plots / "representations.png", dpi=80)

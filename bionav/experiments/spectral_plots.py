@@ -6,14 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+from bionav.report.figures import pyplot, save_figure
 
 
 def _border(ax, lda, style, label):
@@ -51,7 +44,7 @@ def plot_pairs(samples, results, path, *, names=None, title="") -> Path:
     """All ten dual-channel scatter plots in an upper-triangle grid (fig. 6.4/6.5), or the given ``names`` in a row (fig. 6.3)."""
     from bionav.spectral.bands import CHANNELS
 
-    plt = _plt()
+    plt = pyplot()
     if names:
         fig, axes = plt.subplots(1, len(names), figsize=(4.2 * len(names), 4))
         for ax, n in zip(np.atleast_1d(axes), names):
@@ -70,9 +63,7 @@ def plot_pairs(samples, results, path, *, names=None, title="") -> Path:
         axes[0, 0].legend(fontsize=7, loc="best")
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
     return Path(path)
 
 
@@ -81,7 +72,7 @@ def plot_projection_histograms(samples, results, path, *, title="") -> Path:
 
     Bin width: range of the projected data divided by ``10 log10 N`` (as in the thesis).
     """
-    plt = _plt()
+    plt = pyplot()
     names = list(results)
     cols = 4
     rows = int(np.ceil(len(names) / cols))
@@ -101,15 +92,13 @@ def plot_projection_histograms(samples, results, path, *, title="") -> Path:
     axes.ravel()[0].legend(fontsize=6)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)
     return Path(path)
 
 
 def plot_criteria(results, path, *, title="") -> Path:
     """Bar chart of J and J_sigma per feature, ranked by J."""
-    plt = _plt()
+    plt = pyplot()
     names = sorted(results, key=lambda n: -results[n].J)
     x = np.arange(len(names))
     fig, ax = plt.subplots(figsize=(10, 3.5))
@@ -120,14 +109,12 @@ def plot_criteria(results, path, *, title="") -> Path:
     ax.legend()
     if title:
         ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
     return Path(path)
 
 
 def _image_grid(images: dict, path, *, title="", cmap="gray", cols=5):
-    plt = _plt()
+    plt = pyplot()
     names = list(images)
     rows = int(np.ceil(len(names) / cols))
     first = np.asarray(images[names[0]])
@@ -143,9 +130,7 @@ def _image_grid(images: dict, path, *, title="", cmap="gray", cols=5):
         ax.axis("off")
     if title:
         fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    save_figure(fig, path, dpi=90)
     return Path(path)
 
 
@@ -171,7 +156,7 @@ def plot_separation_images(separations: dict, path, *, title="") -> Path:
 
 def plot_separated_scatter(counts, is_sky, lda, path, *, title="", channels=(0, 4)) -> Path:
     """Pixels of a scan in a two-channel plane coloured by their classification (figs. 6.16/6.17)."""
-    plt = _plt()
+    plt = pyplot()
     x = counts[..., channels[0]].ravel()
     y = counts[..., channels[1]].ravel()
     sky = np.asarray(is_sky).ravel()
@@ -184,9 +169,7 @@ def plot_separated_scatter(counts, is_sky, lda, path, *, title="", channels=(0, 
     ax.legend(fontsize=7)
     if title:
         ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)
     return Path(path)
 
 
@@ -198,7 +181,7 @@ def plot_stability(rows, hours, path, *, separated: bool, measures=None) -> Path
     from bionav.spectral.bands import CHANNELS, dual_contrasts
     from bionav.spectral.stability import MEASURES
 
-    plt = _plt()
+    plt = pyplot()
     measures = list(measures or MEASURES)
     fig, axes = plt.subplots(len(measures), 2, figsize=(11, 2.6 * len(measures)), squeeze=False)
     groups = (("single channels", list(CHANNELS)), ("dual-channel contrasts", list(dual_contrasts())))
@@ -215,7 +198,5 @@ def plot_stability(rows, hours, path, *, separated: bool, measures=None) -> Path
         axes[row, 1].sharey(axes[row, 0])
     for ax in axes[-1]:
         ax.set_xlabel("hours after the first scan")
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    save_figure(fig, path, dpi=90)
     return Path(path)

@@ -19,6 +19,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Iterable, Mapping, Sequence
 
+from bionav.report.figures import pyplot
 from bionav.report.table import markdown_table
 
 ROWS_FILE = "param_sweep.jsonl"
@@ -185,10 +186,7 @@ def plot_per_snapshot(path: Path, ranked: Sequence[Mapping[str, Any]], *, db: st
     top : int
         How many signatures to show.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     import numpy as np
 
     shown = [r for r in ranked[:top] if r.get("positions")]
