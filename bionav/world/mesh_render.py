@@ -191,6 +191,33 @@ def _run(threads, kernel, *args):
         numba.set_num_threads(prev)
 
 
+def cast_mesh_directions(world: MeshWorld, *, position: Sequence[float], azimuths, elevations,
+                         threads: int | None = 1):
+    """Depth and hit index for the ray grid ``elevations x azimuths`` (any field of view).
+
+    Parameters
+    ----------
+    position : (x, y, z) in metres
+    azimuths : ndarray, shape (W,)
+        World azimuths, radians CCW from ``+x``.
+    elevations : ndarray, shape (H,)
+        Radians above the horizontal.
+
+    Returns
+    -------
+    depth, index : ndarray, shape (H, W)
+        As :func:`cast_mesh_rays`.
+    """
+    az = np.ascontiguousarray(azimuths, np.float64).ravel()
+    el = np.ascontiguousarray(elevations, np.float64).ravel()
+    depth = np.empty((el.size, az.size))
+    index = np.empty((el.size, az.size), np.int64)
+    ox, oy, oz = (float(v) for v in position)
+    _run(threads, cast_kernel, ox, oy, oz, az, el, *world._grid_args(), float(world.ground_z),
+         world.ground == "plane", depth, index)
+    return depth, index
+
+
 def cast_mesh_rays(world: MeshWorld, *, position: Sequence[float], heading: float = 0.0,
                    geometry: PanoramaGeometry, threads: int | None = 1):
     """Depth and what each pixel of a canonical panorama sees.
@@ -205,12 +232,7 @@ def cast_mesh_rays(world: MeshWorld, *, position: Sequence[float], heading: floa
     from bionav.world.render import ray_grid
 
     az, el = ray_grid(geometry, heading)
-    depth = np.empty((el.size, az.size))
-    index = np.empty((el.size, az.size), np.int64)
-    ox, oy, oz = (float(v) for v in position)
-    _run(threads, cast_kernel, ox, oy, oz, az, el, *world._grid_args(), float(world.ground_z),
-         world.ground == "plane", depth, index)
-    return depth, index
+    return cast_mesh_directions(world, position=position, azimuths=az, elevations=el, threads=threads)
 
 
 def render_mesh_panorama(world: MeshWorld, *, position: Sequence[float], heading: float = 0.0,
