@@ -189,7 +189,7 @@ def test_bad_input_gives_one_message_and_exit_2(tmp_path, args, needle):
 
 def test_route_homing_cli_small(tmp_path):
     proc = run_bionav("experiment=route_homing", "db.step_m=0.5", "db.image_size=[72,16]",
-                      "experiment.methods=[perfect_memory,windowed,homing]", "experiment.test_stride=4",
+                      "experiment.methods=[perfect_memory,windowed,zernike,homing]", "experiment.test_stride=4",
                       "experiment.offsets_m=[-0.2,0.0,0.2]", "experiment.agent_step_m=0.2",
                       "experiment.success_radius_m=0.4", "experiment.give_up_m=1.5",
                       f"hydra.run.dir={tmp_path / 'run'}", f"cache_dir={tmp_path}", cwd=tmp_path)
@@ -197,12 +197,12 @@ def test_route_homing_cli_small(tmp_path):
     run = tmp_path / "run"
     m = json.loads((run / "metrics.json").read_text())
     assert m["status"] == "completed" and m["routes"] == ["Ant1_Route1"]
-    for method in ("perfect_memory", "windowed", "homing"):
+    for method in ("perfect_memory", "windowed", "zernike", "homing"):
         assert 0 <= m[f"heading_error_{method}"] <= np.pi
         assert 0 <= m[f"completed_{method}"] <= 1 and m[f"route_distance_m_{method}"] >= 0
     # on the route itself perfect memory finds the stored view: the error is below one column (5 deg)
     assert m["heading_error_on_route_perfect_memory"] < np.deg2rad(5)
     rows = (run / "route_homing.csv").read_text().splitlines()
-    assert len(rows) == 4 and rows[0].startswith("route,method")
+    assert len(rows) == 5 and rows[0].startswith("route,method")
     for name in ("world_routes.png", "headings_Ant1_Route1.png", "error_map_Ant1_Route1.png"):
         assert (run / "plots" / name).stat().st_size > 1000

@@ -9,6 +9,10 @@ ant's recorded heading (:func:`bionav.db.mesh.route_database`). Methods
   rotation points (Baddeley et al. 2012, doi:10.1371/journal.pcbi.1002336);
 * ``windowed`` -- the same against the snapshots in a window ahead of the last
   best match (sequential perfect memory; open loop: around the true index);
+* ``zernike`` -- perfect memory on Zernike-moment amplitudes (rotation
+  invariant: one comparison per snapshot), heading from the phases of the best
+  snapshot's moments (Sun, Yue & Mangan 2020, doi:10.7554/eLife.54026;
+  :mod:`bionav.homing.signatures.zernike`);
 * ``homing`` -- the configured ``homing=`` method as a route follower: home
   to the snapshot ``lookahead`` views after the current best match (progress
   tracked by windowed RIDF); the agent's view is aligned with that snapshot
@@ -39,6 +43,7 @@ from __future__ import annotations
 
 import csv
 import math
+import zlib
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -48,7 +53,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav.errors import UserError
 from bionav.geometry import angular_difference, wrap_angle
 
-METHODS = ("perfect_memory", "windowed", "homing")
+METHODS = ("perfect_memory", "windowed", "zernike", "homing")
 PATH_TOPIC = "/route_homing/agent_path"
 PATH_SCHEMA = {
     "type": "object",
@@ -66,7 +71,7 @@ class RouteHomingConfig:
     """Typed ``experiment.*`` of ``route_homing`` (ranges checked by :meth:`validate`).
 
     routes : route names (``Ant<a>_Route<r>``); empty = ``db.route``.
-    methods : subset of ``perfect_memory``, ``windowed``, ``homing``.
+    methods : subset of ``perfect_memory``, ``windowed``, ``zernike``, ``homing``.
     offsets_m : lateral offsets of the open-loop test points, metres in [-5, 5]; must include 0.
     test_stride : every k-th route view is a test point, k >= 1.
     error_threshold_deg : catchment threshold, (0, 180].
@@ -79,6 +84,7 @@ class RouteHomingConfig:
     success_radius_m : route completed within this distance of its end, (0, 5] m.
     give_up_m : agent lost beyond this distance from the route, (0, 20] m.
     max_steps_factor : step budget = factor x route length / step, [1, 20].
+    zernike_order : highest moment order of the ``zernike`` method, 1..40.
     plots : write plots/.
     """
 
@@ -97,6 +103,7 @@ class RouteHomingConfig:
     success_radius_m: float = 0.2
     give_up_m: float = 1.0
     max_steps_factor: float = 2.0
+    zernike_order: int = 16
     plots: bool = True
 
     def validate(self) -> "RouteHomingConfig":
@@ -119,7 +126,8 @@ class RouteHomingConfig:
                   ("agent_step_m", self.agent_step_m, 1e-9, 1, "(0, 1] metres"),
                   ("success_radius_m", self.success_radius_m, 1e-9, 5, "(0, 5] metres"),
                   ("give_up_m", self.give_up_m, 1e-9, 20, "(0, 20] metres"),
-                  ("max_steps_factor", self.max_steps_factor, 1, 20, "[1, 20]")]
+                  ("max_steps_factor", self.max_steps_factor, 1, 20, "[1, 20]"),
+                  ("zernike_order", self.zernike_order, 1, 40, "1..40")]
         for key, value, lo, hi, text in checks:
             if not lo <= float(value) <= hi:
                 bad(key, value, text)
@@ -166,6 +174,23 @@ class _Follower:
         self.prepared = None
         if method == "homing":
             self.prepared = [homing.prepare(img) for img in setup.db.images]
+        if method == "zernike":
+            from bionav.plugins.signatures.zernike import Zernike
+
+            self.zernike = Zernike({"order": exp.zernike_order})
+            self.moments = np.array([self.zernike.moments(img)[0] for img in setup.db.images])
+            self.zindex = self.zernike.moments(setup.db.images[0])[1]
+
+    def zernike_heading(self, view0, lo: int = 0, hi: int | None = None):
+        """Best snapshot by moment amplitudes; heading from the phases (view0 looks along heading 0)."""
+        from bionav.homing.signatures.zernike import rotation_from_moments
+
+        hi = len(self.moments) if hi is None else hi
+        zc = self.zernike.moments(view0)[0]
+        d = ((np.abs(self.moments[lo:hi]) - np.abs(zc)[None]) ** 2).sum(axis=1)
+        k = lo + int(np.argmin(d))
+        delta = rotation_from_moments(zc, self.moments[k], self.zindex)  # heading(view0) - heading(snapshot k)
+        return float(wrap_angle(-delta)), k
 
     def ridf_heading(self, view0, lo: int = 0, hi: int | None = None):
         from bionav.evaluation.route import best_match
@@ -232,8 +257,11 @@ def open_loop(f: _Follower, render, exp: RouteHomingConfig, progress=None):
             else:
                 truth = float(s.heading[i])
                 view0 = render(p, 0.0)
-                lo, hi = (0, None) if f.method == "perfect_memory" else f.window_of(i, centred=True)
-                h, _k = f.ridf_heading(view0, lo, hi)
+                if f.method == "zernike":
+                    h, _k = f.zernike_heading(view0)
+                else:
+                    lo, hi = (0, None) if f.method == "perfect_memory" else f.window_of(i, centred=True)
+                    h, _k = f.ridf_heading(view0, lo, hi)
             est[a, b] = h
             err[a, b] = angular_difference(h, truth) if np.isfinite(h) else np.nan
     return stations, err, est
@@ -255,6 +283,8 @@ def closed_loop(f: _Follower, render, exp: RouteHomingConfig):
     for _ in range(max_steps):
         if f.method == "perfect_memory":
             heading, k_last = f.ridf_heading(render(pos, 0.0))
+        elif f.method == "zernike":
+            heading, k_last = f.zernike_heading(render(pos, 0.0))
         elif f.method == "windowed":
             lo, hi = f.window_of(k_last, centred=False)
             heading, k_last = f.ridf_heading(render(pos, 0.0), lo, hi)
@@ -305,7 +335,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         homing = make_homing(cfg, ctx, setup.geometry) if "homing" in exp.methods else None
         per_route[name] = {"setup": setup, "results": {}}
         for method in exp.methods:
-            rng = np.random.default_rng(np.random.SeedSequence([int(cfg.get("seed", 0)), len(rows)]))
+            key = zlib.crc32(f"{name}/{method}".encode())  # camera noise per route and method, whatever the order
+            rng = np.random.default_rng(np.random.SeedSequence([int(cfg.get("seed", 0)), key]))
             render = _make_renderer(setup, rng)
             f = _Follower(method, setup, exp, homing)
             stations, err, est = open_loop(f, render, exp, progress=lambda it, n=name, m=method: ctx.progress(
