@@ -206,3 +206,16 @@ def test_route_homing_cli_small(tmp_path):
     assert len(rows) == 5 and rows[0].startswith("route,method")
     for name in ("world_routes.png", "headings_Ant1_Route1.png", "error_map_Ant1_Route1.png"):
         assert (run / "plots" / name).stat().st_size > 1000
+
+
+def test_commands_in_docs_worlds_compose(tmp_path):
+    import re
+    import shlex
+
+    text = (ROOT / "docs" / "worlds.md").read_text()
+    commands = [c for c in re.findall(r"^python -m bionav (.+)$", text, flags=re.M)]
+    assert len(commands) >= 5
+    for cmd in commands:
+        args = [a for a in shlex.split(cmd.split("  #")[0])]
+        proc = run_bionav(*args, "--cfg", "job", cwd=tmp_path)
+        assert proc.returncode == 0, (cmd, proc.stderr[-1500:])
