@@ -195,19 +195,12 @@ def _render_views(world, positions: np.ndarray, headings: np.ndarray, geometry: 
 
 def _cached_render(name: str, params: dict, cache_dir, render: Callable[[], np.ndarray], noise: float, seed: int):
     """Render (or read) quantised uint8 images keyed by ``params``; returns (float images, cache path, from_cache)."""
-    from bionav.db.synthetic import _write_npz_atomic, cache_key, default_cache_dir, quantise
+    from bionav.db.synthetic import _write_npz_atomic, cache_key, default_cache_dir, quantise, read_cached_images
 
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     path = cdir / f"{name}-{key[:20]}.npz"
-    images_u8 = None
-    if path.exists():
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if str(z["key"]) == key:
-                    images_u8 = z["images"]
-        except (OSError, ValueError, KeyError):
-            images_u8 = None
+    images_u8 = read_cached_images(path, key)
     cached = images_u8 is not None
     if not cached:
         rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x6D657368]))

@@ -57,6 +57,12 @@ def _fill_grid(tri, x0, y0, cell, nx, ny, counts_only, starts, items, zlo, zhi):
     return fill
 
 
+def edge_form(triangles: np.ndarray) -> np.ndarray:
+    """Triangles as rows ``(a, b - a, c - a)``, shape ``(N, 9)`` (what the kernels intersect)."""
+    t = np.asarray(triangles, np.float64)
+    return np.ascontiguousarray(np.concatenate([t[:, 0], t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]], axis=1))
+
+
 def build_grid(triangles: np.ndarray, *, per_cell: float = TRIANGLES_PER_CELL):
     """Uniform ``x, y`` grid over a triangle soup.
 
@@ -100,14 +106,13 @@ def build_grid(triangles: np.ndarray, *, per_cell: float = TRIANGLES_PER_CELL):
 
 @njit(cache=True, inline="always")
 def _hit_triangle(ox, oy, oz, dx, dy, dz, tri, i, tmin, tmax):
-    """Möller-Trumbore: ray parameter of the hit with triangle ``i`` in ``(tmin, tmax)``, else INF."""
-    ax, ay, az = tri[i, 0, 0], tri[i, 0, 1], tri[i, 0, 2]
-    e1x = tri[i, 1, 0] - ax
-    e1y = tri[i, 1, 1] - ay
-    e1z = tri[i, 1, 2] - az
-    e2x = tri[i, 2, 0] - ax
-    e2y = tri[i, 2, 1] - ay
-    e2z = tri[i, 2, 2] - az
+    """Möller-Trumbore: ray parameter of the hit with triangle ``i`` in ``(tmin, tmax)``, else INF.
+
+    ``tri`` is the edge form of :func:`edge_form`: corner ``a`` and edges ``b - a``, ``c - a``.
+    """
+    ax, ay, az = tri[i, 0], tri[i, 1], tri[i, 2]
+    e1x, e1y, e1z = tri[i, 3], tri[i, 4], tri[i, 5]
+    e2x, e2y, e2z = tri[i, 6], tri[i, 7], tri[i, 8]
     px = dy * e2z - dz * e2y
     py = dz * e2x - dx * e2z
     pz = dx * e2y - dy * e2x
@@ -131,6 +136,16 @@ def _hit_triangle(ox, oy, oz, dx, dy, dz, tri, i, tmin, tmax):
     if t <= tmin or t >= tmax:
         return INF
     return t
+
+
+@njit(cache=True, inline="always")
+def _dda_axis(o, d, g0, i, cell):
+    """Grid walk along one axis: (step, ray parameter of the next cell boundary, parameter per cell)."""
+    if d > 0.0:
+        return 1, (g0 + (i + 1) * cell - o) / d, cell / d
+    if d < 0.0:
+        return -1, (g0 + i * cell - o) / d, -cell / d
+    return 0, INF, INF
 
 
 @njit(cache=True)
@@ -179,30 +194,8 @@ def trace_ray(ox, oy, oz, dx, dy, dz, tmax, tri, gx0, gy0, cell, nx, ny, starts,
     py = oy + dy * t0
     ix = min(max(int((px - gx0) / cell), 0), nx - 1)
     iy = min(max(int((py - gy0) / cell), 0), ny - 1)
-    if dx > 0.0:
-        stepx = 1
-        tnx = (gx0 + (ix + 1) * cell - ox) / dx
-        tdx = cell / dx
-    elif dx < 0.0:
-        stepx = -1
-        tnx = (gx0 + ix * cell - ox) / dx
-        tdx = -cell / dx
-    else:
-        stepx = 0
-        tnx = INF
-        tdx = INF
-    if dy > 0.0:
-        stepy = 1
-        tny = (gy0 + (iy + 1) * cell - oy) / dy
-        tdy = cell / dy
-    elif dy < 0.0:
-        stepy = -1
-        tny = (gy0 + iy * cell - oy) / dy
-        tdy = -cell / dy
-    else:
-        stepy = 0
-        tny = INF
-        tdy = INF
+    stepx, tnx, tdx = _dda_axis(ox, dx, gx0, ix, cell)
+    stepy, tny, tdy = _dda_axis(oy, dy, gy0, iy, cell)
     best = INF
     best_i = -1
     tc0 = t0

@@ -23,7 +23,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.geometry import PanoramaGeometry
 from bionav.world.mesh import TriangleMesh
-from bionav.world.mesh_kernels import build_grid, cast_kernel, vertical_kernel
+from bionav.world.mesh_kernels import build_grid, cast_kernel, edge_form, vertical_kernel
 
 #: Bump when a change to the mesh renderer changes pixels (invalidates cached databases).
 MESH_RENDERER_VERSION = 1
@@ -103,6 +103,7 @@ class MeshWorld:
             self.ground_z = 0.0 if self.ground == "plane" else float(self.mesh.bounds[0, 2])
         self.band_names = CHANNEL_SETS[self.channels]
         self.grid = build_grid(self.mesh.triangles)
+        self._edges = edge_form(self.mesh.triangles)
         se, ce = np.sin(self.sun_elevation), np.cos(self.sun_elevation)
         self.sun = np.array([ce * np.cos(self.sun_azimuth), ce * np.sin(self.sun_azimuth), se])
         if self.sky is None:
@@ -126,7 +127,7 @@ class MeshWorld:
 
     def _grid_args(self):
         g = self.grid
-        return (self.mesh.triangles, g["origin"][0], g["origin"][1], g["cell"], g["shape"][0], g["shape"][1],
+        return (self._edges, g["origin"][0], g["origin"][1], g["cell"], g["shape"][0], g["shape"][1],
                 g["starts"], g["items"], g["zlo"], g["zhi"], g["zmax"])
 
     def extent(self) -> np.ndarray:
