@@ -219,3 +219,23 @@ def test_commands_in_docs_worlds_compose(tmp_path):
         args = [a for a in shlex.split(cmd.split("  #")[0])]
         proc = run_bionav(*args, "--cfg", "job", cwd=tmp_path)
         assert proc.returncode == 0, (cmd, proc.stderr[-1500:])
+
+
+def test_route_database_views_sit_on_the_route_at_the_recorded_heading(tmp_path, world):
+    from bionav.config import compose
+    from bionav.db.loading import as_database_config
+    from bionav.db.mesh import route_database
+
+    cfg = compose(["db=seville_route", "db.route=Ant3_Route2", "db.step_m=0.5", "db.noise=0"])
+    db = route_database(as_database_config(cfg.db), cache_dir=tmp_path)
+    r = load_route("Ant3_Route2")
+    xy = np.asarray(db.meta["world_xy"])
+    assert len(db) == int(np.ceil(r.length_m / 0.5)) + 1 and db.grid_shape == (len(db), 1)
+    np.testing.assert_allclose(xy[0], r.xy[0])
+    np.testing.assert_allclose(xy[-1], r.xy[-1])
+    chords = np.linalg.norm(np.diff(xy[:-1], axis=0), axis=1)  # 0.5 m of path between views: chords <= 0.5
+    assert chords.max() <= 0.5 + 1e-9 and chords.mean() > 0.4
+    assert distance_to_route(xy, r.xy)[0].max() < 0.01
+    k = len(db) // 2
+    again = render_mesh_panorama(world, position=(*xy[k], 0.01), heading=float(db.headings[k]), geometry=db.geometry)
+    assert np.abs(again[..., 0] - db.images[k]).max() <= 0.5 / 255 + 1e-6  # noise 0: only 8-bit rounding
