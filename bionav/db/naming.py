@@ -82,9 +82,40 @@ def _natural_key(name: str):
     return [int(tok) if tok.isdigit() else tok.lower() for tok in re.split(r"(\d+)", name)]
 
 
+def _named_like_image(path: Path) -> bool:
+    return bool(VARDY_PATTERN.match(path.name) or MOELLER_PATTERN.match(path.name))
+
+
 def _listing(folder: Path) -> list[Path]:
-    return sorted((p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")),
+    """Regular files of a folder, plus anything named like a database image.
+
+    A directory, broken symlink or symlink loop named ``1_1.png`` is kept, so
+    the loader reports it instead of silently dropping its grid cell.
+    """
+    return sorted((p for p in folder.iterdir()
+                   if not p.name.startswith(".") and (p.is_file() or _named_like_image(p))),
                   key=lambda p: _natural_key(p.name))
+
+
+def not_a_file_reason(path: Path) -> str | None:
+    """Why ``path`` is not a readable regular file (directory, symlink loop, ...), or None."""
+    import errno
+    import os
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return "is a symbolic-link loop"
+        if path.is_symlink():
+            return f"is a symbolic link to {os.readlink(path)!r}, which does not exist"
+        return f"cannot be accessed ({exc.strerror or exc})"
+    if stat.S_ISDIR(mode):
+        return "is a directory, not an image file"
+    if not stat.S_ISREG(mode):
+        return "is not a regular file (a device, pipe or socket)"
+    return None
 
 
 def describe_schemes() -> str:
@@ -207,7 +238,7 @@ def read_moeller_db(path: Path) -> dict:
 
 def _scan_moeller(folder: Path, files: list[Path], *, grid_shape, bw_cutoff) -> Scan:
     matched, ignored = [], []
-    db_files = [p for p in files if p.suffix.lower() == ".db" and not _quiet(p)]
+    db_files = [p for p in files if p.suffix.lower() == ".db" and p.is_file() and not _quiet(p)]
     for path in files:
         match = MOELLER_PATTERN.match(path.name)
         if match:
@@ -306,7 +337,7 @@ def _scan_csv(folder: Path, files: list[Path]) -> Scan:
         rows = rows[1:]
     width = max(len(r) for r in rows) if rows else 0
     has_files = "filename" in columns and columns["filename"] < width
-    images = [p for p in files if p.suffix.lower() in IMAGE_EXTENSIONS]
+    images = [p for p in files if p.suffix.lower() in IMAGE_EXTENSIONS and p.is_file()]
     if not has_files and len(images) != len(rows):
         raise UserError(
             f"{table} has {len(rows)} position rows without file names, but {folder} holds "
