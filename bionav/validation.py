@@ -67,8 +67,8 @@ class Range:
     item: "Range | None" = None
     allow_inf: bool = False
 
-    def describe(self) -> str:
-        """The allowed values in words, e.g. ``a number > 0 and <= 10``."""
+    def describe(self, *, integer: bool = False) -> str:
+        """The allowed values in words, e.g. ``a finite number > 0 and <= 10`` (``an integer ...``)."""
         if self.choices is not None:
             return "one of " + ", ".join(str(c) for c in self.choices)
         parts = []
@@ -78,7 +78,7 @@ class Range:
             else:
                 parts.append(f"a list of {self.length} items")
             if self.item is not None:
-                parts.append("each " + self.item.describe())
+                parts.append("each " + self.item.describe(integer=integer))
             return ", ".join(parts)
         bounds = []
         if self.ge is not None:
@@ -89,7 +89,7 @@ class Range:
             bounds.append(f"<= {_fmt(self.le)}")
         if self.lt is not None:
             bounds.append(f"< {_fmt(self.lt)}")
-        text = "a finite number" if not self.allow_inf else "a number (not NaN)"
+        text = "an integer" if integer else ("a finite number" if not self.allow_inf else "a number (not NaN)")
         return text + (" " + " and ".join(bounds) if bounds else "")
 
     def problem(self, value: Any) -> str | None:
@@ -229,7 +229,9 @@ def check_config(config: Any, *, prefix: str) -> Any:
                     why = f"has an item {v!r} that {inner}"
                     break
         if why:
-            allowed = rng.describe() if rng is not None else "a finite number"
+            items = value if isinstance(value, (list, tuple)) else [value]
+            integer = bool(items) and all(isinstance(v, int) and not isinstance(v, bool) for v in items)
+            allowed = rng.describe(integer=integer) if rng is not None else "a finite number"
             raise UserError(
                 f"bad value {key}={_show(value)}: it {why}; allowed: {allowed}. "
                 f"Set {key} to an allowed value (default: {_default_text(field)})."

@@ -129,10 +129,10 @@ class ContrastScanConfig:
 
     name: str = "contrast_scan"
     times: list[str] = field(default_factory=_scan_times)
-    cloud_cover: list[float] = bounded([0.85, 0.9, 0.8, 0.85, 0.9, 0.75, 0.7, 0.8, 0.6, 0.45, 0.3, 0.2, 0.15, 0.1],
-                                       length=(1, 100_000), item=Range(ge=0.0, le=1.0))
-    cloud_optical_depth: list[float] = bounded([35, 40, 35, 45, 40, 35, 30, 35, 25, 20, 15, 12, 10, 10],
-                                               length=(1, 100_000), item=Range(ge=0.0, le=1000.0))
+    # one value, or a list with one value per time
+    cloud_cover: Any = bounded([0.85, 0.9, 0.8, 0.85, 0.9, 0.75, 0.7, 0.8, 0.6, 0.45, 0.3, 0.2, 0.15, 0.1],
+                               ge=0.0, le=1.0)
+    cloud_optical_depth: Any = bounded([35, 40, 35, 45, 40, 35, 30, 35, 25, 20, 15, 12, 10, 10], ge=0.0, le=1000.0)
     turbidity: float = bounded(0.1, ge=0.0, le=100.0)
     cloud_seed: int = bounded(0, ge=0, le=2**32 - 1)
     scene_seed: int = bounded(0, ge=0, le=2**32 - 1)

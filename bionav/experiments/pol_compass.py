@@ -429,6 +429,8 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
         Where figures and tables go (``None``: none written).
     progress : callable, optional
     """
+    if not (isinstance(exp, DictConfig) and OmegaConf.get_type(exp) is not dict):  # defaults and ranges
+        exp = experiment_config(OmegaConf.create({"experiment": exp}), "pol_compass")
     mode = str(exp.mode)
     if mode not in MODES:
         raise UserError(f"mode {mode!r} is unknown; choose one of {', '.join(MODES)} (mode=<name>).")

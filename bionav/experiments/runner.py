@@ -103,8 +103,8 @@ def validate_run_config(cfg: DictConfig) -> None:
 
     for group, kind in PLUGIN_NODES.items():
         node = cfg.get(group)
-        if node and node.get("name") and not node.get("broken"):
-            plugin_config(kind, node, key=group)
+        if node and node.get("name"):
+            plugin_config(kind, node, key=group)  # a broken or conflicting plugin raises its message
     if cfg.get("db") is not None:
         as_database_config(cfg.db)
     if cfg.get("experiment") is not None:
