@@ -213,8 +213,8 @@ def check_config(config: Any, *, prefix: str) -> Any:
         if dataclasses.is_dataclass(value) and not isinstance(value, type):
             check_config(value, prefix=key)
             continue
-        if value is None:
-            continue
+        if value is None or (isinstance(value, str) and "${" in value):
+            continue  # unset, or an interpolation not resolved yet (checked once resolved)
         rng = range_of(field)
         why = rng.problem(value) if rng is not None else None
         if why is None and rng is None:

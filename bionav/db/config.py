@@ -44,7 +44,9 @@ class DatabaseConfig:
     seed: int = bounded(0, ge=0, le=2**32 - 1)  # synthetic worlds: which world of this kind
     noise: float = bounded(0.01, ge=0.0, le=1.0)  # synthetic: camera noise std before 8-bit quantisation
     naming: str = bounded("auto", choices=("auto", "vardy", "moeller", "csv"))
-    azimuth: str = "clockwise"  # how azimuth grows with the column index on disk (checked by conventions)
+    # how azimuth grows with the column index on disk
+    azimuth: str = bounded("clockwise", choices=("clockwise", "counterclockwise", "cw", "ccw", "anticlockwise",
+                                                 "counter-clockwise"))
     x_axis_column: float = bounded(0.0, ge=-100_000.0, le=100_000.0)  # on-disk column along the grid's +x axis
     horizon_row: Optional[float] = bounded(None, ge=-100_000.0, le=100_000.0)  # on-disk horizon row; None = middle
     rad_per_row: Optional[float] = bounded(None, gt=0.0, le=1.0)  # vertical angle per pixel; None = horizontal's

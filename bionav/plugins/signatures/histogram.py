@@ -33,7 +33,7 @@ class HistogramConfig:
 
     rings: int = bounded(20, ge=1, le=1000)
     bins: int = bounded(16, ge=2, le=4096)
-    bin_range: str = "unit"
+    bin_range: str = bounded("unit", choices=("unit", "image"))
 
 
 def _value_range(signature):
