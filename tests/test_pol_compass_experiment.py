@@ -20,8 +20,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def experiment_config(mode: str, **overrides):
     """``cfg.experiment`` as conf/experiment/pol_compass.yaml + conf/mode/<mode>.yaml compose it."""
-    exp = OmegaConf.load(ROOT / "conf" / "experiment" / "pol_compass.yaml").experiment
-    exp = OmegaConf.merge(exp, OmegaConf.load(ROOT / "conf" / "mode" / f"{mode}.yaml").experiment)
+    exp = OmegaConf.load(ROOT / "bionav" / "conf" / "experiment" / "pol_compass.yaml").experiment
+    exp = OmegaConf.merge(exp, OmegaConf.load(ROOT / "bionav" / "conf" / "mode" / f"{mode}.yaml").experiment)
     for key, value in overrides.items():
         OmegaConf.update(exp, key, value, merge=False)
     return exp

@@ -6,11 +6,11 @@ import pytest
 from bionav.db.synthetic import (
     SYNTHETIC_DATABASES,
     available_databases,
-    cache_key,
     get_spec,
     synthetic_database,
 )
 from bionav.errors import UserError
+from bionav.files import cache_key
 from bionav.geometry import TWO_PI
 from bionav.world.render import render_depth, render_panorama
 

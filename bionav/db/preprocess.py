@@ -1,6 +1,6 @@
 """Image preprocessing of thesis 5.2.1: Butterworth low-pass, edge filter, histogram equalisation, resize.
 
-The thesis' presets (``preprocess=`` on the command line, ``conf/preprocess``):
+The thesis' presets (``preprocess=`` on the command line, ``bionav/conf/preprocess``):
 
 ======  ==========================================================
 none    no preprocessing
