@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from bionav.light import SkyModel, SunPosition
 from bionav.polcompass import (
     ChainParameters,
     CompassOptics,
@@ -26,7 +27,6 @@ from bionav.polcompass import (
     zenith_heading,
 )
 from bionav.polcompass.optics import cone_samples, sensor_frame
-from bionav.sky import SkyModel, SunPosition
 
 ALPHA = np.array([0.0, np.pi / 3, 2 * np.pi / 3])
 

@@ -3,11 +3,9 @@
 import numpy as np
 import pytest
 
-from bionav.spectral.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
-from bionav.spectral.materials import MATERIALS
-from bionav.spectral.sensor_model import LogSensorModel
-from bionav.spectral.sky import (
-    CloudField,
+from bionav.light.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
+from bionav.light.clouds import CloudLayer
+from bionav.light.daylight import (
     SkyState,
     clear_sky_radiance,
     direction,
@@ -17,6 +15,8 @@ from bionav.spectral.sky import (
     sky_radiance,
     solar_spectrum,
 )
+from bionav.light.materials import MATERIALS
+from bionav.spectral.sensor_model import LogSensorModel
 
 
 def test_band_peaks_and_bandwidths_match_table_6_1():
@@ -83,7 +83,7 @@ def test_single_scattering_thin_limit():
 
 
 def test_cloud_field_cover_fraction_and_motion():
-    field = CloudField(cover=0.4, optical_depth=20.0, seed=3, softness=0.01)
+    field = CloudLayer(cover=0.4, optical_depth=20.0, seed=3, softness=0.01)
     rng = np.random.default_rng(0)
     v = rng.normal(size=(20000, 3))
     v[:, 2] = np.abs(v[:, 2]) + 0.3

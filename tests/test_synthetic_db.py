@@ -199,7 +199,7 @@ def test_apartment_free_area_is_free():
 
 
 def test_campus_renders_five_bands_with_caller_albedos_and_sky():
-    from bionav.world.sky import BAND_ALBEDO
+    from bionav.light.materials import BAND_ALBEDO
     from bionav.world.worlds.outdoor import build_campus
 
     bands = ("UV", "B", "G", "R", "IR")

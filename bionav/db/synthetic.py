@@ -30,7 +30,6 @@ sim_uni         10x17   1.0 m   170      normal  outdoors: buildings, trees, sky
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable

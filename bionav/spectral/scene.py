@@ -3,13 +3,13 @@
 :class:`OutdoorScene` ray-casts viewing directions against a handful of
 analytic primitives (ground plane, yawed boxes, ellipsoids, vertical
 cylinders, a distant tree line) and shades the hits with the spectral daylight
-of :mod:`bionav.spectral.sky`:
+of :mod:`bionav.light.daylight`:
 
 ``L_b = rho_b * tex * (sunlit * cos_i * E_dir_b + (1 + n_z)/2 * E_diff_b + (1 - n_z)/2 * a_g * E_glob_b) / pi``
 
 attenuated towards the sensor by the air (extinction per band) plus airlight
 (horizon sky radiance); lines of sight that hit nothing get the sky radiance
-with clouds. ``rho_b`` comes from :data:`bionav.spectral.materials.MATERIALS`
+with clouds. ``rho_b`` comes from :data:`bionav.light.materials.MATERIALS`
 (reflectance constant within each channel), ``tex`` is a smooth multiplicative
 texture (log-normal, per material), shadows are cast by every primitive except
 the ground, foliage is lit in patches (sun flecks).
@@ -28,9 +28,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from bionav.spectral.bands import PEAK_NM, band_integrate
-from bionav.spectral.materials import MATERIALS
-from bionav.spectral.sky import (
+from bionav.light.bands import PEAK_NM, band_integrate
+from bionav.light.daylight import (
     SkyState,
     aerosol_optical_depth,
     band_sky_radiance,
@@ -38,6 +37,7 @@ from bionav.spectral.sky import (
     illumination,
     rayleigh_optical_depth,
 )
+from bionav.light.materials import MATERIALS
 
 _MISS = np.inf
 

@@ -1,4 +1,4 @@
-"""Sun position from time and place (PyEphem), in bionav's sky frame.
+"""Sun position from time and place (PyEphem), in bionav's sky frame; the one time parser.
 
 Sky frame
 ---------
@@ -17,6 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.errors import UserError
+
+#: Bielefeld, Germany, where the thesis' spectral samples and scans were taken (degrees).
+BIELEFELD_LAT_DEG = 52.02
+BIELEFELD_LON_DEG = 8.53
 
 
 @dataclass(frozen=True)
@@ -77,24 +81,46 @@ def azimuth_to_compass(azimuth):
     return np.mod(np.pi / 2.0 - np.asarray(azimuth), 2.0 * np.pi)
 
 
-def parse_time(when) -> _dt.datetime:
-    """A timezone-aware UTC datetime from a datetime or an ISO-8601 string.
+def parse_time(when, *, what: str = "The time", naive_utc: bool = True) -> _dt.datetime:
+    """A timezone-aware datetime from a datetime, a ``numpy.datetime64`` or an ISO-8601 string.
 
-    Naive datetimes and strings without an offset are taken as UTC.
+    Parameters
+    ----------
+    when : datetime, numpy.datetime64 or str
+        The time. ``numpy.datetime64`` values carry no zone and count as UTC.
+    what : str, optional
+        How error messages name the value (e.g. ``"experiment.times[2]"``).
+    naive_utc : bool, optional
+        Take a time without offset as UTC (default); if false, such a time is
+        an error asking for the offset.
+
+    Returns
+    -------
+    datetime
+        Aware, in the offset it was given in (UTC when it had none).
+
+    Raises
+    ------
+    UserError
+        Unparseable text, or a naive time when ``naive_utc`` is false.
     """
-    if isinstance(when, _dt.datetime):
+    if isinstance(when, np.datetime64):
+        t = when.astype("datetime64[us]").item().replace(tzinfo=_dt.timezone.utc)
+    elif isinstance(when, _dt.datetime):
         t = when
     else:
         try:
             t = _dt.datetime.fromisoformat(str(when))
         except ValueError:
             raise UserError(
-                f"The time {when!r} is not an ISO-8601 date and time; write it like "
-                "'2009-08-04T12:30:00+02:00' (a time without offset is taken as UTC)."
+                f"{what} {when!r} is not an ISO-8601 date and time; write it like "
+                "'2009-08-04T12:30:00+02:00'" + (" (a time without offset is taken as UTC)." if naive_utc else ".")
             ) from None
     if t.tzinfo is None:
+        if not naive_utc:
+            raise UserError(f"{what} {when!r} has no time zone; append its offset, e.g. +02:00.")
         t = t.replace(tzinfo=_dt.timezone.utc)
-    return t.astimezone(_dt.timezone.utc)
+    return t
 
 
 def sun_position(when, *, latitude_deg: float, longitude_deg: float, elevation_m: float = 0.0) -> SunPosition:
@@ -106,8 +132,8 @@ def sun_position(when, *, latitude_deg: float, longitude_deg: float, elevation_m
 
     Parameters
     ----------
-    when : datetime or str
-        Time of observation; naive values are UTC.
+    when : datetime, numpy.datetime64 or str
+        Time of observation (see :func:`parse_time`); naive values are UTC.
     latitude_deg, longitude_deg : float
         Geodetic latitude (north positive) and longitude (east positive) in
         degrees.
@@ -123,7 +149,7 @@ def sun_position(when, *, latitude_deg: float, longitude_deg: float, elevation_m
 
     if not -90.0 <= latitude_deg <= 90.0:
         raise UserError(f"Latitude {latitude_deg} deg is outside [-90, 90]; give the observer's latitude in degrees north.")
-    t = parse_time(when)
+    t = parse_time(when).astimezone(_dt.timezone.utc)
     observer = ephem.Observer()
     observer.lat = np.deg2rad(latitude_deg)
     observer.lon = np.deg2rad(longitude_deg)
