@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from bionav.geometry import wrap_axial
 from bionav.light import SkyModel, SunPosition
 from bionav.polcompass import (
     ChainParameters,
@@ -23,7 +24,6 @@ from bionav.polcompass import (
     solve_pose,
     two_unit_evector,
     volts_to_decades,
-    wrap_axial,
     zenith_heading,
 )
 from bionav.polcompass.optics import cone_samples, sensor_frame

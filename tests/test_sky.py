@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from bionav.geometry import direction_from_angles
 from bionav.light import (
     PolarizerLamp,
     SkyModel,
@@ -10,7 +11,6 @@ from bionav.light import (
     angle_in_frame,
     berry_polarization,
     cie_relative_radiance,
-    direction_from_angles,
     max_degree_from_turbidity,
     random_cloud_map,
     rayleigh_polarization,

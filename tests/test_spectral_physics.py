@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
+from bionav.geometry import direction_from_angles
 from bionav.light.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import (
     SkyState,
     clear_sky_radiance,
-    direction,
     illumination,
     rayleigh_optical_depth,
     relative_air_mass,
@@ -77,7 +77,7 @@ def test_single_scattering_thin_limit():
     wl = np.array([800.0])
     state = SkyState(np.deg2rad(90.0), turbidity=1e-9)
     tau = rayleigh_optical_depth(wl)
-    d = direction(np.deg2rad(89.999), 0.0)
+    d = direction_from_angles(0.0, np.deg2rad(89.999))
     expected = solar_spectrum(wl) * tau * 0.75 * 2 / (4 * np.pi) * np.exp(-tau)
     assert clear_sky_radiance(state, d, wl)[0] == pytest.approx(expected[0], rel=0.01)
 

@@ -230,7 +230,7 @@ def rotation_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=Non
 def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
     """``vs_em_compass``: the polarized-light compass against the TCM2 (figs. 4.4, 4.5)."""
     from bionav.experiments import pol_compass_plots as plots_mod
-    from bionav.light.sun import compass_to_azimuth
+    from bionav.geometry import compass_to_azimuth
     from bionav.polcompass import counts_to_volts, heading_errors, zenith_heading
 
     lo, hi, tlo, thi = session.pantilt.limits()
@@ -277,7 +277,8 @@ def _scan_poses(session: Session, node, *, pan_step_deg: float):
 def evector_scan_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
     """``evector_scan``: a pan/tilt grid over the sky (fig. 4.6) against the sky model."""
     from bionav.experiments import pol_compass_plots as plots_mod
-    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, wrap_axial
+    from bionav.geometry import wrap_axial
+    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading
 
     poses = _scan_poses(session, exp.scan, pan_step_deg=float(exp.scan.pan_step_deg))
     cal = _rotation_calibration(session, exp, unit_angles=unit_angles, out_dir=out_dir)
@@ -339,9 +340,9 @@ def _rotation_calibration(session: Session, exp, *, unit_angles, out_dir):
 def partial_sky_mode(session: Session, exp, *, unit_angles, rng_scene, plots=None, out_dir=None) -> dict:
     """``partial_sky`` (thesis 9.1): heading error against clear-sky fraction and sun elevation."""
     from bionav.experiments import pol_compass_plots as plots_mod
-    from bionav.geometry import wrap_angle
+    from bionav.geometry import wrap_angle, wrap_axial
     from bionav.light import SunPosition
-    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, wrap_axial, zenith_heading
+    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, zenith_heading
 
     if session.scene is None:
         raise UserError(

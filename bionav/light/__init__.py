@@ -33,7 +33,7 @@ from bionav.light.rayleigh import (
     rayleigh_polarization,
     scattering_angle,
 )
-from bionav.light.sun import SunPosition, direction_from_angles, parse_time, sun_position
+from bionav.light.sun import SunPosition, parse_time, sun_position
 
 __all__ = [
     "CloudLayer",
@@ -45,7 +45,6 @@ __all__ = [
     "angle_in_frame",
     "berry_polarization",
     "cie_relative_radiance",
-    "direction_from_angles",
     "max_degree_from_turbidity",
     "parse_time",
     "random_cloud_map",

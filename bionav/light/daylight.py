@@ -43,6 +43,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from bionav.geometry import direction_from_angles
 from bionav.light.bands import WAVELENGTHS_NM, band_integrate
 from bionav.light.clouds import CloudLayer
 from bionav.light.sun import BIELEFELD_LAT_DEG, BIELEFELD_LON_DEG, parse_time, sun_position
@@ -80,13 +81,6 @@ def relative_air_mass(elevation) -> np.ndarray:
     h = np.maximum(np.asarray(elevation, dtype=float), np.deg2rad(-1.0))
     h_deg = np.rad2deg(h)
     return 1.0 / (np.sin(h) + 0.50572 * (h_deg + 6.07995) ** -1.6364)
-
-
-def direction(elevation, azimuth) -> np.ndarray:
-    """Unit vector(s) ``(..., 3)`` east-north-up for elevation/azimuth in radians (azimuth CCW from east)."""
-    el = np.asarray(elevation, dtype=float)
-    az = np.asarray(azimuth, dtype=float)
-    return np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)), axis=-1)
 
 
 @dataclass(frozen=True)
@@ -137,7 +131,7 @@ class SkyState:
     @property
     def sun_direction(self) -> np.ndarray:
         """Unit vector towards the sun, shape ``(3,)``."""
-        return direction(self.sun_elevation, self.sun_azimuth)
+        return direction_from_angles(self.sun_azimuth, self.sun_elevation)
 
 
 def _optical_depths(state: SkyState, wl):
@@ -275,7 +269,7 @@ def illumination(state: SkyState, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.
     el = (np.arange(n_elevation) + 0.5) * (np.pi / 2) / n_elevation
     az = (np.arange(n_azimuth) + 0.5) * 2 * np.pi / n_azimuth
     ee, aa = np.meshgrid(el, az, indexing="ij")
-    dirs = direction(ee, aa)
+    dirs = direction_from_angles(aa, ee)
     rad = sky_radiance(state, dirs, wl, origin_m=origin_m)
     d_omega = np.cos(ee) * (np.pi / 2 / n_elevation) * (2 * np.pi / n_azimuth)
     weight = (np.sin(ee) * d_omega)[..., None]

@@ -15,11 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bionav.geometry import direction_from_angles
 from bionav.light.clouds import CloudMap
 from bionav.light.neutral_points import berry_polarization
 from bionav.light.radiance import cie_relative_radiance
 from bionav.light.rayleigh import perpendicular, rayleigh_polarization
-from bionav.light.sun import SunPosition, direction_from_angles
+from bionav.light.sun import SunPosition
 
 
 @dataclass(frozen=True)

@@ -2,11 +2,10 @@
 
 Sky frame
 ---------
-A local east-north-up frame: ``x`` east, ``y`` north, ``z`` up (zenith).
-*Azimuth* is measured counter-clockwise from east seen from above (the
-mathematical convention of :mod:`bionav.geometry`, **not** the compass
-convention clockwise from north); *elevation* is positive above the horizon.
-Angles are radians.
+The ENU frame of :mod:`bionav.geometry`: ``x`` east, ``y`` north, ``z`` up
+(zenith). *Azimuth* is measured counter-clockwise from east seen from above
+(**not** the compass convention clockwise from north); *elevation* is
+positive above the horizon. Angles are radians.
 """
 
 from __future__ import annotations
@@ -17,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.errors import UserError
+from bionav.geometry import compass_to_azimuth, direction_from_angles
 
 #: Bielefeld, Germany, where the thesis' spectral samples and scans were taken (degrees).
 BIELEFELD_LAT_DEG = 52.02
@@ -42,43 +42,6 @@ class SunPosition:
     def direction(self) -> np.ndarray:
         """Unit vector towards the sun, shape ``(3,)``, sky frame (ENU)."""
         return direction_from_angles(self.azimuth, self.elevation)
-
-
-def direction_from_angles(azimuth, elevation):
-    """Unit vectors from azimuth and elevation.
-
-    Parameters
-    ----------
-    azimuth, elevation : float or ndarray
-        Radians; azimuth counter-clockwise from east, elevation above the
-        horizon. Broadcast against each other.
-
-    Returns
-    -------
-    ndarray, shape ``(..., 3)``
-        ``(cos e cos a, cos e sin a, sin e)`` in the sky frame (ENU).
-    """
-    azimuth, elevation = np.broadcast_arrays(np.asarray(azimuth, float), np.asarray(elevation, float))
-    ce = np.cos(elevation)
-    return np.stack([ce * np.cos(azimuth), ce * np.sin(azimuth), np.sin(elevation)], axis=-1)
-
-
-def angles_from_direction(direction):
-    """Azimuth (CCW from east) and elevation of direction vectors, shape ``(..., 3)``."""
-    d = np.asarray(direction, float)
-    azimuth = np.arctan2(d[..., 1], d[..., 0])
-    elevation = np.arctan2(d[..., 2], np.hypot(d[..., 0], d[..., 1]))
-    return azimuth, elevation
-
-
-def compass_to_azimuth(bearing):
-    """Convert a compass bearing (clockwise from north) to an azimuth CCW from east (radians)."""
-    return np.pi / 2.0 - np.asarray(bearing)
-
-
-def azimuth_to_compass(azimuth):
-    """Convert an azimuth CCW from east to a compass bearing clockwise from north, in ``[0, 2 pi)``."""
-    return np.mod(np.pi / 2.0 - np.asarray(azimuth), 2.0 * np.pi)
 
 
 def parse_time(when, *, what: str = "The time", naive_utc: bool = True) -> _dt.datetime:

@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bionav.geometry import wrap_angle
-from bionav.polcompass.compass import choose_candidate, wrap_axial
+from bionav.geometry import wrap_angle, wrap_axial
+from bionav.polcompass.compass import choose_candidate
 from bionav.polcompass.optics import CompassOptics
 
 

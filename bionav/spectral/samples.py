@@ -27,13 +27,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bionav.geometry import direction_from_angles
 from bionav.light.bands import CHANNELS, PEAK_NM, band_integrate
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import (
     SkyState,
     aerosol_optical_depth,
     band_sky_radiance,
-    direction,
     illumination,
     rayleigh_optical_depth,
 )
@@ -162,7 +162,7 @@ def _sky_samples(rng, n, ranges, sensor, n_average):
         state, cloud_kind = weather.state(t, el, az)
         while True:
             v_el = np.arcsin(rng.uniform(np.sin(np.deg2rad(10)), np.sin(np.deg2rad(88))))
-            v = direction(v_el, rng.uniform(0, 2 * np.pi))
+            v = direction_from_angles(rng.uniform(0, 2 * np.pi), v_el)
             if v @ state.sun_direction < np.cos(np.deg2rad(20.0)):
                 break
         rad = band_sky_radiance(state, v)
@@ -184,8 +184,10 @@ def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average):
         mat = MATERIALS[names[rng.choice(len(names), p=p / p.sum())]]
         rho = mat.sample(rng)[0]
         # viewing direction (sensor -> object), roughly horizontal
-        view = direction(np.deg2rad(rng.uniform(-35.0, 5.0)), rng.uniform(0, 2 * np.pi))
-        normal = direction(np.deg2rad(rng.uniform(0.0, 90.0)), rng.uniform(0, 2 * np.pi))
+        view_el = np.deg2rad(rng.uniform(-35.0, 5.0))  # draws: elevation, then azimuth
+        view = direction_from_angles(rng.uniform(0, 2 * np.pi), view_el)
+        normal_el = np.deg2rad(rng.uniform(0.0, 90.0))
+        normal = direction_from_angles(rng.uniform(0, 2 * np.pi), normal_el)
         if normal @ view > 0:  # make the surface face the sensor
             normal = normal * np.array([-1.0, -1.0, 1.0])
         in_shadow = rng.random() < 0.3
@@ -201,7 +203,7 @@ def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average):
                 rad = rad + gloss * 0.15 * band_integrate(ill.global_horizontal) / np.pi
         d = rng.uniform(*distance_m)
         trans = np.exp(-_extinction_per_m(state.turbidity) * d)
-        horizon = band_sky_radiance(state, direction(np.deg2rad(1.0), np.arctan2(-view[1], -view[0]) + np.pi))
+        horizon = band_sky_radiance(state, direction_from_angles(np.arctan2(-view[1], -view[0]) + np.pi, np.deg2rad(1.0)))
         rad = rad * trans + horizon * (1 - trans)
         counts.append(sensor.read(rad, rng=rng, n_readings=n_average)[..., :5].mean(axis=0))
         kinds.append(mat.name)

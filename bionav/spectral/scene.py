@@ -28,12 +28,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from bionav.geometry import direction_from_angles
 from bionav.light.bands import PEAK_NM, band_integrate
 from bionav.light.daylight import (
     SkyState,
     aerosol_optical_depth,
     band_sky_radiance,
-    direction,
     illumination,
     rayleigh_optical_depth,
 )
@@ -175,7 +175,7 @@ class OutdoorScene:
 
     def view_direction(self, pan, tilt) -> np.ndarray:
         """Unit viewing direction(s) ``(..., 3)`` for pan/tilt in radians."""
-        return direction(tilt, self.pan_zero_azimuth + np.asarray(pan))
+        return direction_from_angles(self.pan_zero_azimuth + np.asarray(pan), tilt)
 
     # -- geometry ------------------------------------------------------------------------
     def _intersect(self, o, d, *, shadow=False):
@@ -340,7 +340,7 @@ class OutdoorScene:
                     + aerosol_optical_depth(np.asarray(PEAK_NM), beta=self.sky.turbidity) / 1200.0)
             trans = np.exp(-beta * t[hit, None])
             az = np.arctan2(d[hit, 1], d[hit, 0])
-            horizon = band_sky_radiance(self.sky, direction(np.deg2rad(2.0), az), origin_m=origin_xy)
+            horizon = band_sky_radiance(self.sky, direction_from_angles(az, np.deg2rad(2.0)), origin_m=origin_xy)
             out[hit] = rad * trans + horizon * (1 - trans)
         return out.reshape(shape + (5,)), sky.reshape(shape)
 
@@ -477,4 +477,4 @@ def render_spectral_panorama(scene: OutdoorScene, geometry, *, position, heading
     az = heading + geometry.column_azimuths()
     el = geometry.row_elevations()
     ee, aa = np.meshgrid(el, az, indexing="ij")
-    return scene.render(direction(ee, aa), position=position)
+    return scene.render(direction_from_angles(aa, ee), position=position)

@@ -344,9 +344,10 @@ class OpenField:
         self.pose = (float(pan), float(tilt))
 
     def band_radiance(self) -> np.ndarray:
-        from bionav.light.daylight import band_sky_radiance, direction
+        from bionav.geometry import direction_from_angles
+        from bionav.light.daylight import band_sky_radiance
 
         pan, tilt = self.pose
         if tilt > 0:
-            return band_sky_radiance(self.sky, direction(tilt, pan))
+            return band_sky_radiance(self.sky, direction_from_angles(pan, tilt))
         return self._ground

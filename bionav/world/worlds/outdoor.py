@@ -16,10 +16,11 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from bionav.geometry import direction_from_angles
 from bionav.light.materials import band_albedos
 from bionav.light.simple_sky import SKY_GAIN, SUN_GAIN, SimpleSky
 from bionav.world import textures as tx
-from bionav.world.lights import Ambient, DirectionalLight, sun_direction
+from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.scene import Scene, SkyFunction
 from bionav.world.worlds.common import World, stream
 from bionav.world.worlds.furniture import tree
@@ -70,7 +71,7 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     for k, v in table.items():
         if np.asarray(v).reshape(-1).size not in (1, c):
             raise ValueError(f"albedo of {k!r} must have 1 or {c} values")
-    sun = sun_direction(sun_elevation, sun_azimuth)
+    sun = tuple(float(v) for v in direction_from_angles(sun_azimuth, sun_elevation))
     if sky is None:
         sky = SimpleSky(sun_direction=sun, channels=channels, seed=int(seed))
     if sun_irradiance is None:
