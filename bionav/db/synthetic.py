@@ -40,6 +40,7 @@ from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.files import cache_key, default_cache_dir, write_atomic
 from bionav.geometry import PanoramaGeometry
+from bionav.homing.imageops import check_image_size
 
 #: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
 NATIVE_SIZE = (561, 81)
@@ -253,15 +254,7 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     from bionav.world.render import RENDERER_VERSION
 
     spec = get_spec(name)
-    if image_size is None:
-        w, h = spec.native_size
-    else:
-        try:
-            w, h = (int(v) for v in image_size)
-        except (TypeError, ValueError):
-            raise UserError(f"db.image_size must be [W, H] with two integers, got {image_size!r}.") from None
-    if w < 8 or h < 2:
-        raise UserError(f"db.image_size [W, H] = [{w}, {h}] is too small; use at least [8, 2].")
+    w, h = check_image_size(image_size, name="db.image_size", minimum=(8, 2)) or spec.native_size
     if noise < 0:
         raise UserError(f"db.noise must be >= 0, got {noise}.")
     geometry = spec.geometry(w, h)
