@@ -18,9 +18,9 @@ from bionav.errors import UserError
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix, prepare_images
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
+from bionav.experiments.configs import experiment_config
 from bionav.experiments.grid_homing import evaluate_agents
 from bionav.report.figures import pyplot, save_figure
-from bionav.experiments.configs import experiment_config
 
 #: settings of cfg.db that apply to every member of the family
 SHARED_DB_KEYS = ("image_size", "seed", "noise", "rotate_current", "rotation_seed")
@@ -28,14 +28,14 @@ MEASURES = ("aae", "mae", "rr")
 
 
 def db_preset(name: str) -> dict:
-    """The ``conf/db/<name>.yaml`` preset from any config folder."""
+    """The ``bionav/conf/db/<name>.yaml`` preset from any config folder."""
     from bionav.config import config_dirs
 
     for _n, folder in config_dirs():
         path = folder / "db" / f"{name}.yaml"
         if path.is_file():
             return yaml.safe_load(path.read_text()) or {}
-    raise UserError(f"the cross_db family names the database {name!r}, which has no preset (conf/db/{name}.yaml).")
+    raise UserError(f"the cross_db family names the database {name!r}, which has no preset (bionav/conf/db/{name}.yaml).")
 
 
 def family_nodes(cfg: DictConfig) -> list[dict]:
