@@ -58,6 +58,8 @@ BAD_VALUES = [
     (["experiment=cleaning", "controller.fix_gain=2"], ["controller.fix_gain=2", "<= 1"]),
     (["experiment=contrast_scan", "experiment.cloud_cover=[0.5,1.5]"], ["experiment.cloud_cover", "1.5"]),
     (["experiment=skyline_homing", "experiment.image_width=0"], ["experiment.image_width=0"]),
+    (["workers=0"], ["workers=0", "an integer >= 1"]),
+    (["seed=-1"], ["seed=-1", "an integer >= 0"]),
 ]
 
 
@@ -85,6 +87,11 @@ MISSPELT = [
 def test_misspelt_key_names_the_node_keys_and_the_closest(tmp_path, overrides, key, hint, listed):
     proc = run_bionav(*overrides, cwd=tmp_path)
     clean_error(proc, f"unknown key {key}", hint, listed, absent=("+homing.", "To append to your config use"))
+
+
+def test_snapshot_index_beyond_the_database_is_named(tmp_path):
+    proc = run_bionav("homing=mfdid", "experiment.snapshots=[0,500]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    clean_error(proc, "experiment.snapshots=[0, 500]", "0..169")
 
 
 def test_wrong_type_names_key_and_value(tmp_path):

@@ -366,6 +366,31 @@ class CleaningConfig:
     log_images: bool = False
 
 
+# --------------------------------------------------------------------------- top-level run settings
+@dataclass
+class RunSettings:
+    """Top-level keys of every run (``conf/config.yaml``): ``seed=``, ``workers=``."""
+
+    seed: int = bounded(0, ge=0, le=2**32 - 1)
+    workers: int = bounded(2, ge=1, le=1024)
+
+
+def check_run_settings(cfg: DictConfig) -> None:
+    """Check the top-level ``seed`` and ``workers`` against :class:`RunSettings` (key, value, range)."""
+    from bionav.errors import UserError
+
+    values = {}
+    for f in ("seed", "workers"):
+        value = cfg.get(f) if isinstance(cfg, DictConfig) else None
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise UserError(f"bad value {f}={value}: it must be an integer; allowed: "
+                            f"{RunSettings.__dataclass_fields__[f].metadata['range'].describe(integer=True)}.")
+        values[f] = value
+    check_config(RunSettings(**values), prefix="")
+
+
 #: experiment name -> its config dataclass
 EXPERIMENT_CONFIGS: dict[str, type] = {
     "grid_homing": GridHomingConfig,

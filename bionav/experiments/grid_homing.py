@@ -63,6 +63,13 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     db = load_configured_database(cfg)
     method = make_homing(cfg, ctx, db.geometry)
     snapshots = None if exp.snapshots is None else list(exp.snapshots)
+    if snapshots is not None and max(snapshots) >= len(db):
+        from bionav.errors import UserError
+
+        raise UserError(
+            f"bad value experiment.snapshots={snapshots}: database {db.name!r} has {len(db)} images, so the "
+            f"snapshot indices must be 0..{len(db) - 1}; drop the larger ones (null = every image)."
+        )
     hv = home_vector_matrix(
         method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
         cache=prepared_cache(cfg),

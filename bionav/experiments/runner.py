@@ -75,8 +75,9 @@ def validate_run_config(cfg: DictConfig) -> None:
     """
     from bionav.config import plugin_config
     from bionav.db.loading import as_database_config
-    from bionav.experiments.configs import experiment_config
+    from bionav.experiments.configs import check_run_settings, experiment_config
 
+    check_run_settings(cfg)
     for group, kind in PLUGIN_NODES.items():
         node = cfg.get(group)
         if node and node.get("name"):
