@@ -138,3 +138,13 @@ def test_bad_db_values_on_a_folder(tmp_path, bad):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     key = bad.split("=")[0]
     clean_error(run_folder(tmp_path, folder, bad), key, "allowed")
+
+
+def test_metrics_never_hold_nan():
+    """The last guard before metrics.json: undefined measures become null, so the file stays strict JSON."""
+    from bionav.experiments.runner import json_safe
+
+    safe = json_safe({"aae": float("nan"), "per": [1.0, float("inf")], "x": np.float32(2.5), "n": 3,
+                      "arr": np.array([np.nan, 1.0])})
+    assert safe == {"aae": None, "per": [1.0, None], "x": 2.5, "n": 3, "arr": [None, 1.0]}
+    json.dumps(safe, allow_nan=False)

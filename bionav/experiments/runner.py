@@ -55,6 +55,23 @@ def plugin_versions(cfg: DictConfig) -> dict[str, str]:
     return out
 
 
+def json_safe(value: Any) -> Any:
+    """``value`` with every non-finite float (NaN, inf) replaced by ``None`` (JSON ``null``).
+
+    metrics.json must be strict JSON; a measure that is undefined (e.g. a
+    compass error when no pair had one) is written as ``null``.
+    """
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_safe(value.tolist())
+    if isinstance(value, (float, np.floating)):
+        return float(value) if np.isfinite(value) else None
+    return value
+
+
 #: config groups that select plugins, and the plugin kind each selects
 PLUGIN_NODES = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor",
                 "controller": "controller"}
@@ -141,5 +158,5 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
         try:
             mcap.close()
         finally:
-            write_json_atomic(run_dir / METRICS_FILE, metrics)
+            write_json_atomic(run_dir / METRICS_FILE, json_safe(metrics))
     return metrics
