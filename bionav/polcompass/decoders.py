@@ -1,0 +1,356 @@
+"""Solar azimuth from the e-vectors of a POL-OP array, one sample at a time.
+
+Every decoder takes what the units of an array (:mod:`bionav.polcompass.array`)
+read at one moment, :class:`~bionav.polcompass.array.UnitEvectors` and a
+``valid`` mask (units dropped as faulty or saturated at that sample), and
+returns a :class:`SunEstimate`: the solar azimuth in the *sensor frame*
+(radians, counter-clockwise from the sensor front, ``[-pi, pi)``), the other
+member of the eq. 4.6 candidate pair, and whether the pair was resolved. No
+decoder looks at other samples. A heading follows as ``sun_world_azimuth -
+sun_sensor_azimuth`` (:func:`heading_from_sun`).
+
+Decoders
+--------
+``sky_fit`` (bionav's default)
+    Least squares over all units against the sky model's e-vector pattern
+    for tilted units: the solar azimuth ``phi`` minimising
+    ``E(phi) = sum_k w_k (1 - cos 2(a_k - a^_k(phi)))`` with the sun elevation
+    known from time and place, ``w_k = d_k^2`` (measured degree); a grid,
+    then a parabolic refinement. The candidate pair is the best ``phi`` and
+    the best one more than a quarter turn away (eq. 4.6 generalised to tilted
+    units); the lower error wins, and where the errors differ by less than
+    the margin the brighter side of the sky (first harmonic of the units'
+    intensities) decides.
+``two_unit`` (the thesis' solution)
+    Eqs. 4.4-4.5 give each unit's e-vector; for single scattering the sun is
+    perpendicular to every e-vector, so two units give ``s = +-(e_i x e_j)``
+    (Lambrinos et al. 2000 use the zenith case of this). The pair with the
+    largest ``d_i d_j |e_i x e_j|`` is used; the eq. 4.6 pair ``(s, -s)`` is
+    resolved by the error function ``|elevation - expected elevation|``.
+``eigenvector``
+    The sun vector is the eigenvector of the smallest eigenvalue of
+    ``M = sum_k w_k e_k e_k^T`` (the e-vectors are all perpendicular to it;
+    e.g. Lu et al. 2015, Opt. Express 23:7248, doi:10.1364/OE.23.007248),
+    with ``w_k = d_k``; sign: the sun is above the horizon.
+``mean_vector``
+    The weighted mean of the pairwise sun vectors ``e_i x e_j`` each turned
+    to the upper hemisphere (weights ``d_i d_j |e_i x e_j|``).
+``sol``
+    The sinusoidal population decoder of Gkanias et al. (2019), PLoS Comput.
+    Biol. 15:e1007123, doi:10.1371/journal.pcbi.1007123, with the responses of
+    Gkanias et al. (2023), doi:10.1038/s44172-023-00132-w: each unit gives a
+    POL response ``p_k`` (normalised POL-OP difference), an intensity
+    response ``i_k`` and their difference ``c_k = i_k - p_k``; ``n_sol`` SOL
+    neurons with preferred directions ``theta_z`` respond
+    ``r_z = (n_sol / n_units) sum_k sin(theta_k - theta_z + pi/2) r_k``, and
+    the solar azimuth is the phase of their first Fourier harmonic,
+    ``arg sum_z r_z exp(i theta_z)``. No ambiguity to resolve (a vector, not
+    an axis), reported as resolved where the population vector is non-zero.
+``four_zeros``
+    Smith & Stewart (2014), doi:10.5220/0004792100210026: around a ring of
+    sky points, the angle ``chi`` between e-vector and local meridian passes
+    through +-45 degrees at four azimuths placed symmetrically about the
+    solar meridian; the meridian is the axis of their first harmonic, found
+    here by linear interpolation of ``cos 2 chi`` between neighbouring units;
+    the brighter side picks the sun's end (eq. 4.6 pair).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bionav.geometry import wrap_angle
+from bionav.polcompass.array import PolArray, UnitEvectors, stokes_from_sky
+
+
+@dataclass(frozen=True)
+class SunEstimate:
+    """Solar azimuth of every sample in the sensor frame.
+
+    Attributes
+    ----------
+    azimuth : ndarray, shape ``(N,)``
+        Radians CCW from the sensor front, ``[-pi, pi)``; NaN where the units
+        read at that sample cannot give one.
+    alternative : ndarray, shape ``(N,)``
+        The other member of the candidate pair (about a half turn away).
+    resolved : ndarray of bool, shape ``(N,)``
+        Whether the choice between the two was clear (margin exceeded).
+    """
+
+    azimuth: np.ndarray
+    alternative: np.ndarray
+    resolved: np.ndarray
+
+
+def heading_from_sun(sun_sensor_azimuth, sun_world_azimuth):
+    """Sensor heading (radians CCW from east) from the solar azimuth in the sensor frame."""
+    return wrap_angle(np.asarray(sun_world_azimuth, float) - np.asarray(sun_sensor_azimuth, float))
+
+
+def _weights(ev: UnitEvectors, valid, power: float):
+    ok = np.asarray(valid, bool) & np.isfinite(ev.angle) & np.isfinite(ev.degree)
+    return np.where(ok, np.nan_to_num(ev.degree) ** power, 0.0)
+
+
+def brightness_azimuth(ev: UnitEvectors, valid, array: PolArray):
+    """Azimuth of the first harmonic of the units' intensities (towards the bright sky), shape ``(N,)``.
+
+    Intensities are normalised by their mean over the valid units of each sample.
+    """
+    ok = np.asarray(valid, bool) & np.isfinite(ev.intensity)
+    i = np.where(ok, np.nan_to_num(ev.intensity), 0.0)
+    n = np.maximum(ok.sum(axis=-1), 1)
+    mean = i.sum(axis=-1) / n
+    rel = np.where(ok, i / np.maximum(mean, 1e-12)[:, None] - 1.0, 0.0)
+    z = np.sum(rel * np.sin(array.unit_tilts) * np.exp(1j * array.unit_azimuths), axis=-1)
+    return np.where(np.abs(z) > 0, np.angle(z), np.nan)
+
+
+def _choose_by_brightness(first, second, bright):
+    """Pick the candidate nearer the bright side."""
+    d1 = np.abs(wrap_angle(first - bright))
+    d2 = np.abs(wrap_angle(second - bright))
+    return np.where(np.isfinite(bright) & (d2 < d1), second, first), np.where(np.isfinite(bright) & (d2 < d1), first, second)
+
+
+@dataclass(frozen=True)
+class SkyTable:
+    """Expected e-vectors of every unit for a grid of solar azimuths (one sun elevation).
+
+    Attributes
+    ----------
+    azimuths : ndarray, shape ``(G,)``
+        Solar azimuths in the sensor frame, ``2 pi g / G``.
+    cos2, sin2 : ndarray, shape ``(G, K)``
+        ``cos 2a^``, ``sin 2a^`` of the predicted e-vector angle in each unit frame.
+    degree : ndarray, shape ``(G, K)``
+        Predicted degree.
+    """
+
+    azimuths: np.ndarray
+    cos2: np.ndarray
+    sin2: np.ndarray
+    degree: np.ndarray
+
+
+def sky_table(array: PolArray, sun_elevation: float, *, n_grid: int = 720, max_degree: float = 0.76,
+              neutral_point_separation: float = 0.0) -> SkyTable:
+    """Tabulate the sky model's e-vector pattern seen by the array (:class:`bionav.sky.SkyModel`).
+
+    Parameters
+    ----------
+    array : PolArray
+    sun_elevation : float
+        Radians.
+    n_grid : int
+        Number of solar azimuths.
+    max_degree, neutral_point_separation : float
+        Sky model parameters (Rayleigh for separation 0, else Berry et al. 2004).
+    """
+    from bionav.sky import SkyModel, SunPosition
+
+    phis = 2.0 * np.pi * np.arange(n_grid) / n_grid
+    model = SkyModel(SunPosition(0.0, float(sun_elevation)), max_degree=max_degree,
+                     neutral_point_separation=neutral_point_separation)
+    # the sun at sensor azimuth phi = a sensor heading of -phi under a sun at world azimuth 0
+    _, q, u = stokes_from_sky(model, array, -phis)
+    degree = np.hypot(q, u)
+    a2 = np.arctan2(u, q)
+    return SkyTable(phis, np.cos(a2), np.sin(a2), degree)
+
+
+def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, weight_power: float = 2.0,
+                     margin: float = 0.02) -> SunEstimate:
+    """bionav's least-squares fit of the sky model's pattern (see the module docstring).
+
+    Parameters
+    ----------
+    ev : UnitEvectors
+    valid : ndarray of bool, shape ``(N, K)``
+    table : SkyTable
+        From :func:`sky_table` for the session's sun elevation.
+    array : PolArray
+    weight_power : float
+        Unit weight ``d_k ** weight_power``.
+    margin : float
+        Minimum difference of the normalised errors of the pair for a
+        resolved choice; below it the brighter side decides.
+
+    Returns
+    -------
+    SunEstimate
+    """
+    w = _weights(ev, valid, weight_power)
+    a2 = 2.0 * np.nan_to_num(ev.angle)
+    score = (w * np.cos(a2)) @ table.cos2.T + (w * np.sin(a2)) @ table.sin2.T  # (N, G)
+    total = w.sum(axis=-1)
+    n, g = score.shape
+    rows = np.arange(n)
+    best = np.argmax(score, axis=1)
+    # best candidate more than a quarter turn away: mask the half circle around the best
+    offset = (np.arange(g)[None, :] - best[:, None]) % g
+    far = (offset > g // 4) & (offset < g - g // 4)
+    alt = np.argmax(np.where(far, score, -np.inf), axis=1)
+    step = 2.0 * np.pi / g
+
+    def refine(j):
+        y0, y1, y2 = score[rows, (j - 1) % g], score[rows, j], score[rows, (j + 1) % g]
+        den = y0 - 2.0 * y1 + y2
+        shift = np.where(np.abs(den) > 1e-12, 0.5 * (y0 - y2) / np.where(np.abs(den) > 1e-12, den, 1.0), 0.0)
+        return wrap_angle(table.azimuths[j] + np.clip(shift, -0.5, 0.5) * step)
+
+    first, second = refine(best), refine(alt)
+    gap = (score[rows, best] - score[rows, alt]) / np.maximum(total, 1e-12)
+    resolved = gap > margin
+    bright = brightness_azimuth(ev, valid, array)
+    by_light, other = _choose_by_brightness(first, second, bright)
+    azimuth = np.where(resolved, first, by_light)
+    alternative = np.where(resolved, second, other)
+    usable = total > 0
+    return SunEstimate(np.where(usable, azimuth, np.nan), np.where(usable, alternative, np.nan), resolved & usable)
+
+
+def _sun_candidates(s, expected_elevation, margin):
+    """Eq. 4.6 pair for sun vectors ``+-s``: choose by the elevation error function."""
+    s = np.asarray(s, float)
+    norm = np.linalg.norm(s, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = s / norm[..., None]
+    el = np.arcsin(np.clip(s[..., 2], -1.0, 1.0))
+    az = np.arctan2(s[..., 1], s[..., 0])
+    err_plus = np.abs(el - expected_elevation)
+    err_minus = np.abs(-el - expected_elevation)
+    flip = err_minus < err_plus
+    first = np.where(flip, wrap_angle(az + np.pi), az)
+    second = wrap_angle(first + np.pi)
+    resolved = np.abs(err_plus - err_minus) > margin
+    bad = ~np.isfinite(az) | (norm < 1e-12)
+    return SunEstimate(np.where(bad, np.nan, first), np.where(bad, np.nan, second), resolved & ~bad)
+
+
+def _pair_index(k):
+    i, j = np.triu_indices(k, 1)
+    return i, j
+
+
+def sun_from_two_units(ev: UnitEvectors, valid, *, sun_elevation, margin: float = np.deg2rad(2.0)) -> SunEstimate:
+    """The thesis' two-unit solution generalised to tilted units (see the module docstring).
+
+    Parameters
+    ----------
+    sun_elevation : float or ndarray, shape ``(N,)``
+        Expected sun elevation (radians), the error function's reference.
+    margin : float
+        Minimum difference of the elevation errors for a resolved choice, radians.
+    """
+    w = _weights(ev, valid, 1.0)
+    e = np.nan_to_num(ev.evector)
+    i, j = _pair_index(e.shape[1])
+    cross = np.cross(e[:, i], e[:, j])  # (N, pairs, 3)
+    score = w[:, i] * w[:, j] * np.linalg.norm(cross, axis=-1)
+    best = np.argmax(score, axis=1)
+    s = cross[np.arange(len(best)), best]
+    s = np.where((score[np.arange(len(best)), best] > 0)[:, None], s, np.nan)
+    return _sun_candidates(s, np.asarray(sun_elevation, float), margin)
+
+
+def sun_from_eigenvector(ev: UnitEvectors, valid, *, margin: float = np.deg2rad(2.0)) -> SunEstimate:
+    """Eigenvector method: the direction most perpendicular to all weighted e-vectors."""
+    w = _weights(ev, valid, 1.0)
+    e = np.nan_to_num(ev.evector)
+    m = np.einsum("nk,nki,nkj->nij", w, e, e)
+    _, vecs = np.linalg.eigh(m)
+    s = vecs[..., 0]
+    s = np.where((np.sum(w > 0, axis=1) >= 2)[:, None], s, np.nan)
+    return _up(s, margin)
+
+
+def _up(s, margin):
+    """Resolve ``+-s`` by "the sun is above the horizon"; resolved where ``|s_z| > sin(margin)``."""
+    s = np.asarray(s, float)
+    norm = np.linalg.norm(s, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = s / norm[..., None]
+    s = np.where((s[..., 2] < 0)[..., None], -s, s)
+    az = np.arctan2(s[..., 1], s[..., 0])
+    bad = ~np.isfinite(az) | ~(norm > 1e-12)
+    resolved = np.abs(s[..., 2]) > np.sin(margin)
+    return SunEstimate(np.where(bad, np.nan, az), np.where(bad, np.nan, wrap_angle(az + np.pi)), resolved & ~bad)
+
+
+def sun_from_mean_vector(ev: UnitEvectors, valid, *, margin: float = np.deg2rad(2.0)) -> SunEstimate:
+    """Mean-vector method: weighted mean of pairwise sun vectors turned upwards."""
+    w = _weights(ev, valid, 1.0)
+    e = np.nan_to_num(ev.evector)
+    i, j = _pair_index(e.shape[1])
+    cross = np.cross(e[:, i], e[:, j])
+    cross = np.where((cross[..., 2] < 0)[..., None], -cross, cross)  # |e_i x e_j| already weights by angle
+    s = np.einsum("np,npi->ni", w[:, i] * w[:, j], cross)
+    return _up(s, margin)
+
+
+def sol_responses(ev: UnitEvectors, valid, *, response: str = "c", pol_op: int = 0):
+    """Per-unit responses of Gkanias et al. (2023): ``p`` (POL), ``i`` (intensity) or ``c = i - p``.
+
+    ``p_k`` is the normalised POL-OP difference ``(s_a - s_b) / (s_a + s_b)``
+    (eq. 4.3's ``x``) of POL-OP ``pol_op``; ``i_k`` the unit's intensity
+    divided by the mean over the valid units, minus one.
+    """
+    ok = np.asarray(valid, bool) & np.isfinite(ev.intensity)
+    p = np.where(ok, np.nan_to_num(ev.x[..., pol_op]), 0.0)
+    n = np.maximum(ok.sum(axis=-1), 1)
+    inten = np.where(ok, np.nan_to_num(ev.intensity), 0.0)
+    mean = inten.sum(axis=-1) / n
+    i = np.where(ok, inten / np.maximum(mean, 1e-12)[:, None] - 1.0, 0.0)
+    if response == "p":
+        return p, ok
+    if response == "i":
+        return i, ok
+    if response == "c":
+        return i - p, ok
+    raise ValueError(f"response must be p, i or c, got {response!r}")
+
+
+def sun_from_sol(ev: UnitEvectors, valid, *, array: PolArray, n_sol: int = 8, response: str = "c",
+                 pol_op: int = 0) -> SunEstimate:
+    """Sinusoidal population (SOL) decoder (see the module docstring)."""
+    r, ok = sol_responses(ev, valid, response=response, pol_op=pol_op)
+    theta_z = 2.0 * np.pi * np.arange(n_sol) / n_sol
+    theta_k = array.unit_azimuths
+    n_units = np.maximum(ok.sum(axis=-1), 1)
+    weights = np.sin(theta_k[None, :] - theta_z[:, None] + np.pi / 2.0)  # (n_sol, K)
+    r_sol = (n_sol / n_units)[:, None] * (r @ weights.T)  # (N, n_sol)
+    z = r_sol @ np.exp(1j * theta_z)
+    if response == "p":  # the POL population points away from the sun (Gkanias et al. 2023, fig. 2c)
+        z = -z
+    az = np.angle(z)
+    good = np.abs(z) > 1e-12
+    return SunEstimate(np.where(good, az, np.nan), np.where(good, wrap_angle(az + np.pi), np.nan), good)
+
+
+def sun_from_four_zeros(ev: UnitEvectors, valid, *, array: PolArray) -> SunEstimate:
+    """Four-zeros method (see the module docstring)."""
+    n, k = ev.angle.shape
+    order = np.argsort(np.mod(array.unit_azimuths, 2.0 * np.pi))
+    theta = np.mod(array.unit_azimuths[order], 2.0 * np.pi)
+    f = np.cos(2.0 * ev.angle[:, order])
+    ok = np.asarray(valid, bool)[:, order] & np.isfinite(f)
+    f = np.where(ok, f, np.nan)
+    nxt = np.roll(np.arange(k), -1)
+    t0, t1 = theta, np.where(theta[nxt] <= theta, theta[nxt] + 2.0 * np.pi, theta[nxt])
+    f0, f1 = f, f[:, nxt]
+    crossing = ok & ok[:, nxt] & (np.sign(f0) != np.sign(f1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        frac = f0 / (f0 - f1)
+    zeros = t0 + np.nan_to_num(frac) * (t1 - t0)
+    z = np.sum(np.where(crossing, np.exp(1j * zeros), 0.0), axis=1)
+    count = crossing.sum(axis=1)
+    axis = np.angle(z)
+    good = (count >= 2) & (np.abs(z) > 1e-9)
+    first, second = axis, wrap_angle(axis + np.pi)
+    bright = brightness_azimuth(ev, valid, array)
+    first, second = _choose_by_brightness(first, second, bright)
+    return SunEstimate(np.where(good, first, np.nan), np.where(good, second, np.nan), good & np.isfinite(bright))
