@@ -162,8 +162,35 @@ def sky_table(array: PolArray, sun_elevation: float, *, n_grid: int = 720, max_d
     return SkyTable(phis, np.cos(a2), np.sin(a2), degree)
 
 
-def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, weight_power: float = 2.0,
-                     margin: float = 0.02) -> SunEstimate:
+def sun_directions(azimuths, elevation):
+    """Unit sun vectors in the sensor frame for solar azimuths (sensor frame) at one elevation, shape ``(G, 3)``."""
+    az = np.asarray(azimuths, float)
+    return np.stack([np.cos(elevation) * np.cos(az), np.cos(elevation) * np.sin(az), np.full(az.shape, np.sin(elevation))], axis=-1)
+
+
+def _pick_pair(score, azimuths, total, margin):
+    """Best grid column, best column more than a quarter turn away, both refined; normalised gap."""
+    n, g = score.shape
+    rows = np.arange(n)
+    best = np.argmax(score, axis=1)
+    far = (best[:, None] + g // 4 + 1 + np.arange(g - 2 * (g // 4) - 1)[None, :]) % g  # more than a quarter turn away
+    alt = far[rows, np.argmax(np.take_along_axis(score, far, axis=1), axis=1)]
+    step = 2.0 * np.pi / g
+
+    def refine(j):
+        y0, y1, y2 = score[rows, (j - 1) % g], score[rows, j], score[rows, (j + 1) % g]
+        den = y0 - 2.0 * y1 + y2
+        ok = np.abs(den) > 1e-15
+        shift = np.where(ok, 0.5 * (y0 - y2) / np.where(ok, den, 1.0), 0.0)
+        return wrap_angle(azimuths[j] + np.clip(shift, -0.5, 0.5) * step)
+
+    gap = (score[rows, best] - score[rows, alt]) / np.maximum(total, 1e-12)
+    return best, refine(best), refine(alt), gap
+
+
+def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, sun_elevation: float | None = None,
+                     residual: str = "perpendicular", weight_power: float = 1.0, robust_iterations: int = 2,
+                     robust_scale: float = np.deg2rad(10.0), margin: float = 0.01) -> SunEstimate:
     """bionav's least-squares fit of the sky model's pattern (see the module docstring).
 
     Parameters
@@ -173,8 +200,23 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     table : SkyTable
         From :func:`sky_table` for the session's sun elevation.
     array : PolArray
+    sun_elevation : float, optional
+        Radians; needed for ``residual="perpendicular"``.
+    residual : {'perpendicular', 'angle'}
+        ``perpendicular``: the single-scattering pattern's condition that
+        every e-vector is perpendicular to the sun, ``E = sum_k w_k (e_k .
+        s(phi))^2`` with ``s(phi)`` at the known elevation; ``angle``:
+        ``E = sum_k w_k (1 - cos 2(a_k - a^_k(phi)))`` against the tabulated
+        model angles (any sky model, e.g. with neutral points).
     weight_power : float
         Unit weight ``d_k ** weight_power``.
+    robust_iterations : int
+        Re-weighting rounds with Cauchy weights ``1 / (1 + (r_k / scale)^2)``
+        of each unit's residual at the current solution (units contradicting
+        the others at that sample, e.g. glare, count less).
+    robust_scale : float
+        Residual scale of the re-weighting (radians for ``angle``; the
+        perpendicular residual ``e . s`` is compared with its sine).
     margin : float
         Minimum difference of the normalised errors of the pair for a
         resolved choice; below it the brighter side decides.
@@ -183,27 +225,36 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     -------
     SunEstimate
     """
-    w = _weights(ev, valid, weight_power)
-    a2 = 2.0 * np.nan_to_num(ev.angle)
-    score = (w * np.cos(a2)) @ table.cos2.T + (w * np.sin(a2)) @ table.sin2.T  # (N, G)
-    total = w.sum(axis=-1)
-    n, g = score.shape
-    rows = np.arange(n)
-    best = np.argmax(score, axis=1)
-    # best candidate more than a quarter turn away: mask the half circle around the best
-    offset = (np.arange(g)[None, :] - best[:, None]) % g
-    far = (offset > g // 4) & (offset < g - g // 4)
-    alt = np.argmax(np.where(far, score, -np.inf), axis=1)
-    step = 2.0 * np.pi / g
-
-    def refine(j):
-        y0, y1, y2 = score[rows, (j - 1) % g], score[rows, j], score[rows, (j + 1) % g]
-        den = y0 - 2.0 * y1 + y2
-        shift = np.where(np.abs(den) > 1e-12, 0.5 * (y0 - y2) / np.where(np.abs(den) > 1e-12, den, 1.0), 0.0)
-        return wrap_angle(table.azimuths[j] + np.clip(shift, -0.5, 0.5) * step)
-
-    first, second = refine(best), refine(alt)
-    gap = (score[rows, best] - score[rows, alt]) / np.maximum(total, 1e-12)
+    w0 = _weights(ev, valid, weight_power)
+    w = w0
+    total = w0.sum(axis=-1)
+    if residual == "perpendicular":
+        if sun_elevation is None:
+            raise ValueError("residual='perpendicular' needs the sun elevation")
+        e = np.nan_to_num(ev.evector)
+        v = sun_directions(table.azimuths, float(sun_elevation))  # (G, 3)
+        scale = np.sin(robust_scale)
+        iu, ju = np.triu_indices(3)
+        mono = v[:, iu] * v[:, ju] * np.where(iu == ju, 1.0, 2.0)  # (G, 6): quadratic form as a matmul
+        for it in range(robust_iterations + 1):
+            m6 = np.einsum("nk,nki,nki->ni", w, e[..., iu], e[..., ju])  # upper triangle of sum_k w e e^T
+            score = -(m6 @ mono.T)
+            best = np.argmax(score, axis=1)
+            if it < robust_iterations:
+                r = np.einsum("nki,ni->nk", e, v[best])
+                w = w0 / (1.0 + (r / scale) ** 2)
+    elif residual == "angle":
+        a2 = 2.0 * np.nan_to_num(ev.angle)
+        ca, sa = np.cos(a2), np.sin(a2)
+        for it in range(robust_iterations + 1):
+            score = (w * ca) @ table.cos2.T + (w * sa) @ table.sin2.T  # (N, G)
+            best = np.argmax(score, axis=1)
+            if it < robust_iterations:
+                r = 0.5 * np.arccos(np.clip(ca * table.cos2[best] + sa * table.sin2[best], -1.0, 1.0))
+                w = w0 / (1.0 + (r / robust_scale) ** 2)
+    else:
+        raise ValueError(f"residual must be 'perpendicular' or 'angle', got {residual!r}")
+    _, first, second, gap = _pick_pair(score, table.azimuths, np.maximum(w.sum(axis=-1), 1e-12), margin)
     resolved = gap > margin
     bright = brightness_azimuth(ev, valid, array)
     by_light, other = _choose_by_brightness(first, second, bright)

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bionav.errors import UserError
 from bionav.plugins.decoders.base import Decoder, check_range
 from bionav.polcompass.decoders import sky_table, sun_from_sky_fit, sun_from_two_units
 
@@ -14,14 +15,21 @@ from bionav.polcompass.decoders import sky_table, sun_from_sky_fit, sun_from_two
 class SkyFitConfig:
     """Parameters of ``decoder=sky_fit``."""
 
+    residual: str = "perpendicular"  # perpendicular (e-vectors perpendicular to the sun) | angle (model e-vector angles)
     n_grid: int = 720  # solar azimuths tried (then refined), [36, 7200]
-    weight_power: float = 2.0  # unit weight = measured degree ** weight_power, [0, 4]
-    margin: float = 0.02  # normalised error gap for a resolved eq. 4.6 pair, [0, 1]
+    weight_power: float = 1.0  # unit weight = measured degree ** weight_power, [0, 4]
+    robust_iterations: int = 2  # Cauchy re-weighting rounds, [0, 10]
+    robust_scale_deg: float = 10.0  # residual scale of the re-weighting, degrees, (0, 90]
+    margin: float = 0.01  # normalised error gap for a resolved eq. 4.6 pair, [0, 1]
     max_degree: float = 0.76  # sky model's maximum degree (only the pattern's angles matter), (0, 1]
     neutral_point_separation_deg: float = 0.0  # 0: Rayleigh; >0: Berry et al. 2004, [0, 60]
 
     def __post_init__(self):
+        if self.residual not in ("perpendicular", "angle"):
+            raise UserError(f"decoder.residual={self.residual!r} is unknown; choose perpendicular or angle.")
         check_range("n_grid", self.n_grid, 36, 7200)
+        check_range("robust_iterations", self.robust_iterations, 0, 10)
+        check_range("robust_scale_deg", self.robust_scale_deg, 1e-6, 90.0)
         check_range("weight_power", self.weight_power, 0.0, 4.0)
         check_range("margin", self.margin, 0.0, 1.0)
         check_range("max_degree", self.max_degree, 1e-6, 1.0)
@@ -56,7 +64,11 @@ class SkyFit(Decoder):
             valid,
             table=self.table(array, sun_elevation),
             array=array,
+            sun_elevation=float(sun_elevation),
+            residual=self.config.residual,
             weight_power=self.config.weight_power,
+            robust_iterations=self.config.robust_iterations,
+            robust_scale=np.deg2rad(self.config.robust_scale_deg),
             margin=self.config.margin,
         )
 
