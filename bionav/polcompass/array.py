@@ -216,8 +216,21 @@ def evector_from_pol_ops(x, alphas):
     return wrap_axial(0.5 * np.arctan2(cs[..., 1], cs[..., 0])), np.hypot(cs[..., 0], cs[..., 1])
 
 
+def view_groups(array: PolArray) -> list[list[int]]:
+    """Units sharing one unit frame (same view and same polarizer reference), in order of first appearance."""
+    frames = np.round(array.unit_frames().reshape(array.n_units, -1), 9)
+    groups: dict = {}
+    for k, key in enumerate(map(tuple, frames)):
+        groups.setdefault(key, []).append(k)
+    return list(groups.values())
+
+
 def evectors_from_counts(counts, array: PolArray) -> UnitEvectors:
     """Counts to per-unit e-vectors in the sensor frame (eqs. 4.2-4.5).
+
+    Units that look at the same sky point in the same frame (the thesis'
+    three zenith units) are solved together from all their POL-OPs; a unit
+    with two or more POL-OPs of its own is solved alone.
 
     Parameters
     ----------
@@ -230,8 +243,18 @@ def evectors_from_counts(counts, array: PolArray) -> UnitEvectors:
     """
     counts = np.asarray(counts, float)
     x = delogarithmise(log_ratios_from_counts(counts, array))
-    angle, degree = evector_from_pol_ops(x, array.pair_angles)
     frames = array.unit_frames()  # (K, 3, 3)
+    groups = view_groups(array)
+    if all(len(g) == 1 for g in groups):
+        angle, degree = evector_from_pol_ops(x, array.pair_angles)
+    else:  # units looking at the same sky point (the thesis' zenith units) are solved together
+        angle = np.empty(x.shape[:-1])
+        degree = np.empty(x.shape[:-1])
+        for g in groups:
+            xs = x[..., g, :].reshape(x.shape[:-2] + (1, -1))
+            a, d = evector_from_pol_ops(xs, array.pair_angles[g].reshape(1, -1))
+            angle[..., g] = a
+            degree[..., g] = d
     evector = np.cos(angle)[..., None] * frames[:, :, 0] + np.sin(angle)[..., None] * frames[:, :, 1]
     intensity = np.mean(counts / array.gains, axis=-1)
     return UnitEvectors(x, angle, degree, intensity, evector)

@@ -17,7 +17,7 @@ Decoders
     ``E(phi) = sum_k w_k (1 - cos 2(a_k - a^_k(phi)))`` with the sun elevation
     known from time and place, ``w_k = d_k^2`` (measured degree); a grid,
     then a parabolic refinement. The candidate pair is the best ``phi`` and
-    the best one more than a quarter turn away (eq. 4.6 generalised to tilted
+    the best one within 45 degrees of its antipode (eq. 4.6 generalised to tilted
     units); the lower error wins, and where the errors differ by less than
     the margin the brighter side of the sky (first harmonic of the units'
     intensities) decides.
@@ -51,7 +51,8 @@ Decoders
     sky points, the angle ``chi`` between e-vector and local meridian passes
     through +-45 degrees at four azimuths placed symmetrically about the
     solar meridian; the meridian is the axis of their first harmonic, found
-    here by linear interpolation of ``cos 2 chi`` between neighbouring units;
+    here by linear interpolation of ``cos 2 chi`` between neighbouring units
+    (the axis about which the zero set is most nearly mirror-symmetric);
     the brighter side picks the sun's end (eq. 4.6 pair).
 """
 
@@ -173,7 +174,8 @@ def _pick_pair(score, azimuths, total, margin):
     n, g = score.shape
     rows = np.arange(n)
     best = np.argmax(score, axis=1)
-    far = (best[:, None] + g // 4 + 1 + np.arange(g - 2 * (g // 4) - 1)[None, :]) % g  # more than a quarter turn away
+    # the eq. 4.6 partner: the best candidate within 45 degrees of the antipode
+    far = (best[:, None] + g // 2 - g // 8 + np.arange(2 * (g // 8) + 1)[None, :]) % g
     alt = far[rows, np.argmax(np.take_along_axis(score, far, axis=1), axis=1)]
     step = 2.0 * np.pi / g
 
@@ -343,15 +345,17 @@ def sun_from_mean_vector(ev: UnitEvectors, valid, *, margin: float = np.deg2rad(
     return _up(s, margin)
 
 
-def sol_responses(ev: UnitEvectors, valid, *, response: str = "c", pol_op: int = 0):
+def sol_responses(ev: UnitEvectors, valid, *, response: str = "c", analyser: float = np.pi / 2.0):
     """Per-unit responses of Gkanias et al. (2023): ``p`` (POL), ``i`` (intensity) or ``c = i - p``.
 
-    ``p_k`` is the normalised POL-OP difference ``(s_a - s_b) / (s_a + s_b)``
-    (eq. 4.3's ``x``) of POL-OP ``pol_op``; ``i_k`` the unit's intensity
-    divided by the mean over the valid units, minus one.
+    ``p_k = d_k cos(2 (a_k - analyser))`` is the normalised POL-OP response
+    ``(s_par - s_perp) / (s_par + s_perp)`` of an analyser at ``analyser`` in
+    the unit frame (``pi/2``: horizontal, perpendicular to the unit's
+    meridian, i.e. largest for units on the solar meridian); ``i_k`` is the
+    unit's intensity divided by the mean over the valid units, minus one.
     """
-    ok = np.asarray(valid, bool) & np.isfinite(ev.intensity)
-    p = np.where(ok, np.nan_to_num(ev.x[..., pol_op]), 0.0)
+    ok = np.asarray(valid, bool) & np.isfinite(ev.intensity) & np.isfinite(ev.angle)
+    p = np.where(ok, np.nan_to_num(ev.degree) * np.cos(2.0 * (np.nan_to_num(ev.angle) - analyser)), 0.0)
     n = np.maximum(ok.sum(axis=-1), 1)
     inten = np.where(ok, np.nan_to_num(ev.intensity), 0.0)
     mean = inten.sum(axis=-1) / n
@@ -366,9 +370,9 @@ def sol_responses(ev: UnitEvectors, valid, *, response: str = "c", pol_op: int =
 
 
 def sun_from_sol(ev: UnitEvectors, valid, *, array: PolArray, n_sol: int = 8, response: str = "c",
-                 pol_op: int = 0) -> SunEstimate:
+                 analyser: float = np.pi / 2.0) -> SunEstimate:
     """Sinusoidal population (SOL) decoder (see the module docstring)."""
-    r, ok = sol_responses(ev, valid, response=response, pol_op=pol_op)
+    r, ok = sol_responses(ev, valid, response=response, analyser=analyser)
     theta_z = 2.0 * np.pi * np.arange(n_sol) / n_sol
     theta_k = array.unit_azimuths
     n_units = np.maximum(ok.sum(axis=-1), 1)
@@ -382,26 +386,78 @@ def sun_from_sol(ev: UnitEvectors, valid, *, array: PolArray, n_sol: int = 8, re
     return SunEstimate(np.where(good, az, np.nan), np.where(good, wrap_angle(az + np.pi), np.nan), good)
 
 
-def sun_from_four_zeros(ev: UnitEvectors, valid, *, array: PolArray) -> SunEstimate:
-    """Four-zeros method (see the module docstring)."""
+def _ring_fit(values, valid, azimuths, grid, n_harmonics):
+    """Weighted least-squares trigonometric interpolation of per-unit values around the ring, on ``grid``."""
+    def basis(t):
+        cols = [np.ones_like(t)]
+        for m in range(1, n_harmonics + 1):
+            cols += [np.cos(m * t), np.sin(m * t)]
+        return np.stack(cols, axis=-1)
+
+    b = basis(np.asarray(azimuths, float))  # (K, P)
+    w = np.asarray(valid, float)
+    a = np.einsum("nk,kp,kq->npq", w, b, b) + 1e-9 * np.eye(b.shape[1])
+    rhs = np.einsum("nk,kp,nk->np", w, b, np.nan_to_num(values))
+    coef = np.linalg.solve(a, rhs[..., None])[..., 0]
+    return coef @ basis(grid).T  # (N, G)
+
+
+def sun_from_four_zeros(ev: UnitEvectors, valid, *, array: PolArray, n_harmonics: int = 3, n_grid: int = 720) -> SunEstimate:
+    """Four-zeros method (see the module docstring).
+
+    ``cos 2 chi`` (``chi`` = e-vector angle from the unit's meridian, the unit
+    frame's ``x_u``) is interpolated around the ring by a trigonometric
+    least-squares fit with up to ``n_harmonics`` harmonics (fewer when fewer
+    units are valid) and cut at ``chi = +-45`` degrees, else (Smith & Stewart's
+    other options) at ``+-(45 + 60)`` or ``+-(45 - 60)`` degrees; samples whose
+    curve crosses none of these levels exactly four times are not decoded. The four zeros form two pairs placed
+    symmetrically about the solar meridian; of the two ways to pair
+    neighbouring zeros (mirror pairs are nested) the one whose pair bisectors
+    lie most nearly on one line gives the meridian; the brighter side picks the sun's end.
+    """
     n, k = ev.angle.shape
-    order = np.argsort(np.mod(array.unit_azimuths, 2.0 * np.pi))
-    theta = np.mod(array.unit_azimuths[order], 2.0 * np.pi)
-    f = np.cos(2.0 * ev.angle[:, order])
-    ok = np.asarray(valid, bool)[:, order] & np.isfinite(f)
-    f = np.where(ok, f, np.nan)
-    nxt = np.roll(np.arange(k), -1)
-    t0, t1 = theta, np.where(theta[nxt] <= theta, theta[nxt] + 2.0 * np.pi, theta[nxt])
-    f0, f1 = f, f[:, nxt]
-    crossing = ok & ok[:, nxt] & (np.sign(f0) != np.sign(f1))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        frac = f0 / (f0 - f1)
-    zeros = t0 + np.nan_to_num(frac) * (t1 - t0)
-    z = np.sum(np.where(crossing, np.exp(1j * zeros), 0.0), axis=1)
-    count = crossing.sum(axis=1)
-    axis = np.angle(z)
-    good = (count >= 2) & (np.abs(z) > 1e-9)
-    first, second = axis, wrap_angle(axis + np.pi)
-    bright = brightness_azimuth(ev, valid, array)
-    first, second = _choose_by_brightness(first, second, bright)
-    return SunEstimate(np.where(good, first, np.nan), np.where(good, second, np.nan), good & np.isfinite(bright))
+    ok = np.asarray(valid, bool) & np.isfinite(ev.angle)
+    count = ok.sum(axis=1)
+    grid = 2.0 * np.pi * np.arange(n_grid) / n_grid
+    f = np.cos(2.0 * np.nan_to_num(ev.angle))
+    curve = np.full((n, n_grid), np.nan)
+    for h in range(1, n_harmonics + 1):
+        rows = (count >= 2 * h + 1) & ((h == n_harmonics) | (count < 2 * h + 3))
+        if rows.any():
+            curve[rows] = _ring_fit(f[rows], ok[rows], array.unit_azimuths, grid, h)
+    nxt = np.roll(np.arange(n_grid), -1)
+    azimuth = np.full(n, np.nan)
+    alternative = np.full(n, np.nan)
+    resolved = np.zeros(n, bool)
+    bright_all = brightness_azimuth(ev, valid, array)
+    # Smith & Stewart's three options: chi = +-45, +-(45 + 60), +-(45 - 60) degrees
+    for level in (0.0, -np.cos(np.pi / 6.0), np.cos(np.pi / 6.0)):
+        g = curve - level
+        crossing = (np.sign(g) != np.sign(g[:, nxt])) & np.isfinite(g) & np.isfinite(g[:, nxt])
+        four = (crossing.sum(axis=1) == 4) & np.isnan(azimuth)
+        if not four.any():
+            continue
+        rows, cols = np.nonzero(crossing[four])
+        c0, c1 = g[four][rows, cols], g[four][rows, nxt[cols]]
+        step = 2.0 * np.pi / n_grid
+        z = (grid[cols] + c0 / (c0 - c1) * step).reshape(-1, 4)  # sorted around the ring
+
+        def mid(a, b):
+            return np.angle(np.exp(1j * a) + np.exp(1j * b))
+
+        best_axis, best_err = None, None
+        for pairing in (((0, 1), (2, 3)), ((1, 2), (3, 0))):
+            m1 = mid(z[:, pairing[0][0]], z[:, pairing[0][1]])
+            m2 = mid(z[:, pairing[1][0]], z[:, pairing[1][1]])
+            err = np.abs(wrap_angle(2.0 * (m1 - m2)))  # both bisectors lie on the meridian (a line)
+            axis = 0.5 * np.angle(np.exp(2j * m1) + np.exp(2j * m2))
+            if best_axis is None:
+                best_axis, best_err = axis, err
+            else:
+                better = err < best_err
+                best_axis = np.where(better, axis, best_axis)
+                best_err = np.where(better, err, best_err)
+        bright = bright_all[four]
+        first, second = _choose_by_brightness(best_axis, wrap_angle(best_axis + np.pi), bright)
+        azimuth[four], alternative[four], resolved[four] = first, second, np.isfinite(bright)
+    return SunEstimate(azimuth, alternative, resolved)

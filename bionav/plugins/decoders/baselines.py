@@ -20,11 +20,11 @@ class SolConfig:
 
     n_sol: int = 8  # SOL neurons, [3, 360]
     response: str = "c"  # per-unit response: p (polarization), i (intensity), c = i - p
-    pol_op: int = 0  # which POL-OP of a unit gives p (0: the 0/90 degree pair), [0, 7]
+    analyser_deg: float = 90.0  # analyser of the POL response in the unit frame (90: horizontal), [-180, 180]
 
     def __post_init__(self):
         check_range("n_sol", self.n_sol, 3, 360)
-        check_range("pol_op", self.pol_op, 0, 7)
+        check_range("analyser_deg", self.analyser_deg, -180.0, 180.0)
         if self.response not in ("p", "i", "c"):
             raise UserError(f"decoder.response={self.response!r} is unknown; choose p, i or c.")
 
@@ -35,10 +35,8 @@ class Sol(Decoder):
     Config = SolConfig
 
     def decode(self, evectors, valid, *, array, sun_elevation: float):
-        if self.config.pol_op >= evectors.x.shape[-1]:
-            raise UserError(f"decoder.pol_op={self.config.pol_op} but the array's units have {evectors.x.shape[-1]} POL-OPs.")
         return sun_from_sol(evectors, valid, array=array, n_sol=self.config.n_sol, response=self.config.response,
-                            pol_op=self.config.pol_op)
+                            analyser=np.deg2rad(self.config.analyser_deg))
 
 
 @dataclass
