@@ -148,6 +148,10 @@ def circular_offset(decoded, yaw) -> float:
 def session_errors(decoded, yaw, *, undecoded_error: float = np.pi / 2.0):
     """Errors ``wrap(decoded - yaw - c)`` with one ``c`` for the session; undecoded samples get ``undecoded_error``.
 
+    A sample a decoder cannot decode (NaN) counts as a 90 degree error, the
+    mean absolute error of a guess; ``sessions.csv`` also gives the MAE over
+    decoded samples only (``mae_decoded_deg``) and the decoded fraction.
+
     Returns
     -------
     errors : ndarray, radians in ``[-pi, pi)``
@@ -403,8 +407,10 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             heading, resolved, seconds = decode_session(dec, data)
             err, c = session_errors(heading, data.yaw)
             stats = error_stats(err)
+            decoded = np.isfinite(heading)
             row = {**base, "decoder": name, **stats,
-                   "decoded_fraction": float(np.mean(np.isfinite(heading))),
+                   "decoded_fraction": float(np.mean(decoded)),
+                   "mae_decoded_deg": error_stats(err[decoded])["mae_deg"],
                    "resolved_fraction": float(np.mean(resolved)),
                    "offset_deg": float(np.degrees(c)),
                    "decode_ms": 1000.0 * seconds}
