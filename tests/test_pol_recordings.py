@@ -163,3 +163,21 @@ def test_experiment_on_one_real_session(tmp_path):
     assert metrics["n_rotations"] == 2 and metrics["tod_daylight_mae_deg"] < 8.0
     sessions, errors = load_sessions(tmp_path / "rec")
     assert not errors and len(sessions) == 1
+
+
+def test_pol_compass_rotation_runs_on_recorded_counts_and_replays_exactly(tmp_path):
+    folder = _synthetic_session(tmp_path / "rec", rotations=1, n=60)
+    sky = ["experiment.sky.time=2022-05-12T13:00:00+02:00", "experiment.sky.latitude_deg=39.2",
+           "experiment.sky.longitude_deg=9.1"]
+    rec = tmp_path / "a"
+    proc = run_bionav("experiment=pol_compass", "sensor=recording", f"sensor.path={folder / '1.json'}", *sky,
+                      f"hydra.run.dir={rec}", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    first = json.loads((rec / "metrics.json").read_text())
+    assert first["n_samples"] == 60 and first["heading_mae_deg"] < 0.5 and first["axial"] is False
+    rep = tmp_path / "b"
+    proc = run_bionav("experiment=pol_compass", "sensor=replay", f"sensor.path={rec / 'run.mcap'}", *sky,
+                      f"hydra.run.dir={rep}", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    second = json.loads((rep / "metrics.json").read_text())
+    assert second["heading_mae_deg"] == first["heading_mae_deg"] and second["n_samples"] == 60
