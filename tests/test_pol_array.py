@@ -20,7 +20,7 @@ from bionav.polcompass.decoders import (
     sun_from_sol,
     sun_from_two_units,
 )
-from bionav.sky import SkyModel, SunPosition
+from bionav.light import SkyModel, SunPosition
 
 
 def test_thesis_array_recovers_angle_and_degree_exactly():

@@ -12,7 +12,7 @@ from helpers import run_bionav
 
 from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
 from bionav.polcompass.recordings import RecordingError, detect_faults, load_rotation, load_sessions
-from bionav.sky import SkyModel, sun_position
+from bionav.light import SkyModel, sun_position
 
 REPO = Path(__file__).resolve().parents[1]
 EXTERNAL = Path(os.environ.get("BIONAV_EXTERNAL_DATA", REPO.parent / "shared" / "data"))

@@ -220,7 +220,7 @@ def prepare_session(session, rc: RecordingsConfig) -> SessionData:
     """Counts, validity, e-vectors and the sun position of one session."""
     from bionav.polcompass.array import evectors_from_counts
     from bionav.polcompass.recordings import detect_faults, sample_validity
-    from bionav.sky import sun_position
+    from bionav.light import sun_position
 
     rots = session.rotations
     counts = np.concatenate([r.counts for r in rots])
@@ -269,9 +269,9 @@ def simulate_session(data: SessionData, exp: PolRecordingsConfig, rng) -> Sessio
     get a cloud field of ``sim_canopy_cover``.
     """
     from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
-    from bionav.sky import SkyModel, random_cloud_field
+    from bionav.light import SkyModel, random_cloud_map
 
-    clouds = random_cloud_field(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
+    clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
     model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
     mount = float(rng.uniform(-np.pi, np.pi))
     intensity, q, u = stokes_from_sky(model, data.array, mount + data.yaw)

@@ -35,7 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.polcompass.compass import delogarithmise, wrap_axial
+from bionav.geometry import wrap_axial
+from bionav.polcompass.compass import delogarithmise
 from bionav.polcompass.optics import sensor_frame
 
 
@@ -306,7 +307,7 @@ def stokes_from_sky(source, array: PolArray, heading=0.0):
     Parameters
     ----------
     source : object with ``light(view) -> SkyLight``
-        A :class:`bionav.sky.SkyModel`.
+        A :class:`bionav.light.SkyModel`.
     array : PolArray
     heading : float or ndarray, shape ``S``
         Sensor heading(s), radians CCW from east.

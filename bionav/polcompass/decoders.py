@@ -139,7 +139,7 @@ class SkyTable:
 
 def sky_table(array: PolArray, sun_elevation: float, *, n_grid: int = 720, max_degree: float = 0.76,
               neutral_point_separation: float = 0.0) -> SkyTable:
-    """Tabulate the sky model's e-vector pattern seen by the array (:class:`bionav.sky.SkyModel`).
+    """Tabulate the sky model's e-vector pattern seen by the array (:class:`bionav.light.SkyModel`).
 
     Parameters
     ----------
@@ -151,7 +151,7 @@ def sky_table(array: PolArray, sun_elevation: float, *, n_grid: int = 720, max_d
     max_degree, neutral_point_separation : float
         Sky model parameters (Rayleigh for separation 0, else Berry et al. 2004).
     """
-    from bionav.sky import SkyModel, SunPosition
+    from bionav.light import SkyModel, SunPosition
 
     phis = 2.0 * np.pi * np.arange(n_grid) / n_grid
     model = SkyModel(SunPosition(0.0, float(sun_elevation)), max_degree=max_degree,
