@@ -27,7 +27,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import registry
 
 #: config groups users select plugins in
-PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller")
+PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
 
 
 def config_dirs() -> list[tuple[str, Path]]:
