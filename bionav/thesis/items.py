@@ -341,7 +341,7 @@ class _Table53:
 class _Table54:
     @staticmethod
     def runs(preset: Preset) -> list[RunSpec]:
-        specs = [grid_spec(f"sim_{db}", homing=h, snapshots=preset.warping_snapshots)
+        specs = [grid_spec(f"sim_{db}", homing=h, size=preset.warping_size, snapshots=preset.warping_snapshots)
                  for h in preset.warping for db in THESIS_DBS]
         return specs + _Table53.runs(preset)
 

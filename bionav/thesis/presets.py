@@ -33,6 +33,7 @@ class Preset:
     sift_size: tuple[int, int]
     warping: tuple[str, ...]
     warping_snapshots: int | None
+    warping_size: tuple[int, int] | None
     fig54_sizes: tuple[tuple[int, int], ...]
     fig54_cutoffs: tuple[float, ...]
     fig55_sizes: tuple[tuple[int, int], ...]
@@ -60,6 +61,7 @@ FULL = Preset(
     sift_size=(1122, 162),
     warping=("warping2d_thesis", "minwarping_thesis"),
     warping_snapshots=None,
+    warping_size=None,
     fig54_sizes=((346, 50), (561, 81), (1122, 162)),
     fig54_cutoffs=THESIS_CUTOFFS,
     fig55_sizes=((346, 50), (561, 81), (1122, 162)),
@@ -87,6 +89,7 @@ QUICK = Preset(
     sift_size=(561, 81),
     warping=("warping2d", "minwarping"),
     warping_snapshots=2,
+    warping_size=None,
     fig54_sizes=((346, 50), (561, 81)),
     fig54_cutoffs=(0.05, 0.1, 0.3, 1.0),
     fig55_sizes=((346, 50), (561, 81)),
@@ -134,6 +137,7 @@ TINY = Preset(
     sift_size=(120, 18),
     warping=("warping2d",),
     warping_snapshots=1,
+    warping_size=(120, 18),
     fig54_sizes=((120, 18),),
     fig54_cutoffs=(0.3, 1.0),
     fig55_sizes=((120, 18),),
