@@ -211,3 +211,21 @@ def test_cli_dry_run_prints_launcher_multiruns(tmp_path):
     assert all("hydra/launcher=submitit_slurm" in ln and "hydra.launcher.partition=cpu" in ln for ln in lines)
     assert any("experiment=param_sweep" in ln and "experiment.grid=full" in ln for ln in lines)
     assert not (tmp_path / "x").exists()
+
+
+def test_grid_homing_reports_sift_keypoints_per_image(tmp_path):
+    """Tables B.1-B.4 need "Keys": grid homing reports the mean SIFT keypoint count, checked against OpenCV."""
+    import cv2
+    import numpy as np
+
+    from bionav.db.synthetic import synthetic_database
+
+    proc = run_bionav("db.image_size=[120,18]", "experiment.snapshots=[0]", f"hydra.run.dir={tmp_path / 'run'}",
+                      cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    metrics = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    db = synthetic_database("sim_original", image_size=(120, 18), cache_dir=tmp_path / "cache")
+    counts = [len(cv2.SIFT_create().detect(np.clip(np.rint(im * 255.0), 0, 255).astype(np.uint8), None))
+              for im in db.images]
+    assert metrics["keypoints_per_image"] == pytest.approx(np.mean(counts))
+    assert metrics["keypoints_per_image"] > 0
