@@ -79,7 +79,7 @@ def _run_lines(section: Section, out: Path) -> list[str]:
 def section_markdown(s: Section, out: Path) -> str:
     o = s.outcome
     passed, total = o.score
-    md = [f"## {s.label}: {s.title}", "", f"*Source:* {s.source}.  ", f"*Verdict:* **{o.verdict}** "
+    md = [f"## {_heading(s)}", "", f"*Source:* {s.source}.  ", f"*Verdict:* **{o.verdict}** "
           f"({passed} of {total} checks pass).  ", f"*Rule:* {s.rule}.", ""]
     if s.claims:
         md += ["The thesis claims:", *[f"- {c}" for c in s.claims], ""]
@@ -131,8 +131,12 @@ def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, w
     return "\n".join(head + [section_markdown(s, out) for s in sections])
 
 
+def _heading(s: Section) -> str:
+    return s.title if s.title.lower().startswith(s.label.split(" /")[0].lower()) else f"{s.label}: {s.title}"
+
+
 def _anchor(s: Section) -> str:
-    text = f"{s.label}: {s.title}".lower()
+    text = _heading(s).lower()
     return re.sub(r"[^a-z0-9 -]", "", text).replace(" ", "-")
 
 

@@ -21,6 +21,7 @@ import subprocess
 import sys
 import time
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
@@ -89,13 +90,19 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def _canonical_override(text: str) -> tuple[str, str] | None:
-    """``(key, canonical value)`` of one override, None for neutral keys."""
+@lru_cache(maxsize=1)
+def _parser():
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
+    return OverridesParser.create()
+
+
+@lru_cache(maxsize=4096)
+def _canonical_override(text: str) -> tuple[str, str] | None:
+    """``(key, canonical value)`` of one override, None for neutral keys."""
     text = text.strip()
     try:
-        (ov,) = OverridesParser.create().parse_overrides([text])
+        (ov,) = _parser().parse_overrides([text])
     except Exception:
         key, _, value = text.lstrip("+~").partition("=")
         return (key, re.sub(r"\s+", "", value))
