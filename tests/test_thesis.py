@@ -229,3 +229,22 @@ def test_grid_homing_reports_sift_keypoints_per_image(tmp_path):
               for im in db.images]
     assert metrics["keypoints_per_image"] == pytest.approx(np.mean(counts))
     assert metrics["keypoints_per_image"] > 0
+
+
+def test_cli_runs_through_a_hydra_launcher(tmp_path):
+    """--launcher joblib: the runs become multiruns under DIR/sweeps and the report reads their jobs."""
+    out = tmp_path / "rep"
+    proc = run_bionav("--preset", "tiny", "--only", "fig4_4,fig4_6", "--out", str(out), "--launcher", "joblib",
+                      "--launcher-arg", "hydra.launcher.n_jobs=2", cwd=tmp_path, module="bionav.thesis")
+    assert proc.returncode == 0, proc.stderr + proc.stdout
+    jobs = {}
+    for m in out.glob("sweeps/*/*/metrics.json"):
+        ov = yaml.safe_load((m.parent / ".hydra" / "overrides.yaml").read_text())
+        jobs[next(o for o in ov if o.startswith("experiment.sky.cloud_cover") or o.startswith("mode="))] = json.loads(m.read_text())
+    assert {"experiment.sky.cloud_cover=0.0", "experiment.sky.cloud_cover=0.6", "mode=vs_em_compass"} <= set(jobs)
+    assert not (out / "runs").exists()
+    by = {(r["item"], r["quantity"]): r for r in _rows(out / "items.csv")}
+    assert float(by[("fig4_6", "e-vector residual RMSE, cloud cover 0.6 (deg)")]["bionav"]) == pytest.approx(
+        jobs["experiment.sky.cloud_cover=0.6"]["heading_rmse_deg"], abs=1e-6)
+    assert float(by[("fig4_4", "averaged axial RMSE against the TCM2 (deg)")]["bionav"]) == pytest.approx(
+        jobs["mode=vs_em_compass"]["averaged_rmse_deg"], abs=1e-6)
