@@ -11,6 +11,7 @@ through that launcher; ``--dry-run`` prints the commands only.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -73,6 +74,7 @@ def run(args) -> int:
     from bionav.thesis.runs import Runner, tool_env
 
     started = time.time()
+    load_start = _loadavg()
     if args.preset not in PRESETS:
         raise UserError(f"unknown --preset {args.preset!r}; choose quick or full.")
     preset = PRESETS[args.preset]
@@ -123,7 +125,10 @@ def run(args) -> int:
                                 outcome, [results[s.key] for s in {s.key: s for s in specs[it.id]}.values()], claims))
     wall = time.time() - started
     command = "python -m bionav.thesis " + " ".join(argv_for_display(args))
-    md = report_markdown(sections, preset=preset, out=out, wall_s=wall, command=command)
+    cpu = sum(r.cpu_seconds or 0.0 for r in results.values())
+    machine = f"{os.cpu_count()} CPUs, 1-minute load average {load_start} at the start and {_loadavg()} at the end"
+    md = report_markdown(sections, preset=preset, out=out, wall_s=wall, command=command, cpu_s=cpu or None,
+                         machine=machine)
     (out / "report.md").write_text(md)
     (out / "report.html").write_text(markdown_to_html(md, out))
     write_csv(out / "items.csv", sections)
@@ -132,6 +137,13 @@ def run(args) -> int:
           ", ".join(f"{v} {counts.get(v, 0)}" for v in ("holds", "partly", "does not hold", "not produced")))
     print(f"report: {out / 'report.md'} ({out / 'report.html'}, {out / 'items.csv'})")
     return 0
+
+
+def _loadavg() -> str:
+    try:
+        return f"{os.getloadavg()[0]:.1f}"
+    except OSError:
+        return "unknown"
 
 
 def argv_for_display(args) -> list[str]:

@@ -69,7 +69,8 @@ def _run_lines(section: Section, out: Path) -> list[str]:
     for r in section.runs:
         where = "" if r.dir is None else str(Path(r.dir).relative_to(out)) if str(r.dir).startswith(str(out)) else str(r.dir)
         state = "completed" if r.ok else f"not completed: {r.error}"
-        t = "" if r.seconds is None else f", {r.seconds:.0f} s"
+        t = "" if r.seconds is None else f", {r.seconds:.0f} s wall" + (
+            "" if r.cpu_seconds is None else f", {r.cpu_seconds:.0f} s CPU")
         reused = ", reused" if r.reused else ""
         lines.append(f"- `python -m bionav {'-m ' if r.spec.multirun else ''}{' '.join(r.spec.overrides)}` "
                      f"-> `{where}` ({state}{t}{reused})")
@@ -109,12 +110,13 @@ def section_markdown(s: Section, out: Path) -> str:
 
 
 def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, wall_s: float, command: str,
-                    cpu_s: float | None = None) -> str:
+                    cpu_s: float | None = None, machine: str = "") -> str:
     counts = verdict_counts(sections)
     head = [
         "# The thesis, reproduced by bionav", "",
         f"Command: `{command}`  ", f"Preset: **{preset.name}** ({preset.summary}).  ",
-        f"Wall time of this invocation: {wall_s:.0f} s" + (f" (CPU of the runs: {cpu_s:.0f} s)" if cpu_s else "") + ".",
+        f"Wall time of this invocation: {wall_s:.0f} s" + (f" (CPU of the runs it executed: {cpu_s:.0f} s)" if cpu_s else "")
+        + (f"; machine: {machine}" if machine else "") + ".",
         "",
         "bionav runs on synthetic stand-ins of the thesis' databases, sensors and scenes; many verdicts are honestly "
         "'does not hold' because the stand-ins are not calibrated to the thesis' environments.", "",

@@ -130,6 +130,7 @@ class RunResult:
     error: str | None = None
     seconds: float | None = None
     reused: bool = False
+    cpu_seconds: float | None = None
 
     @property
     def ok(self) -> bool:
@@ -205,10 +206,12 @@ def execute_local(spec: RunSpec, out: Path, *, env: Mapping[str, str] | None = N
     run_dir.parent.mkdir(parents=True, exist_ok=True)
     log_path = run_dir.parent / f"{spec.slug}.log"
     started = time.time()
+    cpu0 = _children_cpu()
     with open(log_path, "w") as fh:
         proc = subprocess.run(spec.command(run_dir, launcher=launcher), stdout=fh, stderr=subprocess.STDOUT,
                               env=dict(env) if env is not None else None)
     seconds = time.time() - started
+    cpu = _children_cpu() - cpu0
     if spec.multirun:
         metrics = _sweep_metrics(run_dir)
         if metrics["status"] == "completed":
@@ -218,7 +221,15 @@ def execute_local(spec: RunSpec, out: Path, *, env: Mapping[str, str] | None = N
     error = None
     if proc.returncode != 0 or not metrics or metrics.get("status") != "completed":
         error = _last_error(log_path, metrics)
-    return RunResult(spec, run_dir, metrics, error, seconds)
+    return RunResult(spec, run_dir, metrics, error, seconds, cpu_seconds=cpu)
+
+
+def _children_cpu() -> float:
+    """User + system CPU seconds of the finished child processes (``resource.getrusage``)."""
+    import resource
+
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
 
 
 def _last_error(log_path: Path, metrics: dict | None) -> str:
@@ -331,7 +342,8 @@ class Runner:
                 continue
             self.echo(f"[{i}/{len(todo)}] python {cmd}")
             res = execute_local(spec, self.out, env=self.env)
-            self.echo(f"    {'done' if res.ok else 'FAILED: ' + str(res.error)} in {res.seconds:.0f} s")
+            self.echo(f"    {'done' if res.ok else 'FAILED: ' + str(res.error)} in {res.seconds:.0f} s "
+                      f"(CPU {res.cpu_seconds:.0f} s)")
             results[spec.key] = res
         return results
 
