@@ -248,3 +248,20 @@ def test_cli_runs_through_a_hydra_launcher(tmp_path):
         jobs["experiment.sky.cloud_cover=0.6"]["heading_rmse_deg"], abs=1e-6)
     assert float(by[("fig4_4", "averaged axial RMSE against the TCM2 (deg)")]["bionav"]) == pytest.approx(
         jobs["mode=vs_em_compass"]["averaged_rmse_deg"], abs=1e-6)
+
+
+def test_fig4_5_shows_the_raw_first_candidate():
+    """Fig. 4.5 plots the first candidate of eq. 4.6 (jumping by 180 degrees), fig. 4.4 the nearest one."""
+    import numpy as np
+
+    from bionav.experiments.pol_compass_plots import displayed_heading_deg
+
+    truth = np.deg2rad(np.arange(-170.0, 180.0, 20.0))
+    first = np.where(np.abs(truth) > np.pi / 2, truth - np.pi, truth)  # an axial sensor: one 180-degree window
+    raw = displayed_heading_deg(first, truth, nearest=False)
+    near = displayed_heading_deg(first, truth, nearest=True)
+    wrapped_truth = (np.degrees(truth) + 180.0) % 360.0 - 180.0
+    jump = np.abs(truth) > np.pi / 2
+    assert np.allclose(np.abs((raw - wrapped_truth + 180.0) % 360.0 - 180.0)[jump], 180.0)
+    assert np.allclose(raw[~jump], wrapped_truth[~jump])
+    assert np.allclose(near, np.degrees(truth))
