@@ -59,6 +59,11 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as exc:
         print(f"bionav.thesis: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # full disk, permissions while writing the report
+        print(f"bionav.thesis: error: cannot write {getattr(exc, 'filename', None) or args.out}: "
+              f"{exc.strerror or exc}. Free space or choose another --out; completed runs are kept and reused.",
+              file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"bionav.thesis: interrupted; completed runs are kept in {args.out}/runs and are reused when you run "
               f"the same command again.", file=sys.stderr)
