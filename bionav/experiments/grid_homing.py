@@ -127,6 +127,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "n_pairs": hv.n_pairs,
         "ms_per_home_vector": hv.ms_per_home_vector,
     }
+    metrics.update({f"{k}_per_image": v for k, v in hv.prepared_stats.items()})
     if hv.compass_error is not None:
         metrics["compass_aae"] = float(np.nanmean(np.abs(hv.compass_error)))
     return metrics
