@@ -102,6 +102,12 @@ def register_configs() -> dict[str, list[str]]:
 
     # every db preset is merged onto this schema: all db.* keys exist and are typed
     store.store(name="db_schema", node=DatabaseConfig, provider="bionav")
+    try:  # hydra/launcher=submitit_slurm records cancelled/killed jobs as failed (bionav/launcher.py)
+        from bionav.launcher import register as register_launcher
+    except ImportError:  # the slurm extra is not installed
+        pass
+    else:
+        register_launcher()
     names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
     for kind in registry.GROUPS:
         with warnings.catch_warnings():
