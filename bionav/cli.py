@@ -147,6 +147,12 @@ def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
     argv = list(sys.argv[1:] if argv is None else argv)
     limit_blas_threads()
+    from bionav.completion import BASH_SCRIPT, rewrite_query_line, wants_bash_install
+
+    if wants_bash_install(argv):  # Hydra's script does not know `python -m bionav`
+        print(BASH_SCRIPT, end="")
+        return
+    rewrite_query_line()
     try:
         from bionav.config import register_configs
 

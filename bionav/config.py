@@ -63,8 +63,18 @@ class BionavSearchPathPlugin(SearchPathPlugin):
     """Adds every ``bionav.configs`` folder to Hydra's config search path."""
 
     def manipulate_search_path(self, search_path: ConfigSearchPath) -> None:
-        for name, folder in config_dirs():
-            search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
+        dirs = config_dirs()
+        own = dict(dirs).get("bionav")
+        for element in search_path.get_path():
+            # ``python -m bionav`` (config_path=None) searches the package itself, where an installed
+            # ``bionav/conf`` would show up as a second set of groups named ``conf/...`` in --help and
+            # completion: search bionav's own config folder there instead, and only there.
+            if element.provider == "main" and own is not None and element.path != f"file://{own}":
+                element.path = f"file://{own}"
+        present = {element.path for element in search_path.get_path()}
+        for name, folder in dirs:
+            if f"file://{folder}" not in present:
+                search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
 
 
 def plugin_node_class(name: str, config_cls: type) -> type:
