@@ -170,7 +170,8 @@ class BionavSlurmLauncher(SlurmLauncher):
 
     def _failed_return(self, overrides: list[str], num: int, message: str) -> JobReturn:
         from bionav.experiments.objective import objective_from_config
-        from bionav.experiments.runner import is_completed, write_json_atomic
+        from bionav.experiments.runner import is_completed
+        from bionav.files import write_json_atomic
 
         assert self.hydra_context is not None and self.config is not None
         sweep_config = self.hydra_context.config_loader.load_sweep_config(self.config, list(overrides))
