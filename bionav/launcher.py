@@ -23,6 +23,7 @@ documented command is unchanged. It
 from __future__ import annotations
 
 import logging
+import os
 import subprocess
 import time
 from dataclasses import dataclass
@@ -114,6 +115,8 @@ class BionavSlurmLauncher(SlurmLauncher):
         )
         sweep_dir = Path(str(self.config.hydra.sweep.dir))
         sweep_dir.mkdir(parents=True, exist_ok=True)
+        if "mode" in self.config.hydra.sweep:
+            os.chmod(sweep_dir, mode=int(str(self.config.hydra.sweep.mode), 8))
         log.info("Submitit 'slurm' sweep output dir : %s", sweep_dir)
         arguments = []
         for num, overrides in enumerate(job_overrides, start=initial_job_idx):

@@ -19,8 +19,6 @@ ACCOUNTING="${SLURM_LOCAL_ACCOUNTING:-1}"
 MARKER="# written by bionav scripts/slurm-localhost.sh"
 CONF=/etc/slurm/slurm.conf
 DBDCONF=/etc/slurm/slurmdbd.conf
-PACKAGES=(slurm-wlm munge)
-[ "$ACCOUNTING" = 1 ] && PACKAGES+=(slurmdbd mariadb-server)
 
 say() { echo "slurm-localhost: $*" >&2; }
 die() { say "error: $*"; exit 1; }
