@@ -172,27 +172,32 @@ def _check_writable(path: Path) -> None:
 
 
 def _task(cfg) -> float | None:
+    """One job; returns the run's objective (config ``objective``) for sweepers, worst on failure."""
     from hydra.core.hydra_config import HydraConfig
     from hydra.types import RunMode
 
     from bionav.experiments.runner import run_experiment
 
+    from bionav.experiments.objective import objective_from_config
+
     hc = HydraConfig.get()
     run_dir = Path(hc.runtime.output_dir)
     multirun = hc.mode == RunMode.MULTIRUN
+    objective = None
     try:
+        objective = objective_from_config(cfg.get("objective"))
         metrics = run_experiment(cfg, run_dir, show_progress=sys.stderr.isatty() or not multirun)
     except UserError as exc:
         if multirun:
             log.error("job %s failed: %s", hc.job.num, exc)
-            return None
+            return objective.worst if objective else None
         _fail(f"{exc} (run directory: {run_dir})")
     except KeyboardInterrupt:
         _fail(f"interrupted; what was recorded so far is in {run_dir} (metrics.json says failed).", 130)
     except Exception as exc:
         if multirun:
             log.error("job %s failed with an internal error: %s (see %s/error.log)", hc.job.num, exc, run_dir)
-            return None
+            return objective.worst if objective else None
         _fail(
             f"internal error: {type(exc).__name__}: {exc}. This is a bug in bionav or a plugin; the traceback is "
             f"in {run_dir / 'error.log'} and the run's log in {run_dir / 'run.mcap'}.",
@@ -207,7 +212,7 @@ def _task(cfg) -> float | None:
         )
     else:
         _print_result(metrics)
-    return None
+    return objective.value(metrics) if objective else None
 
 
 def _print_result(metrics: dict) -> None:
@@ -232,6 +237,12 @@ def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
     argv = list(sys.argv[1:] if argv is None else argv)
     limit_blas_threads()
+    from bionav.completion import BASH_SCRIPT, rewrite_query_line, wants_bash_install
+
+    if wants_bash_install(argv):  # Hydra's script does not know `python -m bionav`
+        print(BASH_SCRIPT, end="")
+        return
+    rewrite_query_line()
     try:
         from bionav.config import register_configs
 
