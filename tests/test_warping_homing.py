@@ -181,3 +181,20 @@ def test_methods_home_in_the_rendered_lab(lab_views, cls, max_home_deg, mean_hom
         if psi_tol_deg is not None:
             assert np.degrees(angular_difference(hv.compass, heading)) < psi_tol_deg
     assert max(errors) < max_home_deg and np.mean(errors) < mean_home_deg
+
+
+@pytest.mark.parametrize("options", [{}, {"compass_acceleration": True, "compass_fraction": 0.3},
+                                     {"fine_search": True, "double_search": True}])
+def test_quantised_minwarping_agrees_with_the_float_search(views, lab_views, options):
+    # the 8-bit search (default) against the float32 one on rendered pairs:
+    # home direction and compass within one search step (360 / 96 degrees)
+    step_deg = 360.0 / 96
+    for geometry, snap, currents in (views, lab_views):
+        fast = MinWarping(MinWarping.Config(**options), geometry=geometry)
+        slow = MinWarping(MinWarping.Config(quantised=False, **options), geometry=geometry)
+        s_fast, s_slow = fast.prepare(snap), slow.prepare(snap)
+        for cur in currents:
+            a = fast.home_vector(s_fast, fast.prepare(cur))
+            b = slow.home_vector(s_slow, slow.prepare(cur))
+            assert np.degrees(angular_difference(a.angle, b.angle)) <= step_deg + 1e-9
+            assert np.degrees(angular_difference(a.compass, b.compass)) <= step_deg + 1e-9

@@ -9,14 +9,19 @@ which lies in ``[0, 1]`` (0 for identical columns; defined as 0 when both
 columns are zero). Möller, Horst & Fleer (2014, "Illumination tolerance for
 visual navigation with the holistic min-warping method", Robotics 3) found it
 the best measure for min-warping on edge-filtered images.
+
+The fast path (``quantised=True``) computes it as the SIMD reference
+implementation of min-warping does (Möller, Horst & Fleer 2014; WarpingSIMD):
+both stacks are quantised to 16-bit integers with one common scale (NSAD does
+not change when both columns are scaled alike), the absolute differences are
+summed in 16 bits, and the distance is stored as a byte,
+``round(NSAD * q)`` with the quantum ``q`` of :func:`distance_quantum`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
-
-from bionav.homing.warping.kernels import PARALLEL_LOCK
+from numba import njit
 
 
 def column_distance_matrix(snapshot, current):
@@ -44,7 +49,101 @@ def column_distance_matrix(snapshot, current):
     return out
 
 
-@njit(parallel=True, fastmath=True, cache=True)
+def distance_quantum(width: int):
+    """Quantum of the 8-bit distances and the dtype of their sums over ``width`` columns.
+
+    Returns
+    -------
+    q : int
+        Quantised distances are ``round(NSAD * q)`` in ``0 .. q``;
+        ``q = min(255, 65535 // width)`` so that a match value (a sum over
+        ``width`` columns) fits 16 bits (227 at 288 columns, 189 at 346).
+    dtype : numpy dtype
+        ``uint16``, or ``uint32`` with ``q = 255`` for panoramas wider than
+        1023 columns.
+    """
+    q = min(255, 65535 // int(width))
+    if q >= 64:
+        return q, np.dtype(np.uint16)
+    return 255, np.dtype(np.uint32)
+
+
+def _image_quantum(n_rows: int) -> int:
+    """Largest |value| of the 16-bit edge images: ``2 * n_rows * q`` must fit 16 bits."""
+    return max(1, min(2047, 65535 // (2 * int(n_rows))))
+
+
+@njit(nogil=True, fastmath=True, cache=True)
+def _quantise_phases(planes, scale, step, n_out, out, norms):
+    """``out[k, r, ph, m] = round(scale * planes[k, r, (m * step + ph) % W])``; ``norms`` = sum_r |out|."""
+    n_planes, n_rows, width = planes.shape
+    for k in range(n_planes):
+        for ph in range(step):
+            for m in range(n_out):
+                norms[k, ph, m] = 0
+        for r in range(n_rows):
+            for ph in range(step):
+                o = out[k, r, ph]
+                nk = norms[k, ph]
+                src = planes[k, r]
+                for m in range(n_out):
+                    j = m * step + ph
+                    while j >= width:
+                        j -= width
+                    x = np.int16(np.rint(src[j] * scale))
+                    o[m] = x
+                    nk[m] += abs(np.int32(x))
+
+
+@njit(nogil=True, fastmath=True, cache=True)
+def _diagonal_distances_q(sq, cq, sn, cn, quantum, out):
+    """8-bit NSAD in diagonal layout from phase-split 16-bit stacks.
+
+    ``sq[k, r, rr, m]`` holds snapshot column ``m * step + rr``, ``cq[k, r, ph, m]``
+    current column ``(m * step + ph) mod W`` for ``m < 2 n``, so that for a
+    diagonal ``d`` the current columns ``i + d`` of all snapshot columns
+    ``i = m * step + rr`` (one ``rr``) are the contiguous run
+    ``cq[k, r, (rr + d) % step, (rr + d) // step :][:n]``.
+    """
+    n_planes, n_rows, step, n = sq.shape
+    width = step * n
+    acc = np.zeros((step, n), np.uint16)
+    qf = np.float32(quantum)
+    for k in range(n_planes):
+        for d in range(width):
+            for rr in range(step):
+                for m in range(n):
+                    acc[rr, m] = 0
+            for r in range(n_rows):
+                for rr in range(step):
+                    c = rr + d
+                    off = c // step
+                    ph = c - off * step
+                    a = sq[k, r, rr]
+                    b = cq[k, r, ph, off:off + n]
+                    ac = acc[rr]
+                    for m in range(n):
+                        # |a - b| as max - min keeps the loop in 16 bits
+                        ac[m] += np.uint16(max(a[m], b[m]) - min(a[m], b[m]))
+            for rr in range(step):
+                c = rr + d
+                off = c // step
+                ph = c - off * step
+                na = sn[k, rr]
+                nb = cn[k, ph, off:off + n]
+                ac = acc[rr]
+                o = out[k, d, rr]
+                for m in range(n):
+                    den = np.float32(na[m] + nb[m])
+                    val = np.float32(0.5)
+                    if den > 0:
+                        val = np.float32(ac[m]) * qf / den + np.float32(0.5)
+                    x = np.uint8(val)
+                    o[m] = x
+                    o[m + n] = x
+
+
+@njit(nogil=True, fastmath=True, cache=True)
 def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
     """Fill ``out[k, d, i % step, i // step (+ n)] = NSAD(snap[k, :, i], cur[k, :, (i + d) % W])``.
 
@@ -57,31 +156,37 @@ def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
     """
     n_planes, n_rows, width = snap.shape
     n = width // step
-    for t in prange(n_planes * width):
-        k = t // width
-        d = t - k * width
-        acc = np.zeros(width, dtype=np.float32)
-        for r in range(n_rows):
-            a = snap[k, r]
-            b = cur2[k, r, d:d + width]
-            for i in range(width):
-                acc[i] += abs(a[i] - b[i])
-        na = snap_norm[k]
-        nb = cur_norm2[k, d:d + width]
-        # loop over (i % step, i // step) rather than dividing: an integer
-        # division by a run-time step costs more than the whole row sum
-        for rr in range(step):
-            for m in range(n):
-                i = m * step + rr
-                den = na[i] + nb[i]
-                val = np.float32(0.0)
-                if den > 0:
-                    val = acc[i] / den
-                out[k, d, rr, m] = val
-                out[k, d, rr, m + n] = val
+    acc = np.zeros(width, dtype=np.float32)
+    for k in range(n_planes):
+        for d in range(width):
+            acc[:] = 0.0
+            for r in range(n_rows):
+                a = snap[k, r]
+                b = cur2[k, r, d:d + width]
+                for i in range(width):
+                    acc[i] += abs(a[i] - b[i])
+            na = snap_norm[k]
+            nb = cur_norm2[k, d:d + width]
+            # loop over (i % step, i // step) rather than dividing: an integer
+            # division by a run-time step costs more than the whole row sum
+            for rr in range(step):
+                for m in range(n):
+                    i = m * step + rr
+                    den = na[i] + nb[i]
+                    val = np.float32(0.0)
+                    if den > 0:
+                        val = acc[i] / den
+                    out[k, d, rr, m] = val
+                    out[k, d, rr, m + n] = val
 
 
-def diagonal_distances(snapshot, current, *, step: int = 1, out=None):
+def _absmax(stack, key):
+    if f"{key}_absmax" in stack:
+        return float(stack[f"{key}_absmax"])
+    return float(np.abs(np.asarray(stack[key])).max(initial=0.0))
+
+
+def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised: bool = False):
     """Fast column distances in the layout the search kernels read.
 
     Parameters
@@ -90,15 +195,20 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None):
         Scale-plane stacks (see :func:`column_distance_matrix`).
     step : int
         Alpha step in columns (``W`` must be a multiple of it).
-    out : ndarray, shape (K, W, step, 2 * W // step), float32, optional
-        Array to fill (C-contiguous), e.g. the first level of the search's
-        window minima; a new one by default.
+    out : ndarray, shape (K, W, step, 2 * W // step), optional
+        Array to fill (C-contiguous, float32 or uint8 for ``quantised``), e.g.
+        the first level of the search's window minima; a new one by default.
+    quantised : bool
+        Quantise as the SIMD reference does (16-bit images, 16-bit sums, 8-bit
+        distances ``round(NSAD * q)``, ``q`` of :func:`distance_quantum`);
+        float32 NSAD otherwise.
 
     Returns
     -------
-    ndarray, shape (K, W, step, 2 * W // step), float32
+    ndarray, shape (K, W, step, 2 * W // step), float32 or uint8
         ``E[k, d, i % step, i // step]`` (and again at ``i // step + W // step``)
-        equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``.
+        equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``
+        (times ``q`` and rounded when quantised).
     """
     snap = np.ascontiguousarray(snapshot["snap"], dtype=np.float32)
     cur = np.ascontiguousarray(current["cur"], dtype=np.float32)
@@ -106,22 +216,34 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None):
         raise ValueError(
             f"snapshot and current view stacks differ in shape: {snap.shape} vs {cur.shape}"
         )
-    n_planes, _, width = snap.shape
+    n_planes, n_rows, width = snap.shape
     if width % step:
         raise ValueError(f"width {width} is not a multiple of the alpha step {step}")
-    shape = (n_planes, width, step, 2 * (width // step))
+    n = width // step
+    shape = (n_planes, width, step, 2 * n)
+    dtype = np.uint8 if quantised else np.float32
     if out is None:
-        out = np.empty(shape, dtype=np.float32)
-    elif out.shape != shape or out.dtype != np.float32 or not out.flags.c_contiguous:
-        raise ValueError(f"out must be a C-contiguous float32 array of shape {shape}")
+        out = np.empty(shape, dtype=dtype)
+    elif out.shape != shape or out.dtype != dtype or not out.flags.c_contiguous:
+        raise ValueError(f"out must be a C-contiguous {np.dtype(dtype).name} array of shape {shape}")
+    if quantised:
+        top = max(_absmax(snapshot, "snap"), _absmax(current, "cur"))
+        scale = np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
+        sq = np.empty((n_planes, n_rows, step, n), np.int16)
+        sn = np.empty((n_planes, step, n), np.int32)
+        cq = np.empty((n_planes, n_rows, step, 2 * n), np.int16)
+        cn = np.empty((n_planes, step, 2 * n), np.int32)
+        _quantise_phases(snap, scale, int(step), n, sq, sn)
+        _quantise_phases(cur, scale, int(step), 2 * n, cq, cn)
+        _diagonal_distances_q(sq, cq, sn, cn, distance_quantum(width)[0], out)
+        return out
     cur_norm = np.asarray(current["cur_norm"], dtype=np.float32)
-    with PARALLEL_LOCK:
-        _diagonal_distances(
-            snap,
-            np.concatenate([cur, cur], axis=2),
-            np.ascontiguousarray(snapshot["snap_norm"], dtype=np.float32),
-            np.concatenate([cur_norm, cur_norm], axis=1),
-            int(step),
-            out,
-        )
+    _diagonal_distances(
+        snap,
+        np.concatenate([cur, cur], axis=2),
+        np.ascontiguousarray(snapshot["snap_norm"], dtype=np.float32),
+        np.concatenate([cur_norm, cur_norm], axis=1),
+        int(step),
+        out,
+    )
     return out

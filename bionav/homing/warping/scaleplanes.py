@@ -159,7 +159,10 @@ def scale_plane_stack(image, *, geometry: PanoramaGeometry, scales=None):
         planes in the snapshot role; ``cur`` (K, H-1, W) float32: its planes in
         the current-view role; ``snap_norm`` and ``cur_norm`` (K, W) float32:
         the sum of absolute values of every column of those planes (the
-        denominators of the normalised sum of absolute differences).
+        denominators of the normalised sum of absolute differences);
+        ``snap_absmax`` and ``cur_absmax`` () float32: the largest absolute
+        value of each role's planes (the quantised distances scale both
+        images of a pair by the larger of the two).
     """
     s = default_scales() if scales is None else np.asarray(scales, dtype=np.float64)
     s, _ = check_scales(s)
@@ -186,4 +189,6 @@ def scale_plane_stack(image, *, geometry: PanoramaGeometry, scales=None):
         "cur": np.ascontiguousarray(cur, dtype=np.float32),
         "snap_norm": np.abs(snap).sum(axis=1).astype(np.float32),
         "cur_norm": np.abs(cur).sum(axis=1).astype(np.float32),
+        "snap_absmax": np.array(np.abs(snap).max(initial=0.0), dtype=np.float32),
+        "cur_absmax": np.array(np.abs(cur).max(initial=0.0), dtype=np.float32),
     }
