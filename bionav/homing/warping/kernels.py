@@ -111,28 +111,31 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     """
     _, n_planes, width, step, _ = levels.shape
     n_p = p_cols.shape[0]
-    best = np.empty(n_alpha, dtype=levels.dtype)
-    # snapshot columns in phase order (u = rr, rr + step, ...): the rows of one
-    # phase rr are a quarter of the table, which keeps the reads in cache
+    best = np.empty((n_p, n_alpha), dtype=levels.dtype)
+    # snapshot columns in phase order (u = rr, rr + step, ...): one phase reads
+    # a third of the table (step 3), which keeps the reads in cache; per window
+    # all rotations at once (the window's plane and level stay fixed)
     for rr in range(step):
         for u in range(rr, width, step):
             m0 = u // step
-            e0 = start[u]
-            e1 = start[u + 1]
-            for ip in range(n_p):
-                best[:] = big
-                pc = p_cols[ip]
-                for e in range(e0, e1):
-                    d = _wrap(w_v[e] - u - pc, width)
-                    row = levels[w_level[e], w_plane[e], d, rr, m0:m0 + n_alpha]
+            best[:] = big
+            for e in range(start[u], start[u + 1]):
+                plane = levels[w_level[e], w_plane[e]]
+                v0 = w_v[e] - u
+                for ip in range(n_p):
+                    d = _wrap(v0 - p_cols[ip], width)
+                    row = plane[d, rr, m0:m0 + n_alpha]
+                    b = best[ip]
                     for a in range(n_alpha):
-                        # compare-and-select: compiles to packed byte compares
+                        # compare and select: packed byte compares
                         x = row[a]
-                        if x < best[a]:
-                            best[a] = x
+                        if x < b[a]:
+                            b[a] = x
+            for ip in range(n_p):
                 acc = out[ip]
+                b = best[ip]
                 for a in range(n_alpha):
-                    acc[a] += best[a]
+                    acc[a] += b[a]
     return out
 
 

@@ -21,6 +21,7 @@ entry as one vector; otherwise they search every column and keep the grid.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -96,20 +97,30 @@ def _layout_step(width: int, n_alpha: int, p_cols, double_search: bool) -> int:
 WINDOW_LEVEL = 4
 
 
-def _window_minima(snapshot, current, step, windows, quantised, dist=None):
+_WORKSPACE = threading.local()
+
+
+def _buffer(name, shape, dtype):
+    """A per-thread array reused between calls (saves allocating and faulting in
+    several MB per home vector); valid until the next call on the same thread."""
+    cache = _WORKSPACE.__dict__.setdefault("arrays", {})
+    arr = cache.get(name)
+    if arr is None or arr.shape != shape or arr.dtype != dtype:
+        arr = np.empty(shape, dtype=dtype)
+        cache[name] = arr
+    return arr
+
+
+def _window_minima(snapshot, current, step, windows, quantised, name="levels"):
     """Column distances (level 0) and the sliding minima the windows read.
 
-    ``dist``: level 0 already computed (e.g. the transposed stack of the
-    swapped pair); copied in.
+    The result is a per-thread buffer ``name``.
     """
     n_levels = int(windows[2].max(initial=0)) + 1
     n_planes, _, width = np.shape(snapshot["snap"])
-    dtype = np.uint8 if quantised else np.float32
-    levels = np.empty((n_levels, n_planes, width, step, 2 * (width // step)), dtype=dtype)
-    if dist is None:
-        diagonal_distances(snapshot, current, step=step, out=levels[0], quantised=quantised)
-    else:
-        levels[0] = dist
+    dtype = np.dtype(np.uint8 if quantised else np.float32)
+    levels = _buffer(name, (n_levels, n_planes, width, step, 2 * (width // step)), dtype)
+    diagonal_distances(snapshot, current, step=step, out=levels[0], quantised=quantised)
     if n_levels > 1:
         fill_window_minima(levels)
     return levels
@@ -310,11 +321,13 @@ def minwarping(
     scores = _search(levels, n_a_eff, p_cols, windows, quantised)
     levels2 = None
     if double_search:
-        dist2 = None
+        levels2 = _buffer("levels2", levels.shape, levels.dtype)
         if _symmetric_scales(scales):
-            dist2 = np.empty_like(levels[0])
-            swap_roles(levels[0], dist2)
-        levels2 = _window_minima(current, snapshot, step, windows, quantised, dist=dist2)
+            swap_roles(levels[0], levels2[0])
+            if levels2.shape[0] > 1:
+                fill_window_minima(levels2)
+        else:
+            _window_minima(current, snapshot, step, windows, quantised, name="levels2")
         scores2 = _search(levels2, n_a_eff, (-p_cols) % width, windows, quantised)
         # hypothesis (a, p) of the pair corresponds to (a + W/2 - p, -p) of the swapped pair
         a_eff = np.arange(n_a_eff) * step
