@@ -74,91 +74,103 @@ def _image_quantum(n_rows: int) -> int:
 
 
 @njit(nogil=True, fastmath=True, cache=True)
-def _quantise_phases(planes, scale, step, n_out, out, norms):
-    """``out[k, r, ph, m] = round(scale * planes[k, r, (m * step + ph) % W])``; ``norms`` = sum_r |out|."""
+def _quantise(planes, scale, out, norms):
+    """``out[k, r, j] = round(scale * planes[k, r, j % W])`` (``j < out.shape[2]``); ``norms`` = sum_r |out|."""
     n_planes, n_rows, width = planes.shape
+    n_out = out.shape[2]
     for k in range(n_planes):
-        for ph in range(step):
-            for m in range(n_out):
-                norms[k, ph, m] = 0
+        nk = norms[k]
+        for j in range(n_out):
+            nk[j] = 0
         for r in range(n_rows):
-            for ph in range(step):
-                o = out[k, r, ph]
-                nk = norms[k, ph]
-                src = planes[k, r]
-                for m in range(n_out):
-                    j = m * step + ph
-                    while j >= width:
-                        j -= width
-                    x = np.int16(np.rint(src[j] * scale))
-                    o[m] = x
-                    nk[m] += abs(np.int32(x))
+            src = planes[k, r]
+            o = out[k, r]
+            for j in range(width):
+                o[j] = np.int16(np.rint(src[j] * scale))
+            for j in range(width, n_out):
+                o[j] = o[j - width]
+            for j in range(n_out):
+                nk[j] += abs(np.int32(o[j]))
 
 
 @njit(nogil=True, fastmath=True, cache=True)
-def _diagonal_distances_q(sq, cq, sn, cn, quantum, out):
-    """8-bit NSAD in diagonal layout from phase-split 16-bit stacks.
+def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
+    """8-bit NSAD in diagonal layout from 16-bit stacks.
 
-    ``sq[k, r, rr, m]`` holds snapshot column ``m * step + rr``, ``cq[k, r, ph, m]``
-    current column ``(m * step + ph) mod W`` for ``m < 2 n``, so that for a
-    diagonal ``d`` the current columns ``i + d`` of all snapshot columns
-    ``i = m * step + rr`` (one ``rr``) are the contiguous run
-    ``cq[k, r, (rr + d) % step, (rr + d) // step :][:n]``.
+    ``sq`` (K, R, W) and ``sn`` (K, W): quantised snapshot planes and column
+    norms; ``cq2`` (K, R, 2 W) and ``cn2`` (K, 2 W): the current view's, twice
+    side by side, so that the columns ``i + d`` of all snapshot columns ``i``
+    are one contiguous run. The sums run over all ``W`` columns at once (long
+    inner loops of 32 16-bit lanes), the bytes are then de-interleaved into
+    ``out[k, d, i % step, i // step]``.
     """
-    n_planes, n_rows, step, n = sq.shape
-    width = step * n
-    acc = np.zeros((step, n), np.uint16)
+    n_planes, n_rows, width = sq.shape
+    n = width // step
+    acc = np.zeros(width, np.uint16)
+    t = np.zeros(width, np.uint8)
     qf = np.float32(quantum)
     for k in range(n_planes):
         for d in range(width):
-            for rr in range(step):
+            acc[:] = 0
+            # |a - b| as max - min keeps the loop in 16-bit lanes; four rows
+            # per pass save loads and stores of the sums
+            r = 0
+            while r + 4 <= n_rows:
+                a0 = sq[k, r]
+                b0 = cq2[k, r, d:d + width]
+                a1 = sq[k, r + 1]
+                b1 = cq2[k, r + 1, d:d + width]
+                a2 = sq[k, r + 2]
+                b2 = cq2[k, r + 2, d:d + width]
+                a3 = sq[k, r + 3]
+                b3 = cq2[k, r + 3, d:d + width]
+                for i in range(width):
+                    acc[i] += np.uint16(
+                        max(a0[i], b0[i]) - min(a0[i], b0[i]) + max(a1[i], b1[i]) - min(a1[i], b1[i])
+                        + max(a2[i], b2[i]) - min(a2[i], b2[i]) + max(a3[i], b3[i]) - min(a3[i], b3[i])
+                    )
+                r += 4
+            while r < n_rows:
+                a0 = sq[k, r]
+                b0 = cq2[k, r, d:d + width]
+                for i in range(width):
+                    acc[i] += np.uint16(max(a0[i], b0[i]) - min(a0[i], b0[i]))
+                r += 1
+            na = sn[k]
+            nb = cn2[k, d:d + width]
+            for i in range(width):
+                den = np.float32(na[i] + nb[i])
+                val = np.float32(0.5)
+                if den > 0:
+                    val = np.float32(acc[i]) * qf / den + np.float32(0.5)
+                t[i] = np.uint8(val)
+            o = out[k, d]
+            if step == 1:
+                o0 = o[0]
                 for m in range(n):
-                    acc[rr, m] = 0
-            for rr in range(step):
-                c = rr + d
-                off = c // step
-                ph = c - off * step
-                ac = acc[rr]
-                # |a - b| as max - min keeps the loop in 16-bit lanes; four rows
-                # per pass save loads and stores of the sums
-                r = 0
-                while r + 4 <= n_rows:
-                    a0 = sq[k, r, rr]
-                    b0 = cq[k, r, ph, off:off + n]
-                    a1 = sq[k, r + 1, rr]
-                    b1 = cq[k, r + 1, ph, off:off + n]
-                    a2 = sq[k, r + 2, rr]
-                    b2 = cq[k, r + 2, ph, off:off + n]
-                    a3 = sq[k, r + 3, rr]
-                    b3 = cq[k, r + 3, ph, off:off + n]
-                    for m in range(n):
-                        ac[m] += np.uint16(
-                            max(a0[m], b0[m]) - min(a0[m], b0[m]) + max(a1[m], b1[m]) - min(a1[m], b1[m])
-                            + max(a2[m], b2[m]) - min(a2[m], b2[m]) + max(a3[m], b3[m]) - min(a3[m], b3[m])
-                        )
-                    r += 4
-                while r < n_rows:
-                    a0 = sq[k, r, rr]
-                    b0 = cq[k, r, ph, off:off + n]
-                    for m in range(n):
-                        ac[m] += np.uint16(max(a0[m], b0[m]) - min(a0[m], b0[m]))
-                    r += 1
-            for rr in range(step):
-                c = rr + d
-                off = c // step
-                ph = c - off * step
-                na = sn[k, rr]
-                nb = cn[k, ph, off:off + n]
-                ac = acc[rr]
-                o = out[k, d, rr]
+                    o0[m] = t[m]
+                    o0[m + n] = t[m]
+            elif step == 3:  # constant stride: compiles to byte shuffles
+                o0 = o[0]
+                o1 = o[1]
+                o2 = o[2]
                 for m in range(n):
-                    den = np.float32(na[m] + nb[m])
-                    val = np.float32(0.5)
-                    if den > 0:
-                        val = np.float32(ac[m]) * qf / den + np.float32(0.5)
-                    x = np.uint8(val)
-                    o[m] = x
-                    o[m + n] = x
+                    x0 = t[3 * m]
+                    x1 = t[3 * m + 1]
+                    x2 = t[3 * m + 2]
+                    o0[m] = x0
+                    o1[m] = x1
+                    o2[m] = x2
+                    o0[m + n] = x0
+                    o1[m + n] = x1
+                    o2[m + n] = x2
+            else:
+                for rr in range(step):
+                    orr = o[rr]
+                    for m in range(n):
+                        x = t[m * step + rr]
+                        orr[m] = x
+                        orr[m + n] = x
 
 
 @njit(nogil=True, fastmath=True, cache=True)
@@ -247,13 +259,13 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
     if quantised:
         top = max(_absmax(snapshot, "snap"), _absmax(current, "cur"))
         scale = np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
-        sq = np.empty((n_planes, n_rows, step, n), np.int16)
-        sn = np.empty((n_planes, step, n), np.int32)
-        cq = np.empty((n_planes, n_rows, step, 2 * n), np.int16)
-        cn = np.empty((n_planes, step, 2 * n), np.int32)
-        _quantise_phases(snap, scale, int(step), n, sq, sn)
-        _quantise_phases(cur, scale, int(step), 2 * n, cq, cn)
-        _diagonal_distances_q(sq, cq, sn, cn, distance_quantum(width)[0], out)
+        sq = np.empty((n_planes, n_rows, width), np.int16)
+        sn = np.empty((n_planes, width), np.int32)
+        cq2 = np.empty((n_planes, n_rows, 2 * width), np.int16)
+        cn2 = np.empty((n_planes, 2 * width), np.int32)
+        _quantise(snap, scale, sq, sn)
+        _quantise(cur, scale, cq2, cn2)
+        _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
         return out
     cur_norm = np.asarray(current["cur_norm"], dtype=np.float32)
     _diagonal_distances(
