@@ -63,6 +63,38 @@ def default_thresholds(scales) -> np.ndarray:
     return tau
 
 
+def reference_thresholds(scales, *, max_ratio: float = 2.5) -> np.ndarray:
+    """Thresholds of the SIMD reference implementation (WarpingSIMD).
+
+    The arithmetic means of neighbouring scale factors, and a finite last
+    threshold: scale ratios above ``max_ratio`` are not allowed (the reference
+    default 2.5 with scale factors up to 2).
+
+    Parameters
+    ----------
+    scales : array_like, shape (K,)
+        Increasing scale factors.
+    max_ratio : float
+        Largest allowed scale ratio (``> scales[-1]``).
+
+    Returns
+    -------
+    ndarray, shape (K,)
+    """
+    s = np.asarray(scales, dtype=np.float64)
+    if not max_ratio > s[-1]:
+        raise ValueError(f"the largest scale ratio {max_ratio} must exceed the largest scale factor {s[-1]}")
+    tau = np.empty_like(s)
+    tau[:-1] = 0.5 * (s[:-1] + s[1:])
+    tau[-1] = float(max_ratio)
+    return tau
+
+
+#: Rules for the thresholds when none are given: ``geometric`` (geometric means,
+#: no largest ratio) and ``reference`` (arithmetic means, largest ratio 2.5).
+THRESHOLD_RULES = ("geometric", "reference")
+
+
 def check_scales(scales, thresholds=None):
     """Validate scale factors and thresholds; return both as float64 arrays.
 

@@ -72,17 +72,26 @@ class _PlaneWarping(HomingMethod):
         self._template_width = None
 
     def _scales(self):
-        from bionav.homing.warping.scaleplanes import check_scales, default_scales
+        from bionav.homing.warping.scaleplanes import check_scales, default_scales, reference_thresholds
 
         cfg = self.config
         scales = default_scales() if cfg.scales is None else [float(x) for x in cfg.scales]
         thresholds = None if cfg.thresholds is None else [float(x) for x in cfg.thresholds]
+        if thresholds is None and getattr(cfg, "threshold_rule", "geometric") == "reference":
+            thresholds = reference_thresholds(scales, max_ratio=cfg.max_scale_ratio)
         return check_scales(scales, thresholds)
 
     def _check(self) -> None:
         cfg = self.config
         name = self.name
         _check_common(name, cfg)
+        from bionav.homing.warping.scaleplanes import THRESHOLD_RULES
+
+        rule = getattr(cfg, "threshold_rule", "geometric")
+        if rule not in THRESHOLD_RULES:
+            raise UserError(
+                f"homing.threshold_rule={rule!r} is not one of {', '.join(THRESHOLD_RULES)}"
+            )
         try:
             self._scales()
         except ValueError as exc:
@@ -156,7 +165,11 @@ class MinWarping(_PlaneWarping):
         butterworth_order: order of that filter.
         n_alpha, n_psi: search steps over 360 degrees for movement direction and rotation.
         scales: scale factors of the planes; null = 2 ** ((k - 4) / 4), k = 0..8.
-        thresholds: upper scale thresholds per plane; null = geometric midpoints.
+        thresholds: upper scale thresholds per plane; null = by threshold_rule.
+        threshold_rule: thresholds when none are given: geometric (geometric means of
+            neighbouring scales, no largest ratio) or reference (arithmetic means, largest
+            scale ratio max_scale_ratio, as the SIMD reference implementation WarpingSIMD).
+        max_scale_ratio: largest allowed scale ratio of the reference rule.
         compass_acceleration: search only compass_fraction of the rotations, those the
             visual compass measure ranks best.
         compass_fraction: fraction of rotations searched with compass acceleration.
@@ -174,6 +187,8 @@ class MinWarping(_PlaneWarping):
         n_psi: int = 96
         scales: list[float] | None = None
         thresholds: list[float] | None = None
+        threshold_rule: str = "geometric"
+        max_scale_ratio: float = 2.5
         compass_acceleration: bool = False
         compass_fraction: float = 0.25
         fine_search: bool = False
