@@ -1,7 +1,7 @@
 """Hydra wiring: bionav's config search path and the typed configs of plugins.
 
 * Config folders come from the ``bionav.configs`` entry-point group (bionav's
-  own ``conf/`` is registered there too); a small Hydra ``SearchPathPlugin``
+  own ``bionav/conf/`` is registered there too); a small Hydra ``SearchPathPlugin``
   registered at start-up adds them, so editable installs work (no reliance on
   Hydra's ``hydra_plugins`` namespace scanning).
 * Every plugin's ``Config`` dataclass is stored in Hydra's ConfigStore under
@@ -33,16 +33,11 @@ PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller")
 def config_dirs() -> list[tuple[str, Path]]:
     """Folders of YAML configs, one per ``bionav.configs`` entry point: ``(name, folder)``.
 
-    A package is located with ``importlib.resources``. bionav's own
-    ``bionav.conf`` is the top-level ``conf/`` folder of the source tree,
-    installed inside the package; when the source tree itself is imported
-    (running from a checkout with a regular install, where ``bionav/conf``
-    does not exist) it is found next to the package instead.
+    A package is located with ``importlib.resources``; bionav's own configs
+    are the package ``bionav.conf`` (the folder ``bionav/conf/``).
     """
     import importlib.util
     from importlib.resources import files
-
-    import bionav
 
     out = []
     for name, package, _dist in registry.config_packages():
@@ -52,8 +47,6 @@ def config_dirs() -> list[tuple[str, Path]]:
                 folder = Path(str(files(package)))
         except ModuleNotFoundError:
             folder = None
-        if folder is None and package == "bionav.conf":
-            folder = Path(bionav.__file__).resolve().parent.parent / "conf"
         if folder is not None and folder.is_dir():
             out.append((name, folder))
     return out

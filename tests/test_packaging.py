@@ -1,4 +1,4 @@
-"""Packaging: the wheel ships conf/ and the entry points; the example plugin installs and is selectable."""
+"""Packaging: the wheel ships bionav/conf/ and the entry points; the example plugin installs and is selectable."""
 
 import os
 import subprocess
@@ -47,7 +47,7 @@ def test_wheel_install_runs_from_outside_the_checkout(wheel, tmp_path):
 
 def test_regular_install_runs_from_the_checkout_root(wheel, tmp_path):
     """`pip install . && python -m bionav` from the clone's root imports the source tree, which has
-    no bionav/conf: the configs must still be found (the README's first Quickstart command)."""
+    bionav/conf in place: the configs must be found (the README's first Quickstart command)."""
     target = tmp_path / "site"
     assert _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path).returncode == 0
     proc = run_bionav("--help", cwd=ROOT, env={"PYTHONPATH": str(target), "BIONAV_CACHE": str(tmp_path / "c")})

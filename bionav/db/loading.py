@@ -10,6 +10,7 @@ from bionav.db.database import ImageDatabase
 from bionav.db.preprocess import preprocess_database, resize_database
 from bionav.db.rotation import rotate_views
 from bionav.errors import UserError
+from bionav.homing.imageops import check_image_size
 
 log = logging.getLogger(__name__)
 
@@ -98,11 +99,8 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
     """
     cfg = as_database_config(cfg)
     source = str(cfg.source).strip().lower()
-    size = None
-    if cfg.image_size is not None:
-        size = [int(v) for v in cfg.image_size]
-        if len(size) != 2 or min(size) < 1:
-            raise UserError(f"db.image_size={list(cfg.image_size)} must be [W, H] with positive integers.")
+    size = check_image_size(cfg.image_size, name="db.image_size")
+    size = None if size is None else list(size)
     if source == "synthetic":
         from bionav.db.synthetic import synthetic_database
 

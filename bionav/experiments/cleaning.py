@@ -9,7 +9,7 @@ controller=triangulation|odometry|random``
 
 A differential-drive robot with a static wheel-speed error (``+e`` left /
 ``-e`` right for the first half of the runs, swapped for the second half,
-unknown to its odometry) cleans the target area of a layout (``conf/layout``:
+unknown to its odometry) cleans the target area of a layout (``bionav/conf/layout``:
 7 lanes of 4 m or 14 lanes of 2 m, 0.30 m apart, first lane by wall
 following). With ``experiment.vision=render`` the robot sees 335 x 40
 panoramas rendered in its own frame at its true pose in the synthetic world
@@ -75,7 +75,7 @@ class CleaningWorld:
 
 
 def plan_from_layout(node: Any) -> LanePlan:
-    """A :class:`LanePlan` from a ``layout`` config node (``conf/layout/*.yaml``)."""
+    """A :class:`LanePlan` from a ``layout`` config node (``bionav/conf/layout/*.yaml``)."""
     try:
         return LanePlan(
             n_lanes=int(node.n_lanes),

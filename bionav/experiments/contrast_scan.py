@@ -28,6 +28,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.experiments.contrast_lda import _get, load_samples
+from bionav.light.sun import parse_time
 
 SCAN_TOPIC = "/contrast_scan/scan"
 TRUTH_TOPIC = "/contrast_scan/sky_truth"
@@ -55,17 +56,6 @@ def _per_scan(value, k, n, what):
     return float(v[k])
 
 
-def _parse_time(text):
-    try:
-        t = _dt.datetime.fromisoformat(str(text))
-    except ValueError:
-        raise UserError(f"experiment.times entry {text!r} is not an ISO 8601 time; write e.g. "
-                        f"2009-06-17T11:27:04+02:00.") from None
-    if t.tzinfo is None:
-        raise UserError(f"experiment.times entry {text!r} has no time zone; append it, e.g. +02:00.")
-    return t
-
-
 def learn_discriminants(node, *, sigma: float) -> dict:
     """``J_sigma`` discriminants per feature learned on the labelled samples a ``data`` node names."""
     from bionav.spectral.lda_analysis import analyse_features
@@ -76,12 +66,13 @@ def learn_discriminants(node, *, sigma: float) -> dict:
 
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
+    from bionav.light.clouds import CloudLayer
+    from bionav.light.daylight import SkyState
     from bionav.spectral.scan import DirectPanTilt, ScanGrid, run_scan
     from bionav.spectral.scene import backyard_scene
-    from bionav.spectral.sky import CloudField, SkyState
 
     exp = cfg.experiment
-    times = [_parse_time(t) for t in _get(exp, "times", [])]
+    times = [parse_time(str(t), what="experiment.times entry", naive_utc=False) for t in _get(exp, "times", [])]
     if not times:
         raise UserError("experiment.times is empty; give the scan times, e.g. experiment.times=[2009-06-17T11:27:04+02:00].")
     n_scans = len(times)
@@ -110,7 +101,7 @@ def run(cfg, ctx) -> dict:
     t0 = times[0]
 
     def sky_at(k, t):
-        clouds = CloudField(cover=_per_scan(covers, k, n_scans, "cloud_cover"),
+        clouds = CloudLayer(cover=_per_scan(covers, k, n_scans, "cloud_cover"),
                             optical_depth=_per_scan(depths, k, n_scans, "cloud_optical_depth"), seed=cloud_seed)
         return SkyState.from_time(t, clouds=clouds, time_s=(t - t0).total_seconds(),
                                   turbidity=float(_get(exp, "turbidity", 0.1)))
@@ -167,7 +158,7 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     """Contrast images, separation, stability series, plots and metrics of a set of scans."""
     import csv
 
-    from bionav.spectral.bands import CHANNELS, dual_contrasts
+    from bionav.light.bands import CHANNELS, dual_contrasts
     from bionav.spectral.scan import separation_images, stability_series
     from bionav.spectral.stability import MEASURES
 

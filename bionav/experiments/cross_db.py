@@ -27,14 +27,14 @@ MEASURES = ("aae", "mae", "rr")
 
 
 def db_preset(name: str) -> dict:
-    """The ``conf/db/<name>.yaml`` preset from any config folder."""
+    """The ``bionav/conf/db/<name>.yaml`` preset from any config folder."""
     from bionav.config import config_dirs
 
     for _n, folder in config_dirs():
         path = folder / "db" / f"{name}.yaml"
         if path.is_file():
             return yaml.safe_load(path.read_text()) or {}
-    raise UserError(f"the cross_db family names the database {name!r}, which has no preset (conf/db/{name}.yaml).")
+    raise UserError(f"the cross_db family names the database {name!r}, which has no preset (bionav/conf/db/{name}.yaml).")
 
 
 def family_nodes(cfg: DictConfig) -> list[dict]:

@@ -4,7 +4,7 @@ One job evaluates one signature on one database at one image size and
 preprocessing, for every ring count ``R`` (ring-based signatures) or every
 number of Fourier coefficients ``K`` (DFT-based signatures) of the sweep;
 [image] has a single configuration. The Hydra multirun over signature x image
-size x preprocessing (x database) is declared in ``conf/experiment/param_sweep.yaml``
+size x preprocessing (x database) is declared in ``bionav/conf/experiment/param_sweep.yaml``
 (``experiment.grid=full`` is the thesis grid, ``experiment.grid=ci`` a reduced one).
 
 For every configuration the signatures are computed once per image

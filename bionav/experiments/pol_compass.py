@@ -230,8 +230,8 @@ def rotation_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=Non
 def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
     """``vs_em_compass``: the polarized-light compass against the TCM2 (figs. 4.4, 4.5)."""
     from bionav.experiments import pol_compass_plots as plots_mod
+    from bionav.geometry import compass_to_azimuth
     from bionav.polcompass import counts_to_volts, heading_errors, zenith_heading
-    from bionav.sky.sun import compass_to_azimuth
 
     lo, hi, tlo, thi = session.pantilt.limits()
     rng = exp.get("pan_range_deg")
@@ -277,7 +277,8 @@ def _scan_poses(session: Session, node, *, pan_step_deg: float):
 def evector_scan_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
     """``evector_scan``: a pan/tilt grid over the sky (fig. 4.6) against the sky model."""
     from bionav.experiments import pol_compass_plots as plots_mod
-    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, wrap_axial
+    from bionav.geometry import wrap_axial
+    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading
 
     poses = _scan_poses(session, exp.scan, pan_step_deg=float(exp.scan.pan_step_deg))
     cal = _rotation_calibration(session, exp, unit_angles=unit_angles, out_dir=out_dir)
@@ -339,9 +340,9 @@ def _rotation_calibration(session: Session, exp, *, unit_angles, out_dir):
 def partial_sky_mode(session: Session, exp, *, unit_angles, rng_scene, plots=None, out_dir=None) -> dict:
     """``partial_sky`` (thesis 9.1): heading error against clear-sky fraction and sun elevation."""
     from bionav.experiments import pol_compass_plots as plots_mod
-    from bionav.geometry import wrap_angle
-    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, wrap_axial, zenith_heading
-    from bionav.sky import SunPosition
+    from bionav.geometry import wrap_angle, wrap_axial
+    from bionav.light import SunPosition
+    from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading, zenith_heading
 
     if session.scene is None:
         raise UserError(
@@ -466,7 +467,7 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
     session.record_pantilt_info()
     unit_angles = np.deg2rad(np.asarray(list(exp.unit_angles_deg), float))
     if scene is not None and mode != "partial_sky":
-        from bionav.sky import PolarizerLamp
+        from bionav.light import PolarizerLamp
 
         if mode == "filter_test":
             scene.source = PolarizerLamp(np.deg2rad(float(exp.filter.axis_deg)), float(exp.filter.efficiency))
@@ -509,7 +510,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     needs_scene = simulated or fake_devices or str(exp.mode) == "partial_sky"
     scene = None
     if needs_scene:
-        from bionav.sky import SkyModel, SunPosition
+        from bionav.light import SkyModel, SunPosition
 
         scene = CompassScene(
             SkyModel(SunPosition(0.0, np.pi / 4)),  # replaced by the mode's source

@@ -5,12 +5,10 @@ from __future__ import annotations
 import importlib
 import json
 import logging
-import os
-import tempfile
 import time
 import traceback
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
@@ -18,35 +16,13 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import __version__
 from bionav.errors import UserError
 from bionav.experiments.context import RunContext
+from bionav.files import write_json_atomic
 from bionav.logs.writer import McapLog
 
 log = logging.getLogger(__name__)
 
 METRICS_FILE = "metrics.json"
 LOG_FILE = "run.mcap"
-
-
-def write_json_atomic(path: Path, data: Mapping[str, Any]) -> None:
-    """Write JSON via a temporary file and ``os.replace`` (never a half-written file)."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as f:
-            json.dump(data, f, indent=2, sort_keys=False, default=_json_scalar)
-            f.write("\n")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
-def _json_scalar(value: Any) -> Any:
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
 
 
 def read_metrics(run_dir: Path) -> dict | None:

@@ -2,7 +2,7 @@
 
 The thesis' own outdoor homing test failed for lack of good data (6.5.3). Here
 a synthetic five-channel outdoor world (a garden: shrubs, trees, buildings,
-a distant tree line; spectral daylight of :mod:`bionav.spectral.sky`) is
+a distant tree line; spectral daylight of :mod:`bionav.light.daylight`) is
 rendered on a full grid under several conditions (sun position and cloud
 state). Every *representation* — single channels, dual-channel contrasts,
 binary skylines from the ``J_sigma`` lines learned on natural samples — is fed
@@ -20,13 +20,13 @@ representation.
 from __future__ import annotations
 
 import csv
-import datetime as _dt
 
 import numpy as np
 
 from bionav.errors import UserError
 from bionav.experiments.contrast_lda import _get
 from bionav.experiments.contrast_scan import learn_discriminants
+from bionav.light.sun import parse_time
 from bionav.report.figures import pyplot, save_figure
 
 CELL_TOPIC = "/skyline_homing/cell"
@@ -36,13 +36,7 @@ def _conditions(exp):
     out = []
     for k, c in enumerate(_get(exp, "conditions", [])):
         name = str(_get(c, "name", f"c{k}"))
-        try:
-            t = _dt.datetime.fromisoformat(str(_get(c, "time", "")))
-        except ValueError:
-            raise UserError(f"experiment.conditions[{k}].time {_get(c, 'time')!r} is not an ISO 8601 time "
-                            f"(e.g. 2009-06-17T16:00:00+02:00).") from None
-        if t.tzinfo is None:
-            raise UserError(f"experiment.conditions[{k}].time has no time zone; append e.g. +02:00.")
+        t = parse_time(str(_get(c, "time", "")), what=f"experiment.conditions[{k}].time", naive_utc=False)
         out.append((name, t, float(_get(c, "cloud_cover", 0.0)), float(_get(c, "cloud_optical_depth", 20.0))))
     if not out:
         raise UserError("experiment.conditions is empty; give at least one {name, time, cloud_cover, "
@@ -74,20 +68,20 @@ CAMPUS_MATERIALS = {
 def campus_world(sky, *, seed: int):
     """The outdoor campus of :mod:`bionav.world.worlds.outdoor` in five bands under a spectral sky.
 
-    Per-kind albedos come from :data:`bionav.spectral.materials.MATERIALS` (via
+    Per-kind albedos come from :data:`bionav.light.materials.MATERIALS` (via
     :data:`CAMPUS_MATERIALS`), the sun and the hemispherical ambient light from
-    :func:`bionav.spectral.sky.illumination` (``E/pi``, so that pixel values are
+    :func:`bionav.light.daylight.illumination` (``E/pi``, so that pixel values are
     band radiances in the unit of the sensor model), rays that hit nothing from
-    :func:`bionav.spectral.sky.band_sky_radiance`.
+    :func:`bionav.light.daylight.band_sky_radiance`.
     """
     try:
         from bionav.world.worlds.outdoor import build_campus
     except ImportError:
         raise UserError("experiment.world=campus needs bionav's outdoor campus world (bionav.world.worlds.outdoor), "
                         "which this installation lacks; use experiment.world=garden.") from None
-    from bionav.spectral.bands import CHANNELS, band_integrate
-    from bionav.spectral.materials import MATERIALS
-    from bionav.spectral.sky import band_sky_radiance, illumination
+    from bionav.light.bands import CHANNELS, band_integrate
+    from bionav.light.daylight import band_sky_radiance, illumination
+    from bionav.light.materials import MATERIALS
 
     ill = illumination(sky)
     e_dir = band_integrate(ill.direct_normal) / np.pi
@@ -122,10 +116,11 @@ def run(cfg, ctx) -> dict:
     from bionav.experiments.common import make_homing
     from bionav.experiments.grid_homing import evaluate_agents
     from bionav.geometry import PanoramaGeometry
+    from bionav.light.clouds import CloudLayer
+    from bionav.light.daylight import SkyState
     from bionav.spectral.representations import check_representation, representation_image
     from bionav.spectral.scene import garden_scene
     from bionav.spectral.sensor_model import LogSensorModel
-    from bionav.spectral.sky import CloudField, SkyState
 
     exp = cfg.experiment
     conditions = _conditions(exp)
@@ -165,7 +160,7 @@ def run(cfg, ctx) -> dict:
 
     counts, squares, truths = [], [], []
     for k, (name, t, cover, tau) in enumerate(conditions):
-        sky = SkyState.from_time(t, clouds=CloudField(cover=cover, optical_depth=tau, seed=seed + 1),
+        sky = SkyState.from_time(t, clouds=CloudLayer(cover=cover, optical_depth=tau, seed=seed + 1),
                                  turbidity=float(_get(exp, "turbidity", 0.1)))
         if world_name == "campus":
             world = campus_world(sky, seed=seed)

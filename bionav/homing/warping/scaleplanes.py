@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from bionav.geometry import PanoramaGeometry
+from bionav.homing.imageops import vertical_difference
 
 
 def default_scales(n: int = 9) -> np.ndarray:
@@ -157,21 +158,6 @@ def magnify_vertical(image, *, factor: float, geometry: PanoramaGeometry):
     return ((1.0 - w1) * img[r0] + w1 * img[r1]).astype(np.float32)
 
 
-def edge_filter(image):
-    """First difference along each column: ``out[r] = image[r + 1] - image[r]``.
-
-    Parameters
-    ----------
-    image : ndarray, shape (H, W)
-
-    Returns
-    -------
-    ndarray, shape (H - 1, W), float32
-    """
-    img = np.asarray(image, dtype=np.float32)
-    return np.diff(img, axis=0).astype(np.float32)
-
-
 def scale_plane_stack(image, *, geometry: PanoramaGeometry, scales=None):
     """Per-image work of 2D-warping and min-warping: the scale-plane stack.
 
@@ -210,7 +196,7 @@ def scale_plane_stack(image, *, geometry: PanoramaGeometry, scales=None):
     def planes_for(m: float) -> np.ndarray:
         key = float(m)
         if key not in cache:
-            cache[key] = edge_filter(magnify_vertical(img, factor=key, geometry=geometry))
+            cache[key] = vertical_difference(magnify_vertical(img, factor=key, geometry=geometry))
         return cache[key]
 
     snap = np.stack([planes_for(sk if sk >= 1.0 else 1.0) for sk in s])

@@ -58,7 +58,7 @@ def warping1d_scores(snapshot, current, *, alphas, psis, rhos):
     Parameters
     ----------
     snapshot, current : ndarray, shape (W,)
-        Horizon strips (:func:`~bionav.homing.warping.preprocess.horizon_strip`).
+        Horizon strips (:func:`~bionav.homing.imageops.horizon_strip`).
     alphas, psis : array_like
         Movement directions and rotations to test, radians.
     rhos : array_like

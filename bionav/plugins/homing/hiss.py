@@ -9,6 +9,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
+from bionav.homing.imageops import check_image_size
 
 
 class HissHoming(HomingMethod):
@@ -47,11 +48,7 @@ class HissHoming(HomingMethod):
     def __init__(self, config: Any, *, geometry) -> None:
         super().__init__(config, geometry=geometry)
         cfg = self.config
-        if cfg.image_size is not None and (len(cfg.image_size) != 2 or min(cfg.image_size) < 8):
-            raise UserError(
-                f"homing.image_size={list(cfg.image_size)} is not a usable [W, H] size for SIFT; "
-                "give two integers of at least 8, or null to keep the database's size"
-            )
+        check_image_size(cfg.image_size, name="homing.image_size", minimum=(8, 8))
         if not (0.0 <= cfg.wrap_pad <= 1.0):
             raise UserError(f"homing.wrap_pad={cfg.wrap_pad} must lie in [0, 1] (a fraction of the width)")
         if not (0.0 < cfg.ratio <= 1.0):
@@ -62,7 +59,7 @@ class HissHoming(HomingMethod):
     def prepare(self, image):
         """SIFT features of the (resized) panorama: dict of arrays (see :func:`bionav.homing.hiss.sift_features`)."""
         from bionav.homing.hiss import sift_features
-        from bionav.homing.warping.preprocess import resize_panorama
+        from bionav.homing.imageops import resize_panorama
 
         img = np.asarray(image, dtype=np.float32)
         if img.ndim == 3:

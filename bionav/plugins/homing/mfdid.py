@@ -47,17 +47,18 @@ class MfdidHoming(HomingMethod):
 
     def __init__(self, config: MfdidConfig, *, geometry) -> None:
         super().__init__(config, geometry=geometry)
-        from bionav.homing.imageops import resize_panorama
+        from bionav.homing.imageops import check_image_size, resize_panorama
 
+        check_image_size(config.image_size, name="homing.image_size")
         _, self.work_geometry = resize_panorama(
-            np.zeros((geometry.height, geometry.width), np.float32), geometry, config.image_size
+            np.zeros((geometry.height, geometry.width), np.float32), geometry=geometry, size=config.image_size
         )
 
     def prepare(self, image: np.ndarray) -> dict:
         from bionav.homing.imageops import gaussian_lowpass, resize_panorama
         from bionav.homing.mfdid import azimuthal_derivative, elevation_derivative
 
-        image, geometry = resize_panorama(image, self.geometry, self.config.image_size)
+        image, geometry = resize_panorama(image, geometry=self.geometry, size=self.config.image_size)
         smooth = gaussian_lowpass(
             image,
             sigma_azimuth=self.config.lowpass_sigma * geometry.width,

@@ -55,17 +55,18 @@ class SiftHoming(HomingMethod):
 
             raise UserError(f"homing.combine must be 'average' or 'max', not {config.combine!r}.")
         super().__init__(config, geometry=geometry)
-        from bionav.homing.imageops import resize_panorama
+        from bionav.homing.imageops import check_image_size, resize_panorama
 
+        check_image_size(config.image_size, name="homing.image_size")
         _, self.work_geometry = resize_panorama(
-            np.zeros((geometry.height, geometry.width), np.float32), geometry, config.image_size
+            np.zeros((geometry.height, geometry.width), np.float32), geometry=geometry, size=config.image_size
         )
 
     def prepare(self, image: np.ndarray):
         from bionav.homing.imageops import resize_panorama
         from bionav.homing.sift_homing import sift_features
 
-        image, _ = resize_panorama(image, self.geometry, self.config.image_size)
+        image, _ = resize_panorama(image, geometry=self.geometry, size=self.config.image_size)
         c = self.config
         return sift_features(
             image,

@@ -17,6 +17,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
+from bionav.homing.imageops import check_image_size
 
 
 def _grey(image) -> np.ndarray:
@@ -32,12 +33,7 @@ def _grey(image) -> np.ndarray:
 
 
 def _check_common(name: str, cfg) -> None:
-    if cfg.image_size is not None:
-        if len(cfg.image_size) != 2 or min(cfg.image_size) < 3:
-            raise UserError(
-                f"homing.image_size={list(cfg.image_size)} is not a valid [W, H] size for {name}; "
-                "give two positive integers such as homing.image_size=[288,50]"
-            )
+    check_image_size(cfg.image_size, name="homing.image_size", minimum=(3, 3))
     if cfg.butterworth_cutoff is not None and not (0.0 < cfg.butterworth_cutoff <= 1.0):
         raise UserError(
             f"homing.butterworth_cutoff={cfg.butterworth_cutoff} is outside (0, 1]; give the cutoff "
@@ -48,12 +44,14 @@ def _check_common(name: str, cfg) -> None:
 
 
 def _prepare_image(method: HomingMethod, image):
-    from bionav.homing.warping import butterworth_lowpass, resize_panorama
+    from bionav.homing.imageops import butterworth_lowpass, resize_panorama
 
     cfg = method.config
     img = _grey(image)
     if cfg.butterworth_cutoff is not None:
-        img = butterworth_lowpass(img, cutoff=cfg.butterworth_cutoff, order=cfg.butterworth_order)
+        # the warping methods' filter: applied twice (power response), float64 transform, no clipping
+        img = butterworth_lowpass(img.astype(np.float64), cutoff=cfg.butterworth_cutoff, order=cfg.butterworth_order,
+                                  passes=2, clip=None)
     geometry = method.geometry
     if img.shape != (geometry.height, geometry.width):
         geometry = geometry.resized(img.shape[1], img.shape[0])
@@ -341,7 +339,7 @@ class Warping1D(HomingMethod):
 
     def prepare(self, image):
         """Resize (and low-pass) the panorama and average its horizon rows; shape (W,)."""
-        from bionav.homing.warping import horizon_strip
+        from bionav.homing.imageops import horizon_strip
 
         img, geometry = _prepare_image(self, image)
         rows = min(self.config.strip_rows, img.shape[0])

@@ -331,9 +331,9 @@ class OpenField:
     """
 
     def __init__(self) -> None:
-        from bionav.spectral.bands import band_integrate
-        from bionav.spectral.materials import MATERIALS
-        from bionav.spectral.sky import SkyState, illumination
+        from bionav.light.bands import band_integrate
+        from bionav.light.daylight import SkyState, illumination
+        from bionav.light.materials import MATERIALS
 
         self.sky = SkyState(sun_elevation=np.deg2rad(45.0), sun_azimuth=np.deg2rad(200.0))
         grass = np.asarray(MATERIALS["grass"].reflectance)
@@ -344,9 +344,10 @@ class OpenField:
         self.pose = (float(pan), float(tilt))
 
     def band_radiance(self) -> np.ndarray:
-        from bionav.spectral.sky import band_sky_radiance, direction
+        from bionav.geometry import direction_from_angles
+        from bionav.light.daylight import band_sky_radiance
 
         pan, tilt = self.pose
         if tilt > 0:
-            return band_sky_radiance(self.sky, direction(tilt, pan))
+            return band_sky_radiance(self.sky, direction_from_angles(pan, tilt))
         return self._ground

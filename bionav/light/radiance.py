@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bionav.sky.rayleigh import scattering_angle
+from bionav.light.rayleigh import scattering_angle
 
 #: Parameters (a, b, c, d, e) of CIE sky type 12.
 CIE_CLEAR_SKY = (-1.0, -0.32, 10.0, -3.0, 0.45)

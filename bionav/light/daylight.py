@@ -30,7 +30,7 @@ channel separates sky from terrestrial objects (thesis ch. 6; Möller 2002):
   cover *flattens* the sky spectrum relative to the blue sky.
 * **Spatial clouds**: a cloud layer at height ``cloud_height_m`` carrying a
   smooth random field (sum of random plane waves), thresholded to the requested
-  cover fraction, drifting with the wind (see :class:`CloudField`).
+  cover fraction, drifting with the wind (see :class:`CloudLayer`).
 
 Frames: directions are unit vectors in a local east-north-up frame (x east,
 y north, z up). Azimuths in this module are radians counter-clockwise from
@@ -42,9 +42,11 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.special import ndtr, ndtri
 
-from bionav.spectral.bands import WAVELENGTHS_NM, band_integrate
+from bionav.geometry import direction_from_angles
+from bionav.light.bands import WAVELENGTHS_NM, band_integrate
+from bionav.light.clouds import CloudLayer
+from bionav.light.sun import BIELEFELD_LAT_DEG, BIELEFELD_LON_DEG, parse_time, sun_position
 
 _H = 6.62607015e-34
 _C = 2.99792458e8
@@ -81,104 +83,6 @@ def relative_air_mass(elevation) -> np.ndarray:
     return 1.0 / (np.sin(h) + 0.50572 * (h_deg + 6.07995) ** -1.6364)
 
 
-def direction(elevation, azimuth) -> np.ndarray:
-    """Unit vector(s) ``(..., 3)`` east-north-up for elevation/azimuth in radians (azimuth CCW from east)."""
-    el = np.asarray(elevation, dtype=float)
-    az = np.asarray(azimuth, dtype=float)
-    return np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)), axis=-1)
-
-
-def geographic_to_enu_azimuth(azimuth_geo):
-    """Convert a compass azimuth (from north, clockwise) to radians CCW from east."""
-    return np.pi / 2 - np.asarray(azimuth_geo)
-
-
-@dataclass(frozen=True)
-class CloudField:
-    """Smooth random cloud layer: optical depth as a function of viewing direction.
-
-    Parameters
-    ----------
-    cover : float
-        Fraction of the layer covered by cloud, 0 (clear) .. 1 (overcast).
-    optical_depth : float
-        Optical depth ``tau_c`` of a cloud's core (cirrus ~1, cumulus ~20,
-        stratus ~40, nimbostratus ~100).
-    seed : int
-        Seed of the random field (the field is a pure function of it).
-    height_m : float
-        Cloud-base height.
-    scale_m : float
-        Typical cloud size (wavelength of the plane waves).
-    wind_mps : tuple of float
-        Drift of the field (east, north) in m/s; ``time_s`` in :meth:`optical_depth_at` moves it.
-    softness : float
-        Width of the cloud edge in units of the field's standard deviation.
-    resolution : float
-        Angular resolution (radians) of a line of sight; cloud detail finer than
-        its footprint on the layer is averaged (no aliasing near the horizon,
-        where distant clouds merge into a uniform cover).
-    """
-
-    cover: float = 0.0
-    optical_depth: float = 20.0
-    seed: int = 0
-    height_m: float = 1500.0
-    scale_m: float = 1500.0
-    wind_mps: tuple = (5.0, 2.0)
-    softness: float = 0.15
-    n_waves: int = 24
-    resolution: float = float(np.deg2rad(1.0))
-
-    def _waves(self):
-        r = np.random.default_rng(self.seed)
-        ang = r.uniform(0, 2 * np.pi, self.n_waves)
-        k = 2 * np.pi / (self.scale_m * r.uniform(0.5, 2.0, self.n_waves))
-        kvec = np.c_[k * np.cos(ang), k * np.sin(ang)]
-        phase = r.uniform(0, 2 * np.pi, self.n_waves)
-        amp = r.uniform(0.5, 1.0, self.n_waves)
-        return kvec, phase, amp / np.sqrt(0.5 * np.sum(amp**2))
-
-    def optical_depth_at(self, directions, *, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
-        """Cloud optical depth along each viewing direction.
-
-        Parameters
-        ----------
-        directions : array_like, shape (..., 3)
-            Unit viewing directions (east-north-up).
-        time_s : float
-            Seconds since the field's epoch (wind drift).
-        origin_m : tuple of float
-            Observer position (east, north) in metres (parallax of the layer).
-
-        Returns
-        -------
-        ndarray, shape (...)
-            0 where the line of sight misses clouds (or looks below 2 degrees).
-        """
-        d = np.asarray(directions, dtype=float)
-        if self.cover <= 0:
-            return np.zeros(d.shape[:-1])
-        if self.cover >= 1:
-            return np.full(d.shape[:-1], float(self.optical_depth))
-        dz = np.maximum(d[..., 2], np.sin(np.deg2rad(1.0)))
-        reach = self.height_m / dz
-        px = origin_m[0] + d[..., 0] * reach - self.wind_mps[0] * time_s
-        py = origin_m[1] + d[..., 1] * reach - self.wind_mps[1] * time_s
-        kvec, phase, amp = self._waves()
-        # anti-aliasing: a line of sight averages the layer over a footprint that
-        # grows with distance and obliquity; waves much smaller than it are damped
-        footprint = reach * self.resolution / dz
-        damp = np.exp(-0.5 * (np.linalg.norm(kvec, axis=1) * footprint[..., None]) ** 2)
-        a = amp * damp
-        f = np.sum(a * np.cos(px[..., None] * kvec[:, 0] + py[..., None] * kvec[:, 1] + phase), axis=-1)
-        lost = np.clip(1.0 - 0.5 * np.sum(a**2, axis=-1), 0.0, 1.0)  # variance no longer resolved
-        thr = ndtri(1.0 - self.cover)
-        # probability that the resolved field plus unresolved detail exceeds the threshold
-        density = ndtr((f - thr) / np.sqrt(self.softness**2 + lost))
-        return self.optical_depth * density
-
-
 @dataclass(frozen=True)
 class SkyState:
     """Illumination conditions: sun position, aerosol, clouds.
@@ -193,7 +97,7 @@ class SkyState:
         Angstrom ``beta`` (0.05 very clear .. 0.3 hazy).
     angstrom_alpha : float
         Angstrom exponent.
-    clouds : CloudField
+    clouds : CloudLayer
         Cloud layer (``cover = 0`` for a clear sky).
     time_s : float
         Time since the cloud field's epoch (drift), seconds.
@@ -203,20 +107,22 @@ class SkyState:
     sun_azimuth: float = 0.0
     turbidity: float = 0.1
     angstrom_alpha: float = 1.3
-    clouds: CloudField = CloudField()
+    clouds: CloudLayer = CloudLayer()
     time_s: float = 0.0
 
     @classmethod
     def from_time(cls, time, *, latitude_deg=None, longitude_deg=None, **kwargs) -> "SkyState":
-        """Sky state with the sun where it stands at ``time`` (see :func:`bionav.spectral.sun.sun_position`)."""
-        from bionav.spectral.sun import BIELEFELD_LAT_DEG, BIELEFELD_LON_DEG, sun_position
+        """Sky state with the sun where it stands at ``time`` (see :func:`bionav.light.sun.sun_position`).
 
-        el, az = sun_position(
-            time,
+        ``time`` must carry its time zone; the place defaults to Bielefeld
+        (:data:`~bionav.light.sun.BIELEFELD_LAT_DEG`, :data:`~bionav.light.sun.BIELEFELD_LON_DEG`).
+        """
+        sun = sun_position(
+            parse_time(time, what="the sky's time", naive_utc=False),
             latitude_deg=BIELEFELD_LAT_DEG if latitude_deg is None else latitude_deg,
             longitude_deg=BIELEFELD_LON_DEG if longitude_deg is None else longitude_deg,
         )
-        return cls(sun_elevation=el, sun_azimuth=float(geographic_to_enu_azimuth(az)), **kwargs)
+        return cls(sun_elevation=sun.elevation, sun_azimuth=sun.azimuth, **kwargs)
 
     def with_clouds(self, **changes) -> "SkyState":
         """A copy with cloud-field parameters changed."""
@@ -225,7 +131,7 @@ class SkyState:
     @property
     def sun_direction(self) -> np.ndarray:
         """Unit vector towards the sun, shape ``(3,)``."""
-        return direction(self.sun_elevation, self.sun_azimuth)
+        return direction_from_angles(self.sun_azimuth, self.sun_elevation)
 
 
 def _optical_depths(state: SkyState, wl):
@@ -363,7 +269,7 @@ def illumination(state: SkyState, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.
     el = (np.arange(n_elevation) + 0.5) * (np.pi / 2) / n_elevation
     az = (np.arange(n_azimuth) + 0.5) * 2 * np.pi / n_azimuth
     ee, aa = np.meshgrid(el, az, indexing="ij")
-    dirs = direction(ee, aa)
+    dirs = direction_from_angles(aa, ee)
     rad = sky_radiance(state, dirs, wl, origin_m=origin_m)
     d_omega = np.cos(ee) * (np.pi / 2 / n_elevation) * (2 * np.pi / n_azimuth)
     weight = (np.sin(ee) * d_omega)[..., None]

@@ -1,4 +1,15 @@
-"""Five-band reflectances of natural and artificial materials.
+"""Material reflectances: the one home of bionav's material tables.
+
+* :data:`MATERIALS`: five-band reflectance spectra with sample-to-sample
+  variability of natural and artificial materials (thesis chapter 6 sample
+  sets and spectral scenes).
+* :data:`BAND_ALBEDO`: the coarse per-band albedos of the *rendered* outdoor
+  worlds (``sim_uni``), including a ``grey`` channel (see the end of this
+  module). They are kept as they are because every rendered stand-in
+  database's pixels depend on them.
+
+Spectral reflectances
+---------------------
 
 Values are diffuse (Lambertian) reflectance factors at the five channels
 (UV 350, B 440, G 500, R 680, IR 800 nm), read off typical spectra of the USGS
@@ -129,3 +140,33 @@ def band_reflectance_table() -> tuple[list[str], np.ndarray]:
     """Names and base reflectances ``(M, 5)`` of every material (documentation and plots)."""
     names = list(MATERIALS)
     return names, np.array([MATERIALS[n].reflectance for n in names])
+
+
+#: Relative reflectance of material kinds, per band. Rough textbook shapes
+#: (vegetation: red edge and low UV; concrete/stone: flat and slightly rising;
+#: glass: low; sky-facing metal: flat). Assumption: UV reflectance of most
+#: terrestrial materials is low (0.03-0.1), which is what makes UV a good sky
+#: separator in the thesis.
+BAND_ALBEDO: dict[str, dict[str, float]] = {
+    "grey": {"concrete": 0.45, "brick": 0.3, "glass": 0.15, "foliage": 0.3, "bark": 0.25, "grass": 0.3,
+             "paving": 0.4, "asphalt": 0.15, "metal": 0.5, "paint": 0.6, "wood": 0.35, "soil": 0.2},
+    "UV": {"concrete": 0.08, "brick": 0.05, "glass": 0.06, "foliage": 0.03, "bark": 0.04, "grass": 0.03,
+           "paving": 0.07, "asphalt": 0.04, "metal": 0.2, "paint": 0.1, "wood": 0.04, "soil": 0.04},
+    "B": {"concrete": 0.25, "brick": 0.12, "glass": 0.1, "foliage": 0.05, "bark": 0.08, "grass": 0.05,
+          "paving": 0.22, "asphalt": 0.08, "metal": 0.4, "paint": 0.5, "wood": 0.12, "soil": 0.08},
+    "G": {"concrete": 0.3, "brick": 0.18, "glass": 0.12, "foliage": 0.14, "bark": 0.12, "grass": 0.15,
+          "paving": 0.27, "asphalt": 0.09, "metal": 0.45, "paint": 0.55, "wood": 0.2, "soil": 0.12},
+    "R": {"concrete": 0.36, "brick": 0.38, "glass": 0.12, "foliage": 0.06, "bark": 0.2, "grass": 0.07,
+          "paving": 0.32, "asphalt": 0.1, "metal": 0.45, "paint": 0.6, "wood": 0.35, "soil": 0.2},
+    "IR": {"concrete": 0.42, "brick": 0.45, "glass": 0.12, "foliage": 0.5, "bark": 0.35, "grass": 0.45,
+           "paving": 0.38, "asphalt": 0.12, "metal": 0.45, "paint": 0.6, "wood": 0.45, "soil": 0.28},
+}
+
+
+def band_albedos(channels: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Albedo per material kind as arrays of shape ``(C,)`` for the given band names."""
+    unknown = [c for c in channels if c not in BAND_ALBEDO]
+    if unknown:
+        raise ValueError(f"no default albedos for bands {unknown}; pass albedos explicitly")
+    kinds = BAND_ALBEDO["grey"].keys()
+    return {k: np.array([BAND_ALBEDO[c][k] for c in channels]) for k in kinds}

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bionav.sky.rayleigh import local_frame
+from bionav.light.rayleigh import local_frame
 
 
 def berry_polarization(view, sun, *, neutral_point_separation: float, max_degree: float = 1.0):

@@ -1,8 +1,9 @@
-"""Default sky radiance and per-band material albedos for outdoor worlds.
+"""Default sky radiance of the rendered outdoor worlds (:class:`SimpleSky`).
 
-These are *simple, replaceable defaults*: the outdoor world builder accepts
-any sky callable and any table of per-band albedos, so a physically based
-sky and measured reflectances (bionav's spectral models) can be plugged in.
+A *simple, replaceable default*: the outdoor world builder accepts any sky
+callable and any table of per-band albedos (default
+:data:`bionav.light.materials.BAND_ALBEDO`), so the physically based sky of
+:mod:`bionav.light.daylight` and measured reflectances can be plugged in.
 
 Band names follow the thesis' five-channel sensor (chapter 6): ``UV`` (350
 nm), ``B`` (440 nm), ``G`` (500 nm), ``R`` (680 nm), ``IR`` (800 nm); a
@@ -15,39 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Relative reflectance of material kinds, per band. Rough textbook shapes
-#: (vegetation: red edge and low UV; concrete/stone: flat and slightly rising;
-#: glass: low; sky-facing metal: flat). Assumption: UV reflectance of most
-#: terrestrial materials is low (0.03-0.1), which is what makes UV a good sky
-#: separator in the thesis.
-BAND_ALBEDO: dict[str, dict[str, float]] = {
-    "grey": {"concrete": 0.45, "brick": 0.3, "glass": 0.15, "foliage": 0.3, "bark": 0.25, "grass": 0.3,
-             "paving": 0.4, "asphalt": 0.15, "metal": 0.5, "paint": 0.6, "wood": 0.35, "soil": 0.2},
-    "UV": {"concrete": 0.08, "brick": 0.05, "glass": 0.06, "foliage": 0.03, "bark": 0.04, "grass": 0.03,
-           "paving": 0.07, "asphalt": 0.04, "metal": 0.2, "paint": 0.1, "wood": 0.04, "soil": 0.04},
-    "B": {"concrete": 0.25, "brick": 0.12, "glass": 0.1, "foliage": 0.05, "bark": 0.08, "grass": 0.05,
-          "paving": 0.22, "asphalt": 0.08, "metal": 0.4, "paint": 0.5, "wood": 0.12, "soil": 0.08},
-    "G": {"concrete": 0.3, "brick": 0.18, "glass": 0.12, "foliage": 0.14, "bark": 0.12, "grass": 0.15,
-          "paving": 0.27, "asphalt": 0.09, "metal": 0.45, "paint": 0.55, "wood": 0.2, "soil": 0.12},
-    "R": {"concrete": 0.36, "brick": 0.38, "glass": 0.12, "foliage": 0.06, "bark": 0.2, "grass": 0.07,
-          "paving": 0.32, "asphalt": 0.1, "metal": 0.45, "paint": 0.6, "wood": 0.35, "soil": 0.2},
-    "IR": {"concrete": 0.42, "brick": 0.45, "glass": 0.12, "foliage": 0.5, "bark": 0.35, "grass": 0.45,
-           "paving": 0.38, "asphalt": 0.12, "metal": 0.45, "paint": 0.6, "wood": 0.45, "soil": 0.28},
-}
-
 #: Relative sky radiance per band (blue sky: strong at short wavelengths).
 SKY_GAIN = {"grey": 1.0, "UV": 1.4, "B": 1.3, "G": 1.0, "R": 0.6, "IR": 0.4}
 #: Relative direct-sun irradiance per band.
 SUN_GAIN = {"grey": 1.0, "UV": 0.7, "B": 1.0, "G": 1.05, "R": 1.0, "IR": 0.9}
-
-
-def band_albedos(channels: tuple[str, ...]) -> dict[str, np.ndarray]:
-    """Albedo per material kind as arrays of shape ``(C,)`` for the given band names."""
-    unknown = [c for c in channels if c not in BAND_ALBEDO]
-    if unknown:
-        raise ValueError(f"no default albedos for bands {unknown}; pass albedos explicitly")
-    kinds = BAND_ALBEDO["grey"].keys()
-    return {k: np.array([BAND_ALBEDO[c][k] for c in channels]) for k in kinds}
 
 
 @dataclass(frozen=True)

@@ -15,11 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.sky.clouds import CloudField
-from bionav.sky.neutral_points import berry_polarization
-from bionav.sky.radiance import cie_relative_radiance
-from bionav.sky.rayleigh import perpendicular, rayleigh_polarization
-from bionav.sky.sun import SunPosition, direction_from_angles
+from bionav.geometry import direction_from_angles
+from bionav.light.clouds import CloudMap
+from bionav.light.neutral_points import berry_polarization
+from bionav.light.radiance import cie_relative_radiance
+from bionav.light.rayleigh import perpendicular, rayleigh_polarization
+from bionav.light.sun import SunPosition
 
 
 @dataclass(frozen=True)
@@ -51,18 +52,18 @@ class SkyModel:
         Sun azimuth (CCW from east) and elevation, radians.
     max_degree : float
         Degree of polarization 90 degrees from the sun (see
-        :func:`bionav.sky.rayleigh.max_degree_from_turbidity`).
+        :func:`bionav.light.rayleigh.max_degree_from_turbidity`).
     neutral_point_separation : float
         ``0`` selects the Rayleigh model; a positive angle (radians) the
         Berry et al. (2004) model with that Babinet-Brewster separation.
-    clouds : CloudField or None
+    clouds : CloudMap or None
         Optional clouds (lower the degree, add e-vector angle noise, brighten).
     """
 
     sun: SunPosition
     max_degree: float = 0.76
     neutral_point_separation: float = 0.0
-    clouds: CloudField | None = None
+    clouds: CloudMap | None = None
 
     def light(self, view) -> SkyLight:
         """Radiance, degree and e-vector for unit viewing directions ``(..., 3)``."""

@@ -14,7 +14,7 @@ and by the thesis, chapter 4:
   between ``v`` and ``s``: zero at the sun and anti-sun, ``d_max`` on the
   great circle 90 degrees from the sun.
 
-Directions are unit vectors in the sky frame of :mod:`bionav.sky.sun`
+Directions are unit vectors in the sky frame of :mod:`bionav.light.sun`
 (east-north-up). E-vectors are axial: ``e`` and ``-e`` are the same.
 """
 

@@ -1,12 +1,11 @@
-"""Sun position from time and place (PyEphem), in bionav's sky frame.
+"""Sun position from time and place (PyEphem), in bionav's sky frame; the one time parser.
 
 Sky frame
 ---------
-A local east-north-up frame: ``x`` east, ``y`` north, ``z`` up (zenith).
-*Azimuth* is measured counter-clockwise from east seen from above (the
-mathematical convention of :mod:`bionav.geometry`, **not** the compass
-convention clockwise from north); *elevation* is positive above the horizon.
-Angles are radians.
+The ENU frame of :mod:`bionav.geometry`: ``x`` east, ``y`` north, ``z`` up
+(zenith). *Azimuth* is measured counter-clockwise from east seen from above
+(**not** the compass convention clockwise from north); *elevation* is
+positive above the horizon. Angles are radians.
 """
 
 from __future__ import annotations
@@ -17,6 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.errors import UserError
+from bionav.geometry import compass_to_azimuth, direction_from_angles
+
+#: Bielefeld, Germany, where the thesis' spectral samples and scans were taken (degrees).
+BIELEFELD_LAT_DEG = 52.02
+BIELEFELD_LON_DEG = 8.53
 
 
 @dataclass(frozen=True)
@@ -40,61 +44,46 @@ class SunPosition:
         return direction_from_angles(self.azimuth, self.elevation)
 
 
-def direction_from_angles(azimuth, elevation):
-    """Unit vectors from azimuth and elevation.
+def parse_time(when, *, what: str = "The time", naive_utc: bool = True) -> _dt.datetime:
+    """A timezone-aware datetime from a datetime, a ``numpy.datetime64`` or an ISO-8601 string.
 
     Parameters
     ----------
-    azimuth, elevation : float or ndarray
-        Radians; azimuth counter-clockwise from east, elevation above the
-        horizon. Broadcast against each other.
+    when : datetime, numpy.datetime64 or str
+        The time. ``numpy.datetime64`` values carry no zone and count as UTC.
+    what : str, optional
+        How error messages name the value (e.g. ``"experiment.times[2]"``).
+    naive_utc : bool, optional
+        Take a time without offset as UTC (default); if false, such a time is
+        an error asking for the offset.
 
     Returns
     -------
-    ndarray, shape ``(..., 3)``
-        ``(cos e cos a, cos e sin a, sin e)`` in the sky frame (ENU).
+    datetime
+        Aware, in the offset it was given in (UTC when it had none).
+
+    Raises
+    ------
+    UserError
+        Unparseable text, or a naive time when ``naive_utc`` is false.
     """
-    azimuth, elevation = np.broadcast_arrays(np.asarray(azimuth, float), np.asarray(elevation, float))
-    ce = np.cos(elevation)
-    return np.stack([ce * np.cos(azimuth), ce * np.sin(azimuth), np.sin(elevation)], axis=-1)
-
-
-def angles_from_direction(direction):
-    """Azimuth (CCW from east) and elevation of direction vectors, shape ``(..., 3)``."""
-    d = np.asarray(direction, float)
-    azimuth = np.arctan2(d[..., 1], d[..., 0])
-    elevation = np.arctan2(d[..., 2], np.hypot(d[..., 0], d[..., 1]))
-    return azimuth, elevation
-
-
-def compass_to_azimuth(bearing):
-    """Convert a compass bearing (clockwise from north) to an azimuth CCW from east (radians)."""
-    return np.pi / 2.0 - np.asarray(bearing)
-
-
-def azimuth_to_compass(azimuth):
-    """Convert an azimuth CCW from east to a compass bearing clockwise from north, in ``[0, 2 pi)``."""
-    return np.mod(np.pi / 2.0 - np.asarray(azimuth), 2.0 * np.pi)
-
-
-def parse_time(when) -> _dt.datetime:
-    """A timezone-aware UTC datetime from a datetime or an ISO-8601 string.
-
-    Naive datetimes and strings without an offset are taken as UTC.
-    """
-    if isinstance(when, _dt.datetime):
+    if isinstance(when, np.datetime64):
+        t = when.astype("datetime64[us]").item().replace(tzinfo=_dt.timezone.utc)
+    elif isinstance(when, _dt.datetime):
         t = when
     else:
         try:
             t = _dt.datetime.fromisoformat(str(when))
         except ValueError:
             raise UserError(
-                f"The time {when!r} is not an ISO-8601 date and time; write it like "
-                "'2009-08-04T12:30:00+02:00' (a time without offset is taken as UTC)."
+                f"{what} {when!r} is not an ISO-8601 date and time; write it like "
+                "'2009-08-04T12:30:00+02:00'" + (" (a time without offset is taken as UTC)." if naive_utc else ".")
             ) from None
     if t.tzinfo is None:
+        if not naive_utc:
+            raise UserError(f"{what} {when!r} has no time zone; append its offset, e.g. +02:00.")
         t = t.replace(tzinfo=_dt.timezone.utc)
-    return t.astimezone(_dt.timezone.utc)
+    return t
 
 
 def sun_position(when, *, latitude_deg: float, longitude_deg: float, elevation_m: float = 0.0) -> SunPosition:
@@ -106,8 +95,8 @@ def sun_position(when, *, latitude_deg: float, longitude_deg: float, elevation_m
 
     Parameters
     ----------
-    when : datetime or str
-        Time of observation; naive values are UTC.
+    when : datetime, numpy.datetime64 or str
+        Time of observation (see :func:`parse_time`); naive values are UTC.
     latitude_deg, longitude_deg : float
         Geodetic latitude (north positive) and longitude (east positive) in
         degrees.
@@ -123,7 +112,7 @@ def sun_position(when, *, latitude_deg: float, longitude_deg: float, elevation_m
 
     if not -90.0 <= latitude_deg <= 90.0:
         raise UserError(f"Latitude {latitude_deg} deg is outside [-90, 90]; give the observer's latitude in degrees north.")
-    t = parse_time(when)
+    t = parse_time(when).astimezone(_dt.timezone.utc)
     observer = ephem.Observer()
     observer.lat = np.deg2rad(latitude_deg)
     observer.lon = np.deg2rad(longitude_deg)
