@@ -100,49 +100,65 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     ``sq`` (K, R, W) and ``sn`` (K, W): quantised snapshot planes and column
     norms; ``cq2`` (K, R, 2 W) and ``cn2`` (K, 2 W): the current view's, twice
     side by side, so that the columns ``i + d`` of all snapshot columns ``i``
-    are one contiguous run. The sums run over all ``W`` columns at once (long
-    inner loops of 32 16-bit lanes), the bytes are then de-interleaved into
-    ``out[k, d, i % step, i // step]``.
+    are one contiguous run. The sums of a plane are kept for all diagonals
+    (``W x W`` 16-bit, in L2 cache) and built eight rows at a time, so that
+    those rows stay in L1 cache while every diagonal visits them; the inner
+    loops run over all ``W`` columns (32 16-bit lanes). The bytes are then
+    de-interleaved into ``out[k, d, i % step, i // step]``.
     """
     n_planes, n_rows, width = sq.shape
     n = width // step
-    acc = np.zeros(width, np.uint16)
+    acc = np.empty((width, width), np.uint16)
     t = np.zeros(width, np.uint8)
     qf = np.float32(quantum)
     for k in range(n_planes):
-        for d in range(width):
-            acc[:] = 0
-            # |a - b| as max - min keeps the loop in 16-bit lanes; four rows
-            # per pass save loads and stores of the sums
-            r = 0
-            while r + 4 <= n_rows:
-                a0 = sq[k, r]
+        acc[:] = 0
+        # |a - b| as max - min keeps the loops in 16-bit lanes
+        r = 0
+        while r + 8 <= n_rows:
+            a0 = sq[k, r]
+            a1 = sq[k, r + 1]
+            a2 = sq[k, r + 2]
+            a3 = sq[k, r + 3]
+            a4 = sq[k, r + 4]
+            a5 = sq[k, r + 5]
+            a6 = sq[k, r + 6]
+            a7 = sq[k, r + 7]
+            for d in range(width):
                 b0 = cq2[k, r, d:d + width]
-                a1 = sq[k, r + 1]
                 b1 = cq2[k, r + 1, d:d + width]
-                a2 = sq[k, r + 2]
                 b2 = cq2[k, r + 2, d:d + width]
-                a3 = sq[k, r + 3]
                 b3 = cq2[k, r + 3, d:d + width]
+                b4 = cq2[k, r + 4, d:d + width]
+                b5 = cq2[k, r + 5, d:d + width]
+                b6 = cq2[k, r + 6, d:d + width]
+                b7 = cq2[k, r + 7, d:d + width]
+                ac = acc[d]
                 for i in range(width):
-                    acc[i] += np.uint16(
+                    ac[i] += np.uint16(
                         max(a0[i], b0[i]) - min(a0[i], b0[i]) + max(a1[i], b1[i]) - min(a1[i], b1[i])
                         + max(a2[i], b2[i]) - min(a2[i], b2[i]) + max(a3[i], b3[i]) - min(a3[i], b3[i])
+                        + max(a4[i], b4[i]) - min(a4[i], b4[i]) + max(a5[i], b5[i]) - min(a5[i], b5[i])
+                        + max(a6[i], b6[i]) - min(a6[i], b6[i]) + max(a7[i], b7[i]) - min(a7[i], b7[i])
                     )
-                r += 4
-            while r < n_rows:
-                a0 = sq[k, r]
+            r += 8
+        while r < n_rows:
+            a0 = sq[k, r]
+            for d in range(width):
                 b0 = cq2[k, r, d:d + width]
+                ac = acc[d]
                 for i in range(width):
-                    acc[i] += np.uint16(max(a0[i], b0[i]) - min(a0[i], b0[i]))
-                r += 1
-            na = sn[k]
+                    ac[i] += np.uint16(max(a0[i], b0[i]) - min(a0[i], b0[i]))
+            r += 1
+        na = sn[k]
+        for d in range(width):
             nb = cn2[k, d:d + width]
+            ac = acc[d]
             for i in range(width):
                 den = np.float32(na[i] + nb[i])
                 val = np.float32(0.5)
                 if den > 0:
-                    val = np.float32(acc[i]) * qf / den + np.float32(0.5)
+                    val = np.float32(ac[i]) * qf / den + np.float32(0.5)
                 t[i] = np.uint8(val)
             o = out[k, d]
             if step == 1:

@@ -109,28 +109,38 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     ndarray, shape (P, n_alpha)
         ``out``: ``sum_u min_{v, k allowed} dist`` for each (psi, alpha); lower is better.
     """
-    _, n_planes, width, step, _ = levels.shape
+    _, n_planes, width, step, m2 = levels.shape
     n_p = p_cols.shape[0]
     best = np.empty((n_p, n_alpha), dtype=levels.dtype)
+    row_stride = step * m2
     # snapshot columns in phase order (u = rr, rr + step, ...): one phase reads
     # a third of the table (step 3), which keeps the reads in cache; per window
-    # all rotations at once (the window's plane and level stay fixed)
+    # all rotations at once (the window's plane and level stay fixed); the
+    # first window of a column is copied, the others compared and selected
+    # (packed byte compares)
     for rr in range(step):
         for u in range(rr, width, step):
-            m0 = u // step
-            best[:] = big
-            for e in range(start[u], start[u + 1]):
-                plane = levels[w_level[e], w_plane[e]]
+            e0 = start[u]
+            e1 = start[u + 1]
+            off = rr * m2 + u // step
+            for e in range(e0, e1):
+                flat = levels[w_level[e], w_plane[e]].reshape(-1)
                 v0 = w_v[e] - u
+                first = e == e0
                 for ip in range(n_p):
-                    d = _wrap(v0 - p_cols[ip], width)
-                    row = plane[d, rr, m0:m0 + n_alpha]
+                    base = _wrap(v0 - p_cols[ip], width) * row_stride + off
+                    row = flat[base:base + n_alpha]
                     b = best[ip]
-                    for a in range(n_alpha):
-                        # compare and select: packed byte compares
-                        x = row[a]
-                        if x < b[a]:
-                            b[a] = x
+                    if first:
+                        for a in range(n_alpha):
+                            b[a] = row[a]
+                    else:
+                        for a in range(n_alpha):
+                            x = row[a]
+                            if x < b[a]:
+                                b[a] = x
+            if e1 == e0:
+                best[:] = big
             for ip in range(n_p):
                 acc = out[ip]
                 b = best[ip]
