@@ -195,7 +195,8 @@ def _render_views(world, positions: np.ndarray, headings: np.ndarray, geometry: 
 
 def _cached_render(name: str, params: dict, cache_dir, render: Callable[[], np.ndarray], noise: float, seed: int):
     """Render (or read) quantised uint8 images keyed by ``params``; returns (float images, cache path, from_cache)."""
-    from bionav.db.synthetic import _write_npz_atomic, cache_key, default_cache_dir, quantise, read_cached_images
+    from bionav.db.synthetic import quantise, read_cached_images
+    from bionav.files import cache_key, default_cache_dir, write_atomic
 
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
@@ -206,7 +207,8 @@ def _cached_render(name: str, params: dict, cache_dir, render: Callable[[], np.n
         rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x6D657368]))
         images_u8 = quantise(render(), noise=noise, rng=rng)
         try:
-            _write_npz_atomic(path, images=images_u8, key=np.array(key), params=np.array(json.dumps(params)))
+            write_atomic(path, lambda f: np.savez(f, images=images_u8, key=np.array(key),
+                                                  params=np.array(json.dumps(params))))
         except OSError:
             pass
     images = images_u8.astype(np.float32) / np.float32(255.0)

@@ -3,7 +3,7 @@
 A :class:`MeshWorld` is a :class:`~bionav.world.mesh.TriangleMesh` plus what
 the file does not say: the ground (an infinite plane at ``ground_z``, as the
 MATLAB ant-world renderer draws it, or the mesh's own lowest surface), the
-sky behind the terrain (:class:`bionav.world.sky.SimpleSky`, grey or the five
+sky behind the terrain (:class:`bionav.light.simple_sky.SimpleSky`, grey or the five
 bands ``UV B G R IR`` of thesis chapter 6), shading and channels.
 
 Conventions are bionav's (:mod:`bionav.geometry`): positions ``(x, y, z)`` in
@@ -37,7 +37,7 @@ SAND_RGB = (229 / 255.0, 183 / 255.0, 90 / 255.0)
 
 def _band_albedo(grey: np.ndarray, channels: tuple[str, ...], material: str) -> np.ndarray:
     """Per-band albedo ``(N, C)`` from grey values, scaled by the default band ratios of ``material``."""
-    from bionav.world.sky import BAND_ALBEDO
+    from bionav.light.materials import BAND_ALBEDO
 
     cols = []
     for c in channels:
@@ -68,7 +68,7 @@ class MeshWorld:
         RGB of the ground plane (default :data:`SAND_RGB`).
     channels : {"grey", "spectral"}
         One grey channel, or the five bands ``UV B G R IR`` (albedos scaled by
-        :data:`bionav.world.sky.BAND_ALBEDO` of ``foliage`` for the mesh and
+        :data:`bionav.light.materials.BAND_ALBEDO` of ``foliage`` for the mesh and
         ``soil`` for the ground).
     shading : {"flat", "lambert"}
         ``flat``: a triangle shows its colour (the MATLAB renderer);
@@ -77,7 +77,7 @@ class MeshWorld:
         Sun direction in radians (azimuth CCW from ``+x``); sky glow and shading.
     sky : callable, optional
         ``sky(directions (N, 3)) -> (N, C)``; default a cloudless
-        :class:`~bionav.world.sky.SimpleSky`.
+        :class:`~bionav.light.simple_sky.SimpleSky`.
     """
 
     mesh: TriangleMesh
@@ -107,7 +107,7 @@ class MeshWorld:
         se, ce = np.sin(self.sun_elevation), np.cos(self.sun_elevation)
         self.sun = np.array([ce * np.cos(self.sun_azimuth), ce * np.sin(self.sun_azimuth), se])
         if self.sky is None:
-            from bionav.world.sky import SimpleSky
+            from bionav.light.simple_sky import SimpleSky
 
             self.sky = SimpleSky(sun_direction=tuple(self.sun), channels=self.band_names, glow=0.6, clouds=0.0)
         grey = self.mesh.grey
