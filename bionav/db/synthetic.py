@@ -39,6 +39,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
+from bionav._umask import shared_file_mode
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.geometry import PanoramaGeometry
@@ -184,6 +185,7 @@ def cache_key(params: dict) -> str:
 def _write_npz_atomic(path: Path, **arrays) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+    os.fchmod(fd, shared_file_mode())  # mkstemp's 0o600 -> follow the umask
     try:
         with os.fdopen(fd, "wb") as fh:
             np.savez(fh, **arrays)

@@ -27,6 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from bionav._umask import shared_file_mode
+
 _KIND = "__bionav_kind__"
 _CLASS = "__bionav_class__"
 
@@ -117,6 +119,7 @@ class PreparedCache:
         path = self._path(key)
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".npz")
+        os.fchmod(fd, shared_file_mode())  # mkstemp's 0o600 -> follow the umask
         try:
             with os.fdopen(fd, "wb") as f:
                 np.savez(f, **arrays)
