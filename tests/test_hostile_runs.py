@@ -319,3 +319,24 @@ def test_corrupt_png_gives_one_clean_line_without_libpng_noise(tmp_path, tiny_fo
     _clean_failure(proc, "1_1.png", "corrupt", code=2)
     assert "libpng" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupt_or_terminate_a_run_keeps_its_results(tmp_path, render_cache, sig):
+    """Ctrl-C or SIGTERM (kill, a cluster's time limit) during the home vectors: exit 130 with one clean
+    line, metrics.json says failed, run.mcap is finished (summary readable) and keeps the rows so far."""
+    run_dir = tmp_path / "run"
+    proc = _start([*SLOW_RUN, f"hydra.run.dir={run_dir}"], tmp_path, render_cache)
+    try:
+        _wait_for(lambda: (run_dir / "run.mcap").exists() and _rows_since(run_dir / "run.mcap") >= 1, 120, proc,
+                  "the first rows are flushed")
+    finally:
+        proc.send_signal(sig)
+        out, err = proc.communicate(timeout=60)
+    _clean_failure(subprocess.CompletedProcess(proc.args, proc.returncode, out, err), "interrupted", code=130)
+    metrics = json.loads((run_dir / "metrics.json").read_text())
+    assert metrics["status"] == "failed" and "KeyboardInterrupt" in metrics["error"]
+    with open(run_dir / "run.mcap", "rb") as f:
+        summary = make_reader(f).get_summary()
+    assert summary.statistics.message_count >= 1
+    assert not (run_dir / ".bionav.lock").exists()
