@@ -19,6 +19,18 @@ Conventions (used everywhere unless a docstring says otherwise)
   ``phi + 2*pi*j/W`` in column ``j``. An angle returned by a homing method lives
   in the *current view's own frame*; add the current view's heading to get the
   grid-frame angle.
+
+ENU frame (sky, sun, outdoor worlds, compass headings)
+------------------------------------------------------
+* x east, y north, z up. A direction is a unit vector ``(..., 3)``.
+* *Azimuth*: radians counter-clockwise from east seen from above (the grid
+  frame's convention with +x east and +y north); *elevation*: radians above
+  the horizon. Functions take ``(azimuth, elevation)`` in that order.
+* *Compass bearing*: radians clockwise from north (what magnetic compasses and
+  ephemerides report); convert with :func:`compass_to_azimuth` and
+  :func:`azimuth_to_compass`.
+* *Axial* angles (e-vectors, polarizer axes) have period ``pi``; wrap them
+  with :func:`wrap_axial`.
 """
 
 from __future__ import annotations
@@ -49,6 +61,51 @@ def wrap_angle(angle):
 def angular_difference(a, b):
     """Absolute angular difference ``|wrap(a - b)|`` in ``[0, pi]`` (radians)."""
     return np.abs(wrap_angle(np.asarray(a) - np.asarray(b)))
+
+
+def wrap_axial(angle):
+    """Wrap axial angles (period ``pi``, e.g. e-vector orientations) to ``[-pi/2, pi/2)`` (radians)."""
+    return (np.asarray(angle) + np.pi / 2.0) % np.pi - np.pi / 2.0
+
+
+# --- ENU frame ---------------------------------------------------------------------------------
+
+
+def direction_from_angles(azimuth, elevation):
+    """Unit vectors from azimuth and elevation (ENU frame).
+
+    Parameters
+    ----------
+    azimuth, elevation : float or ndarray
+        Radians; azimuth counter-clockwise from east, elevation above the
+        horizon. Broadcast against each other.
+
+    Returns
+    -------
+    ndarray, shape ``(..., 3)``
+        ``(cos e cos a, cos e sin a, sin e)``: x east, y north, z up.
+    """
+    azimuth, elevation = np.broadcast_arrays(np.asarray(azimuth, float), np.asarray(elevation, float))
+    ce = np.cos(elevation)
+    return np.stack([ce * np.cos(azimuth), ce * np.sin(azimuth), np.sin(elevation)], axis=-1)
+
+
+def angles_from_direction(direction):
+    """Azimuth (counter-clockwise from east) and elevation (radians) of ENU vectors ``(..., 3)``."""
+    d = np.asarray(direction, float)
+    azimuth = np.arctan2(d[..., 1], d[..., 0])
+    elevation = np.arctan2(d[..., 2], np.hypot(d[..., 0], d[..., 1]))
+    return azimuth, elevation
+
+
+def compass_to_azimuth(bearing):
+    """Compass bearing (radians clockwise from north) to azimuth (radians counter-clockwise from east)."""
+    return np.pi / 2.0 - np.asarray(bearing)
+
+
+def azimuth_to_compass(azimuth):
+    """Azimuth (radians counter-clockwise from east) to compass bearing clockwise from north, in ``[0, 2 pi)``."""
+    return np.mod(np.pi / 2.0 - np.asarray(azimuth), 2.0 * np.pi)
 
 
 @dataclass(frozen=True)

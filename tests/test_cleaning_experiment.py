@@ -9,7 +9,7 @@ from omegaconf import OmegaConf
 from bionav.experiments.runner import run_experiment
 from bionav.logs.reader import read_messages
 
-CONF = Path(__file__).resolve().parents[1] / "conf"
+CONF = Path(__file__).resolve().parents[1] / "bionav" / "conf"
 CONTROLLERS = {
     "triangulation": "bionav.plugins.controllers.triangulation:TriangulationController",
     "odometry": "bionav.plugins.controllers.odometry:OdometryController",

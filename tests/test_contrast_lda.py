@@ -10,7 +10,7 @@ from spectral_ctx import FakeContext
 
 from bionav.errors import UserError
 from bionav.experiments import contrast_lda
-from bionav.spectral.bands import feature_subsets
+from bionav.light.bands import feature_subsets
 
 
 def test_contrast_lda_small_simulated_run(tmp_path):

@@ -5,12 +5,13 @@ import pytest
 from omegaconf import OmegaConf
 from spectral_ctx import FakeContext
 
+from bionav.light.clouds import CloudLayer
+from bionav.light.daylight import SkyState
 from bionav.plugins.sensors.spectral5 import Spectral5Serial, Spectral5Sim
 from bionav.spectral.fake_device import FakeSpectral5
 from bionav.spectral.scan import DirectPanTilt, ScanGrid, feature_images, run_scan, stability_series
 from bionav.spectral.scene import backyard_scene
 from bionav.spectral.sensor_model import LogSensorModel
-from bionav.spectral.sky import CloudField, SkyState
 from bionav.spectral.stability import stability_measures
 
 
@@ -45,7 +46,7 @@ def test_contrasts_are_invariant_to_a_global_intensity_change():
 
 @pytest.fixture(scope="module")
 def scene():
-    sky = SkyState.from_time("2009-06-17T13:00:00+02:00", clouds=CloudField(cover=0.4, optical_depth=25.0, seed=1))
+    sky = SkyState.from_time("2009-06-17T13:00:00+02:00", clouds=CloudLayer(cover=0.4, optical_depth=25.0, seed=1))
     return backyard_scene(sky, seed=2)
 
 

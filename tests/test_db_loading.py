@@ -13,9 +13,9 @@ from bionav.db.config import DatabaseConfig
 from bionav.db.database import ImageDatabase
 from bionav.db.export import export_database
 from bionav.db.loading import load_database
-from bionav.db.preprocess import butterworth_lowpass, resize_images
 from bionav.errors import UserError
 from bionav.geometry import PanoramaGeometry
+from bionav.homing.imageops import butterworth_lowpass, resize_images
 
 
 def test_synthetic_source_calls_the_renderer_lazily(monkeypatch, tmp_path):

@@ -6,16 +6,15 @@ import cv2
 import numpy as np
 import pytest
 
-from bionav.db.preprocess import (
-    PreprocessConfig,
+from bionav.db.preprocess import PreprocessConfig, preprocess_images
+from bionav.errors import UserError
+from bionav.homing.imageops import (
     butterworth_lowpass,
     butterworth_response,
     edge_filter,
     equalize_histogram,
-    preprocess_images,
     resize_images,
 )
-from bionav.errors import UserError
 
 
 @pytest.mark.parametrize("order,cutoff", [(1, 0.03), (2, 0.015), (3, 0.1), (2, 0.4)])

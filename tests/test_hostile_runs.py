@@ -46,7 +46,7 @@ def _clean_failure(proc, *needles, code=None):
 def render_cache():
     """The shared, content-hashed render cache (sim_original is rendered once, ever); per-image work is
     not cached in these runs (bionav.cache_prepared=false)."""
-    from bionav.db.synthetic import default_cache_dir
+    from bionav.files import default_cache_dir
 
     return default_cache_dir()
 

@@ -1,4 +1,4 @@
-"""Packaging: the wheel ships conf/ and the entry points; the example plugin installs and is selectable."""
+"""Packaging: the wheel ships bionav/conf/ and the entry points; the example plugin installs and is selectable."""
 
 import os
 import subprocess
@@ -47,7 +47,7 @@ def test_wheel_install_runs_from_outside_the_checkout(wheel, tmp_path):
 
 def test_regular_install_runs_from_the_checkout_root(wheel, tmp_path):
     """`pip install . && python -m bionav` from the clone's root imports the source tree, which has
-    no bionav/conf: the configs must still be found (the README's first Quickstart command)."""
+    bionav/conf in place: the configs must be found (the README's first Quickstart command)."""
     target = tmp_path / "site"
     assert _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path).returncode == 0
     proc = run_bionav("--help", cwd=ROOT, env={"PYTHONPATH": str(target), "BIONAV_CACHE": str(tmp_path / "c")})
@@ -73,3 +73,15 @@ def test_example_plugin_selected_from_the_cli(tmp_path):
     preset = run_bionav("homing=alv_bright", "--cfg", "job", cwd=tmp_path, env=env)
     assert preset.returncode == 0, preset.stderr
     assert "quantile: 0.9" in preset.stdout and "dark_landmarks: false" in preset.stdout
+
+
+def test_installed_wheel_help_lists_each_group_once(wheel, tmp_path):
+    """An installed bionav/conf must not appear a second time as `conf/<group>` groups (issue 20)."""
+    target = tmp_path / "site"
+    assert _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path).returncode == 0
+    proc = run_bionav("--help", cwd=tmp_path, env={"PYTHONPATH": str(target), "BIONAV_CACHE": str(tmp_path / "c")})
+    assert proc.returncode == 0, proc.stderr
+    section = proc.stdout.split("== Configuration groups ==", 1)[1].split("== Config ==", 1)[0]
+    groups = [line.split(":", 1)[0] for line in section.splitlines() if ": " in line]
+    assert "experiment" in groups and len(groups) == len(set(groups)), groups
+    assert not [g for g in groups if g.startswith("conf")], groups

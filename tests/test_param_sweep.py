@@ -69,7 +69,7 @@ def test_evaluate_configuration_homes_on_rendered_grid(small_db):
 
 
 def test_sweep_levels_and_thesis_grid_size():
-    cfg = OmegaConf.load(ROOT / "conf" / "experiment" / "param_sweep.yaml")
+    cfg = OmegaConf.load(ROOT / "bionav" / "conf" / "experiment" / "param_sweep.yaml")
     exp = cfg.experiment
     assert param_sweep.sweep_levels(builtin_signature_class("image"), rings=[1], n_coeffs=[1]) == [{}]
     assert param_sweep.sweep_levels(builtin_signature_class("hist"), rings=[1, 5], n_coeffs=[3]) == [

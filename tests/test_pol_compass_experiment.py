@@ -20,8 +20,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def experiment_config(mode: str, **overrides):
     """``cfg.experiment`` as conf/experiment/pol_compass.yaml + conf/mode/<mode>.yaml compose it."""
-    exp = OmegaConf.load(ROOT / "conf" / "experiment" / "pol_compass.yaml").experiment
-    exp = OmegaConf.merge(exp, OmegaConf.load(ROOT / "conf" / "mode" / f"{mode}.yaml").experiment)
+    exp = OmegaConf.load(ROOT / "bionav" / "conf" / "experiment" / "pol_compass.yaml").experiment
+    exp = OmegaConf.merge(exp, OmegaConf.load(ROOT / "bionav" / "conf" / "mode" / f"{mode}.yaml").experiment)
     for key, value in overrides.items():
         OmegaConf.update(exp, key, value, merge=False)
     return exp
@@ -156,6 +156,7 @@ def test_missing_port_fails_cleanly(tmp_path):
 
 def test_unplug_mid_scan_keeps_readings_in_the_log(tmp_path):
     from bionav.experiments.pol_compass import run_session
+    from bionav.light import SkyModel, SunPosition
     from bionav.logs.writer import McapLog
     from bionav.plugins.sensors.fakes.dlpio8 import CompassCounts, FakeDLPIO8
     from bionav.plugins.sensors.pantilt_sim import PanTiltSim, PanTiltSimConfig
@@ -163,7 +164,6 @@ def test_unplug_mid_scan_keeps_readings_in_the_log(tmp_path):
     from bionav.plugins.sensors.polcompass_sim import PolCompassSimConfig, build_hardware
     from bionav.plugins.sensors.replay import Replay, ReplayConfig
     from bionav.polcompass import CompassScene
-    from bionav.sky import SkyModel, SunPosition
 
     scene = CompassScene(SkyModel(SunPosition(0.0, 0.5)))
     rng = np.random.default_rng(1)

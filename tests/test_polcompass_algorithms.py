@@ -3,6 +3,8 @@
 import numpy as np
 import pytest
 
+from bionav.geometry import wrap_axial
+from bionav.light import SkyModel, SunPosition
 from bionav.polcompass import (
     ChainParameters,
     CompassOptics,
@@ -22,11 +24,9 @@ from bionav.polcompass import (
     solve_pose,
     two_unit_evector,
     volts_to_decades,
-    wrap_axial,
     zenith_heading,
 )
 from bionav.polcompass.optics import cone_samples, sensor_frame
-from bionav.sky import SkyModel, SunPosition
 
 ALPHA = np.array([0.0, np.pi / 3, 2 * np.pi / 3])
 

@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.evaluation.prepcache import PreparedCache, cache_key
+from bionav.evaluation.prepcache import PreparedCache
+from bionav.evaluation.prepcache import prepared_key as cache_key
 from bionav.geometry import PanoramaGeometry
 from bionav.homing.sift_homing import SiftFeatures
 

@@ -3,20 +3,20 @@
 import numpy as np
 import pytest
 
-from bionav.sky import (
+from bionav.geometry import direction_from_angles
+from bionav.light import (
     PolarizerLamp,
     SkyModel,
     SunPosition,
     angle_in_frame,
     berry_polarization,
     cie_relative_radiance,
-    direction_from_angles,
     max_degree_from_turbidity,
-    random_cloud_field,
+    random_cloud_map,
     rayleigh_polarization,
     sun_position,
 )
-from bionav.sky.rayleigh import local_frame
+from bionav.light.rayleigh import local_frame
 
 ZENITH = np.array([0.0, 0.0, 1.0])
 
@@ -123,16 +123,16 @@ def test_local_frame_and_angle_in_frame():
 
 
 def test_cloud_field_cover_and_reproducibility():
-    a = random_cloud_field(np.random.default_rng(5), cover=0.4)
-    b = random_cloud_field(np.random.default_rng(5), cover=0.4)
+    a = random_cloud_map(np.random.default_rng(5), cover=0.4)
+    b = random_cloud_map(np.random.default_rng(5), cover=0.4)
     np.testing.assert_array_equal(a.cloudiness, b.cloudiness)
     n = a.cloudiness.shape[0]
     u = np.linspace(-1, 1, n)
     disk = np.hypot(*np.meshgrid(u, u)) <= 1
     assert np.mean(a.cloudiness[disk] >= 0.5) == pytest.approx(0.4, abs=0.02)
-    clear = random_cloud_field(np.random.default_rng(1), cover=0.0)
+    clear = random_cloud_map(np.random.default_rng(1), cover=0.0)
     assert clear.clear_fraction() == 1.0
-    overcast = random_cloud_field(np.random.default_rng(1), cover=1.0)
+    overcast = random_cloud_map(np.random.default_rng(1), cover=1.0)
     assert overcast.clear_fraction() == 0.0
     # Clouds lower the degree where they are.
     sun = SunPosition(0.0, np.deg2rad(30))

@@ -77,10 +77,11 @@ def test_campus_world_in_five_bands():
     pytest.importorskip("bionav.world.worlds.outdoor")
     from bionav.experiments.skyline_homing import campus_world, render_campus_counts
     from bionav.geometry import PanoramaGeometry
+    from bionav.light.clouds import CloudLayer
+    from bionav.light.daylight import SkyState
     from bionav.spectral.sensor_model import LogSensorModel
-    from bionav.spectral.sky import CloudField, SkyState
 
-    sky = SkyState.from_time("2009-06-17T16:00:00+02:00", clouds=CloudField(cover=0.3, optical_depth=20, seed=1))
+    sky = SkyState.from_time("2009-06-17T16:00:00+02:00", clouds=CloudLayer(cover=0.3, optical_depth=20, seed=1))
     world = campus_world(sky, seed=0)
     g = PanoramaGeometry(60, 10, 7.5, 2 * np.pi / 60)
     counts, is_sky = render_campus_counts(world, g, np.array([[2, 3]]), sensor_model=LogSensorModel(noise_counts=0.0),

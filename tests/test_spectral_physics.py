@@ -3,20 +3,20 @@
 import numpy as np
 import pytest
 
-from bionav.spectral.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
-from bionav.spectral.materials import MATERIALS
-from bionav.spectral.sensor_model import LogSensorModel
-from bionav.spectral.sky import (
-    CloudField,
+from bionav.geometry import direction_from_angles
+from bionav.light.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
+from bionav.light.clouds import CloudLayer
+from bionav.light.daylight import (
     SkyState,
     clear_sky_radiance,
-    direction,
     illumination,
     rayleigh_optical_depth,
     relative_air_mass,
     sky_radiance,
     solar_spectrum,
 )
+from bionav.light.materials import MATERIALS
+from bionav.spectral.sensor_model import LogSensorModel
 
 
 def test_band_peaks_and_bandwidths_match_table_6_1():
@@ -77,13 +77,13 @@ def test_single_scattering_thin_limit():
     wl = np.array([800.0])
     state = SkyState(np.deg2rad(90.0), turbidity=1e-9)
     tau = rayleigh_optical_depth(wl)
-    d = direction(np.deg2rad(89.999), 0.0)
+    d = direction_from_angles(0.0, np.deg2rad(89.999))
     expected = solar_spectrum(wl) * tau * 0.75 * 2 / (4 * np.pi) * np.exp(-tau)
     assert clear_sky_radiance(state, d, wl)[0] == pytest.approx(expected[0], rel=0.01)
 
 
 def test_cloud_field_cover_fraction_and_motion():
-    field = CloudField(cover=0.4, optical_depth=20.0, seed=3, softness=0.01)
+    field = CloudLayer(cover=0.4, optical_depth=20.0, seed=3, softness=0.01)
     rng = np.random.default_rng(0)
     v = rng.normal(size=(20000, 3))
     v[:, 2] = np.abs(v[:, 2]) + 0.3

@@ -6,11 +6,11 @@ import pytest
 from bionav.db.synthetic import (
     SYNTHETIC_DATABASES,
     available_databases,
-    cache_key,
     get_spec,
     synthetic_database,
 )
 from bionav.errors import UserError
+from bionav.files import cache_key
 from bionav.geometry import TWO_PI
 from bionav.world.render import render_depth, render_panorama
 
@@ -199,7 +199,7 @@ def test_apartment_free_area_is_free():
 
 
 def test_campus_renders_five_bands_with_caller_albedos_and_sky():
-    from bionav.world.sky import BAND_ALBEDO
+    from bionav.light.materials import BAND_ALBEDO
     from bionav.world.worlds.outdoor import build_campus
 
     bands = ("UV", "B", "G", "R", "IR")

@@ -4,15 +4,13 @@ import numpy as np
 import pytest
 
 from bionav.geometry import PanoramaGeometry
+from bionav.homing.imageops import butterworth_lowpass, horizon_strip, resize_panorama
+from bionav.homing.imageops import vertical_difference as edge_filter  # the scale planes' vertical edge filter
 from bionav.homing.warping import (
-    butterworth_lowpass,
     default_scales,
     default_thresholds,
-    edge_filter,
-    horizon_strip,
     magnify_vertical,
     minwarping,
-    resize_panorama,
     scale_plane_stack,
     warping1d,
     warping2d,

@@ -1,4 +1,4 @@
-"""Composing a ``db`` config from bionav's ``conf/`` folder with Hydra's compose API.
+"""Composing a ``db`` config from bionav's ``bionav/conf/`` folder with Hydra's compose API.
 
 Used by ``python -m bionav.db``; the main ``python -m bionav`` entry point
 composes its configs through Hydra's own application machinery instead.
@@ -24,12 +24,6 @@ def available_databases() -> list[str]:
 def default_data_dir() -> Path:
     """``$BIONAV_DATA`` if set, else ``./data``."""
     return Path(os.environ.get("BIONAV_DATA") or "./data")
-
-
-def default_cache_dir() -> Path:
-    """``$BIONAV_CACHE`` if set, else ``~/.cache/bionav``."""
-    env = os.environ.get("BIONAV_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "bionav"
 
 
 @dataclass

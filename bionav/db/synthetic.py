@@ -29,20 +29,18 @@ sim_uni         10x17   1.0 m   170      normal  outdoors: buildings, trees, sky
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable
 
 import numpy as np
 
-from bionav._umask import shared_file_mode
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
+from bionav.files import cache_key, default_cache_dir, write_atomic
 from bionav.geometry import PanoramaGeometry
+from bionav.homing.imageops import check_image_size
 
 #: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
 NATIVE_SIZE = (561, 81)
@@ -161,12 +159,6 @@ def available_databases() -> list[str]:
     return sorted(SYNTHETIC_DATABASES)
 
 
-def default_cache_dir() -> Path:
-    """``$BIONAV_CACHE`` if set, else ``~/.cache/bionav``."""
-    env = os.environ.get("BIONAV_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "bionav"
-
-
 def get_spec(name: str) -> SyntheticSpec:
     """The :class:`SyntheticSpec` of a stand-in; raises :class:`UserError` for unknown names."""
     if name not in SYNTHETIC_DATABASES:
@@ -175,27 +167,6 @@ def get_spec(name: str) -> SyntheticSpec:
             f"{', '.join(available_databases())}. Choose one of them with db=<name>."
         )
     return SYNTHETIC_DATABASES[name]
-
-
-def cache_key(params: dict) -> str:
-    """SHA-256 of the JSON of every parameter that determines a database's pixels."""
-    return hashlib.sha256(json.dumps(params, sort_keys=True, default=str).encode()).hexdigest()
-
-
-def _write_npz_atomic(path: Path, **arrays) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
-    os.fchmod(fd, shared_file_mode())  # mkstemp's 0o600 -> follow the umask
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, **arrays)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def quantise(images: np.ndarray, *, noise: float, rng: np.random.Generator) -> np.ndarray:
@@ -283,20 +254,19 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     from bionav.world.render import RENDERER_VERSION
 
     spec = get_spec(name)
-    if image_size is None:
-        w, h = spec.native_size
-    else:
-        try:
-            w, h = (int(v) for v in image_size)
-        except (TypeError, ValueError):
-            raise UserError(f"db.image_size must be [W, H] with two integers, got {image_size!r}.") from None
-    if w < 8 or h < 2:
-        raise UserError(f"db.image_size [W, H] = [{w}, {h}] is too small; use at least [8, 2].")
+    w, h = check_image_size(image_size, name="db.image_size", minimum=(8, 2)) or spec.native_size
     if noise < 0:
         raise UserError(f"db.noise must be >= 0, got {noise}.")
     geometry = spec.geometry(w, h)
     world = spec.builder(int(seed))
     positions = np.argwhere(world.cells).astype(np.int64)
+    from bionav.validation import check_allocation
+
+    check_allocation(  # float32 render buffer plus the 8-bit images
+        5.0 * len(positions) * w * h,
+        what=f"rendering the {len(positions)} images of {name!r} at db.image_size=[{w},{h}]",
+        fix="choose a smaller db.image_size=[W,H] (the thesis uses up to [600,100])",
+    )
     if world.grid_shape != spec.grid_shape:
         raise RuntimeError(f"{name}: world grid {world.grid_shape} differs from table {spec.grid_shape}")
     compiled_digest = world.scene.compile().digest()
@@ -331,8 +301,8 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x6E6F6973]))
         images_u8 = quantise(imgs, noise=noise, rng=rng)
         try:
-            _write_npz_atomic(path, images=images_u8, positions=positions, key=np.array(key),
-                              params=np.array(json.dumps(params)))
+            write_atomic(path, lambda f: np.savez(f, images=images_u8, positions=positions, key=np.array(key),
+                                                  params=np.array(json.dumps(params))))
         except OSError:
             pass  # a read-only cache is not fatal: the database is still returned
     images = images_u8.astype(np.float32) / np.float32(255.0)

@@ -5,8 +5,7 @@ Per-image results (features, signatures, scale-plane stacks) are stored as
 ``<cache_dir>/prepared/<method>/<hh>/<hash>.npz``. The key hashes the method's
 registry name, its typed config, its ``cache_version``, the image geometry and
 the image bytes, so a sweep over methods or parameters recomputes only what
-changed. Files are written to a temporary name and moved into place with
-``os.replace``: concurrent workers computing the same entry both write the
+changed. Files are written with :func:`bionav.files.write_atomic`: concurrent workers computing the same entry both write the
 same content and never expose a half-written file.
 
 Cacheable results are: an ndarray, a dict of ndarrays, or a dataclass whose
@@ -17,17 +16,13 @@ Anything else is simply not cached.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import importlib
-import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from bionav._umask import shared_file_mode
+from bionav.files import cache_key, write_atomic
 
 _KIND = "__bionav_kind__"
 _CLASS = "__bionav_class__"
@@ -37,21 +32,16 @@ def _plain(config: Any) -> Any:
     return dataclasses.asdict(config) if dataclasses.is_dataclass(config) and not isinstance(config, type) else config
 
 
-def cache_key(
+def prepared_key(
     method_name: str, config: Any, geometry: Any, image: np.ndarray, *, version: str, extra: Any = None
 ) -> str:
-    """SHA-256 of everything the per-image result depends on.
+    """The :func:`bionav.files.cache_key` of everything a per-image result depends on.
 
     ``extra`` holds further configuration the result depends on (e.g. the
     parameter signature's own config for ``homing=parameter``).
     """
-    h = hashlib.sha256()
     payload = [method_name, version, _plain(config), dataclasses.asdict(geometry), _plain(extra)]
-    h.update(json.dumps(payload, sort_keys=True, default=str).encode())
-    arr = np.ascontiguousarray(image)
-    h.update(str((arr.shape, arr.dtype.str)).encode())
-    h.update(arr.tobytes())
-    return h.hexdigest()
+    return cache_key(payload, image)
 
 
 def _to_arrays(value: Any) -> dict[str, np.ndarray] | None:
@@ -116,23 +106,13 @@ class PreparedCache:
         arrays = _to_arrays(value)
         if arrays is None:
             return False
-        path = self._path(key)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".npz")
-        os.fchmod(fd, shared_file_mode())  # mkstemp's 0o600 -> follow the umask
-        try:
-            with os.fdopen(fd, "wb") as f:
-                np.savez(f, **arrays)
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        write_atomic(self._path(key), lambda f: np.savez(f, **arrays))
         return True
 
     def prepare(self, method: Any, image: np.ndarray) -> Any:
         """``method.prepare(image)`` through the cache."""
         signature = getattr(method, "signature", None)
-        key = cache_key(
+        key = prepared_key(
             self.method_name, method.config, method.geometry, image,
             version=str(getattr(method, "cache_version", "1")),
             extra=getattr(signature, "config", None),

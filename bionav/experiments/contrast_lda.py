@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from bionav.errors import UserError
+from bionav.experiments.configs import experiment_config
 
 #: Names ``data=`` accepts.
 DATASETS = ("sim_natural", "sim_artificial", "csv")
@@ -158,7 +159,7 @@ FEATURE_SCHEMA = {
 
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "contrast_lda")
     data = _get(cfg, "data", None)
     if data is None:
         raise UserError("experiment=contrast_lda needs a data set: data=sim_natural, data=sim_artificial or "
@@ -176,6 +177,6 @@ def run(cfg, ctx) -> dict:
             ctx.log.write(FEATURE_TOPIC, {"feature": name, "J": r.J, "J_sigma": r.J_sigma, "n_f": r.n_f},
                           schema_name="bionav.SpectralFeatureLda", schema=FEATURE_SCHEMA)
 
-    return analyse(samples, sigma=float(_get(exp, "sigma", 30.0)), n_resamples=int(_get(exp, "n_resamples", 10000)),
+    return analyse(samples, sigma=float(exp.sigma), n_resamples=int(exp.n_resamples),
                    rng=ctx.rng, out_dir=ctx.dir, plots_dir=ctx.plots, title=title,
-                   plots=bool(_get(exp, "plots", True)), on_features=log_features)
+                   plots=bool(exp.plots), on_features=log_features)

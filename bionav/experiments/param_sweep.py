@@ -4,7 +4,7 @@ One job evaluates one signature on one database at one image size and
 preprocessing, for every ring count ``R`` (ring-based signatures) or every
 number of Fourier coefficients ``K`` (DFT-based signatures) of the sweep;
 [image] has a single configuration. The Hydra multirun over signature x image
-size x preprocessing (x database) is declared in ``conf/experiment/param_sweep.yaml``
+size x preprocessing (x database) is declared in ``bionav/conf/experiment/param_sweep.yaml``
 (``experiment.grid=full`` is the thesis grid, ``experiment.grid=ci`` a reduced one).
 
 For every configuration the signatures are computed once per image
@@ -41,6 +41,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.evaluation.pairs import NEIGHBOUR_OFFSETS, HomeVectorMatrix
+from bionav.experiments.configs import experiment_config
 from bionav.geometry import wrap_angle
 from bionav.report.figures import pyplot, save_figure
 
@@ -211,7 +212,7 @@ def _finite(x: float) -> float | None:
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.common import load_configured_database
 
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "param_sweep")
     homing_cls, homing_cfg, sig_name, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
     db = load_configured_database(cfg)
     levels = sweep_levels(sig_cls, rings=list(exp.rings), n_coeffs=list(exp.n_coeffs))

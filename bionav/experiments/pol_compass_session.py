@@ -116,7 +116,7 @@ def resolve_sun(sky, *, recorded_session: dict | None):
     sun : SunPosition
     time_utc : str or None
     """
-    from bionav.sky import SunPosition, sun_position
+    from bionav.light import SunPosition, parse_time, sun_position
 
     if recorded_session is not None:
         return SunPosition(
@@ -127,14 +127,13 @@ def resolve_sun(sky, *, recorded_session: dict | None):
         return SunPosition(np.deg2rad(float(sky.sun_azimuth_deg)), np.deg2rad(float(sky.sun_elevation_deg))), None
     when = _dt.datetime.now(_dt.timezone.utc) if str(time) == "now" else str(time)
     sun = sun_position(when, latitude_deg=float(sky.latitude_deg), longitude_deg=float(sky.longitude_deg))
-    from bionav.sky.sun import parse_time
 
-    return sun, parse_time(when).isoformat()
+    return sun, parse_time(when).astimezone(_dt.timezone.utc).isoformat()
 
 
 def sky_model(sky, sun, *, clouds=None):
-    """The :class:`~bionav.sky.SkyModel` the ``experiment.sky`` node describes."""
-    from bionav.sky import SkyModel, max_degree_from_turbidity
+    """The :class:`~bionav.light.SkyModel` the ``experiment.sky`` node describes."""
+    from bionav.light import SkyModel, max_degree_from_turbidity
 
     max_degree = sky.get("max_degree")
     if max_degree is None:
@@ -149,12 +148,12 @@ def sky_model(sky, sun, *, clouds=None):
 
 def cloud_field(sky, rng, *, cover: float | None = None):
     """A cloud field for ``experiment.sky`` (None for a clear sky)."""
-    from bionav.sky import random_cloud_field
+    from bionav.light import random_cloud_map
 
     cover = float(sky.cloud_cover) if cover is None else float(cover)
     if cover <= 0.0:
         return None
-    return random_cloud_field(rng, cover=cover, correlation_length=np.deg2rad(float(sky.cloud_correlation_deg)))
+    return random_cloud_map(rng, cover=cover, correlation_length=np.deg2rad(float(sky.cloud_correlation_deg)))
 
 
 def start_fakes(stack: ExitStack, nodes: dict, scene, rng) -> dict:

@@ -26,7 +26,7 @@ def _border(ax, lda, style, label):
 
 def scatter_pair(ax, samples, result) -> None:
     """Objects (green) and sky (red) in a two-channel feature with the J (solid) and J_sigma (dashed) borders."""
-    from bionav.spectral.bands import CHANNELS
+    from bionav.light.bands import CHANNELS
 
     i, j = result.channels
     obj, sky = ~samples.is_sky, samples.is_sky
@@ -42,7 +42,7 @@ def scatter_pair(ax, samples, result) -> None:
 
 def plot_pairs(samples, results, path, *, names=None, title="") -> Path:
     """All ten dual-channel scatter plots in an upper-triangle grid (fig. 6.4/6.5), or the given ``names`` in a row (fig. 6.3)."""
-    from bionav.spectral.bands import CHANNELS
+    from bionav.light.bands import CHANNELS
 
     plt = pyplot()
     if names:
@@ -136,7 +136,7 @@ def _image_grid(images: dict, path, *, title="", cmap="gray", cols=5):
 
 def plot_channel_images(counts, path, *, title="") -> Path:
     """The five channel images of a scan, each normalised for display (figs. 6.8/6.9, D.7-D.10)."""
-    from bionav.spectral.bands import CHANNELS
+    from bionav.light.bands import CHANNELS
 
     return _image_grid({c: counts[..., i] for i, c in enumerate(CHANNELS)}, path, title=title, cols=5)
 
@@ -178,7 +178,7 @@ def plot_stability(rows, hours, path, *, separated: bool, measures=None) -> Path
 
     One row of panels per measure: single channels left, dual-channel contrasts right.
     """
-    from bionav.spectral.bands import CHANNELS, dual_contrasts
+    from bionav.light.bands import CHANNELS, dual_contrasts
     from bionav.spectral.stability import MEASURES
 
     plt = pyplot()

@@ -10,7 +10,6 @@ from bionav.polcompass.compass import (
     least_squares_evector,
     two_unit_evector,
     volts_to_decades,
-    wrap_axial,
     zenith_heading,
 )
 from bionav.polcompass.electronics import (
@@ -50,6 +49,5 @@ __all__ = [
     "solve_pose",
     "two_unit_evector",
     "volts_to_decades",
-    "wrap_axial",
     "zenith_heading",
 ]

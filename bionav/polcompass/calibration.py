@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from bionav.errors import UserError
-from bionav.polcompass.compass import wrap_axial
+from bionav.geometry import wrap_axial
 
 
 @dataclass(frozen=True)

@@ -23,12 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.geometry import wrap_angle
-
-
-def wrap_axial(angle):
-    """Wrap axial angles (period ``pi``) to ``[-pi/2, pi/2)``."""
-    return (np.asarray(angle) + np.pi / 2.0) % np.pi - np.pi / 2.0
+from bionav.geometry import wrap_angle, wrap_axial
 
 
 def volts_to_decades(volts, *, center_v=2.5, volts_per_decade=0.5):

@@ -3,7 +3,7 @@
 The zenith e-vector only fixes a heading modulo ``pi`` (the candidate pair of
 eq. 4.6). The thesis chooses between the candidates with an *error function*
 that compares the computed with the expected result. Here the expected result
-is the sensor response predicted by the sky model (:mod:`bionav.sky`) through
+is the sensor response predicted by the sky model (:mod:`bionav.light`) through
 the compass optics (:mod:`bionav.polcompass.optics`) for a candidate heading,
 with the sun position known from time and place. Looking at the zenith both
 candidates predict the same response, so the pair stays unresolved there;
@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bionav.geometry import wrap_angle
-from bionav.polcompass.compass import choose_candidate, wrap_axial
+from bionav.geometry import wrap_angle, wrap_axial
+from bionav.polcompass.compass import choose_candidate
 from bionav.polcompass.optics import CompassOptics
 
 

@@ -121,7 +121,7 @@ class CompassOptics:
         Parameters
         ----------
         source : object with ``light(view) -> SkyLight``
-            A :class:`bionav.sky.SkyModel` or :class:`bionav.sky.PolarizerLamp`.
+            A :class:`bionav.light.SkyModel` or :class:`bionav.light.PolarizerLamp`.
         heading, tilt : float or ndarray
             Sensor heading(s) and tilt(s), radians, broadcast together to
             shape ``S``.

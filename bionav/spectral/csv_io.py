@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from bionav.errors import UserError
-from bionav.spectral.bands import CHANNELS
+from bionav.light.bands import CHANNELS
 from bionav.spectral.samples import SampleSet
 
 _CLASS_VALUES = {"sky": True, "object": False}

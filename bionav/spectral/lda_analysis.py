@@ -1,7 +1,7 @@
 """Sky/object discrimination per spectral feature: tables 6.2-6.5 of the thesis.
 
 For every feature (single channel, channel pair, all five; see
-:func:`bionav.spectral.bands.feature_subsets`) Fisher's LDA separates sky
+:func:`bionav.light.bands.feature_subsets`) Fisher's LDA separates sky
 (class 1) from objects (class 0) on the counts; reported are ``J``,
 ``J_sigma`` (receptor noise ``sigma``, thesis: 30 counts) and ``n_f``, the
 fraction of samples misclassified by the minimum-error threshold on the
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bionav.spectral.bands import CHANNELS, feature_subsets
+from bionav.light.bands import CHANNELS, feature_subsets
 from bionav.spectral.samples import SampleSet
 from bionav.stats import (
     LinearDiscriminant,
@@ -81,7 +81,7 @@ def analyse_features(samples: SampleSet, *, sigma: float = 30.0) -> dict[str, Fe
     -------
     dict
         Feature name -> :class:`FeatureResult`, in the order of
-        :func:`~bionav.spectral.bands.feature_subsets`.
+        :func:`~bionav.light.bands.feature_subsets`.
     """
     out = {}
     for name, sub in feature_subsets().items():

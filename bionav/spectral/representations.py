@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bionav.spectral.bands import CHANNELS, dual_contrasts, feature_subsets
+from bionav.light.bands import CHANNELS, dual_contrasts, feature_subsets
 
 SKYLINE_PREFIX = "skyline:"
 

@@ -16,7 +16,7 @@ thesis' collections:
 
 Each sample draws a time, a weather regime of that day, a cloud field, the
 viewing direction and, for objects, a material spectrum, a surface orientation,
-sun or shadow and a distance; radiance comes from :mod:`bionav.spectral.sky`
+sun or shadow and a distance; radiance comes from :mod:`bionav.light.daylight`
 and counts from :class:`~bionav.spectral.sensor_model.LogSensorModel`.
 """
 
@@ -27,18 +27,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.spectral.bands import CHANNELS, PEAK_NM, band_integrate
-from bionav.spectral.materials import ARTIFICIAL_MIX, MATERIALS, NATURAL_MIX
-from bionav.spectral.sensor_model import LogSensorModel
-from bionav.spectral.sky import (
-    CloudField,
+from bionav.geometry import direction_from_angles
+from bionav.light.bands import CHANNELS, PEAK_NM, band_integrate
+from bionav.light.clouds import CloudLayer
+from bionav.light.daylight import (
     SkyState,
     aerosol_optical_depth,
     band_sky_radiance,
-    direction,
     illumination,
     rayleigh_optical_depth,
 )
+from bionav.light.materials import ARTIFICIAL_MIX, MATERIALS, NATURAL_MIX
+from bionav.light.sun import BIELEFELD_LAT_DEG, BIELEFELD_LON_DEG, sun_position
+from bionav.spectral.sensor_model import LogSensorModel
 
 
 @dataclass(frozen=True)
@@ -112,17 +113,15 @@ def _berlin(date: _dt.datetime) -> _dt.datetime:
 
 
 def _draw_time(rng, ranges, min_elevation):
-    from bionav.spectral.sun import sun_position
-
     lengths = np.array([(b - a).days + 1 for a, b in ranges], dtype=float)
     while True:
         k = rng.choice(len(ranges), p=lengths / lengths.sum())
         day = ranges[k][0] + _dt.timedelta(days=int(rng.integers(0, lengths[k])))
         minutes = int(rng.integers(8 * 60, 19 * 60 + 30))
         t = _berlin(_dt.datetime(day.year, day.month, day.day, minutes // 60, minutes % 60, int(rng.integers(0, 60))))
-        el, az = sun_position(t)
-        if el >= min_elevation:
-            return t, el, az
+        sun = sun_position(t, latitude_deg=BIELEFELD_LAT_DEG, longitude_deg=BIELEFELD_LON_DEG)
+        if sun.elevation >= min_elevation:
+            return t, sun.elevation, sun.azimuth
 
 
 class _Weather:
@@ -140,14 +139,12 @@ class _Weather:
             self.days[key] = (names[self.rng.choice(len(names), p=p / p.sum())], float(self.rng.uniform(0.05, 0.2)))
         regime, beta = self.days[key]
         _, cover, tau, kind = _REGIMES[regime]
-        clouds = CloudField(
+        clouds = CloudLayer(
             cover=float(self.rng.uniform(*cover)),
             optical_depth=float(self.rng.uniform(*tau)) if tau[1] > 0 else 0.0,
             seed=int(self.rng.integers(0, 2**31)),
         )
-        from bionav.spectral.sky import geographic_to_enu_azimuth
-
-        state = SkyState(sun_elevation=el, sun_azimuth=float(geographic_to_enu_azimuth(az)), turbidity=beta, clouds=clouds)
+        state = SkyState(sun_elevation=el, sun_azimuth=az, turbidity=beta, clouds=clouds)
         return state, kind
 
 
@@ -165,7 +162,7 @@ def _sky_samples(rng, n, ranges, sensor, n_average):
         state, cloud_kind = weather.state(t, el, az)
         while True:
             v_el = np.arcsin(rng.uniform(np.sin(np.deg2rad(10)), np.sin(np.deg2rad(88))))
-            v = direction(v_el, rng.uniform(0, 2 * np.pi))
+            v = direction_from_angles(rng.uniform(0, 2 * np.pi), v_el)
             if v @ state.sun_direction < np.cos(np.deg2rad(20.0)):
                 break
         rad = band_sky_radiance(state, v)
@@ -187,8 +184,10 @@ def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average):
         mat = MATERIALS[names[rng.choice(len(names), p=p / p.sum())]]
         rho = mat.sample(rng)[0]
         # viewing direction (sensor -> object), roughly horizontal
-        view = direction(np.deg2rad(rng.uniform(-35.0, 5.0)), rng.uniform(0, 2 * np.pi))
-        normal = direction(np.deg2rad(rng.uniform(0.0, 90.0)), rng.uniform(0, 2 * np.pi))
+        view_el = np.deg2rad(rng.uniform(-35.0, 5.0))  # draws: elevation, then azimuth
+        view = direction_from_angles(rng.uniform(0, 2 * np.pi), view_el)
+        normal_el = np.deg2rad(rng.uniform(0.0, 90.0))
+        normal = direction_from_angles(rng.uniform(0, 2 * np.pi), normal_el)
         if normal @ view > 0:  # make the surface face the sensor
             normal = normal * np.array([-1.0, -1.0, 1.0])
         in_shadow = rng.random() < 0.3
@@ -204,7 +203,7 @@ def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average):
                 rad = rad + gloss * 0.15 * band_integrate(ill.global_horizontal) / np.pi
         d = rng.uniform(*distance_m)
         trans = np.exp(-_extinction_per_m(state.turbidity) * d)
-        horizon = band_sky_radiance(state, direction(np.deg2rad(1.0), np.arctan2(-view[1], -view[0]) + np.pi))
+        horizon = band_sky_radiance(state, direction_from_angles(np.arctan2(-view[1], -view[0]) + np.pi, np.deg2rad(1.0)))
         rad = rad * trans + horizon * (1 - trans)
         counts.append(sensor.read(rad, rng=rng, n_readings=n_average)[..., :5].mean(axis=0))
         kinds.append(mat.name)

@@ -17,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-from bionav.spectral.bands import CHANNELS, dual_contrasts, feature_subsets
+from bionav.light.bands import CHANNELS, dual_contrasts, feature_subsets
 from bionav.spectral.stability import stability_measures
 
 #: The 14 scan times of the thesis' one-day dataset (Wed 17 June 2009, appendix D.3), local time.
@@ -175,7 +175,7 @@ def separation_images(counts, discriminants: dict) -> dict[str, np.ndarray]:
     discriminants : dict
         Feature name -> fitted :class:`bionav.stats.LinearDiscriminant` (sky =
         class 1) on that feature's channels (see
-        :func:`bionav.spectral.bands.feature_subsets`).
+        :func:`bionav.light.bands.feature_subsets`).
 
     Returns
     -------

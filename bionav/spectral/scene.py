@@ -3,13 +3,13 @@
 :class:`OutdoorScene` ray-casts viewing directions against a handful of
 analytic primitives (ground plane, yawed boxes, ellipsoids, vertical
 cylinders, a distant tree line) and shades the hits with the spectral daylight
-of :mod:`bionav.spectral.sky`:
+of :mod:`bionav.light.daylight`:
 
 ``L_b = rho_b * tex * (sunlit * cos_i * E_dir_b + (1 + n_z)/2 * E_diff_b + (1 - n_z)/2 * a_g * E_glob_b) / pi``
 
 attenuated towards the sensor by the air (extinction per band) plus airlight
 (horizon sky radiance); lines of sight that hit nothing get the sky radiance
-with clouds. ``rho_b`` comes from :data:`bionav.spectral.materials.MATERIALS`
+with clouds. ``rho_b`` comes from :data:`bionav.light.materials.MATERIALS`
 (reflectance constant within each channel), ``tex`` is a smooth multiplicative
 texture (log-normal, per material), shadows are cast by every primitive except
 the ground, foliage is lit in patches (sun flecks).
@@ -28,16 +28,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from bionav.spectral.bands import PEAK_NM, band_integrate
-from bionav.spectral.materials import MATERIALS
-from bionav.spectral.sky import (
+from bionav.geometry import direction_from_angles
+from bionav.light.bands import PEAK_NM, band_integrate
+from bionav.light.daylight import (
     SkyState,
     aerosol_optical_depth,
     band_sky_radiance,
-    direction,
     illumination,
     rayleigh_optical_depth,
 )
+from bionav.light.materials import MATERIALS
 
 _MISS = np.inf
 
@@ -175,7 +175,7 @@ class OutdoorScene:
 
     def view_direction(self, pan, tilt) -> np.ndarray:
         """Unit viewing direction(s) ``(..., 3)`` for pan/tilt in radians."""
-        return direction(tilt, self.pan_zero_azimuth + np.asarray(pan))
+        return direction_from_angles(self.pan_zero_azimuth + np.asarray(pan), tilt)
 
     # -- geometry ------------------------------------------------------------------------
     def _intersect(self, o, d, *, shadow=False):
@@ -340,7 +340,7 @@ class OutdoorScene:
                     + aerosol_optical_depth(np.asarray(PEAK_NM), beta=self.sky.turbidity) / 1200.0)
             trans = np.exp(-beta * t[hit, None])
             az = np.arctan2(d[hit, 1], d[hit, 0])
-            horizon = band_sky_radiance(self.sky, direction(np.deg2rad(2.0), az), origin_m=origin_xy)
+            horizon = band_sky_radiance(self.sky, direction_from_angles(az, np.deg2rad(2.0)), origin_m=origin_xy)
             out[hit] = rad * trans + horizon * (1 - trans)
         return out.reshape(shape + (5,)), sky.reshape(shape)
 
@@ -477,4 +477,4 @@ def render_spectral_panorama(scene: OutdoorScene, geometry, *, position, heading
     az = heading + geometry.column_azimuths()
     el = geometry.row_elevations()
     ee, aa = np.meshgrid(el, az, indexing="ij")
-    return scene.render(direction(ee, aa), position=position)
+    return scene.render(direction_from_angles(aa, ee), position=position)

@@ -29,8 +29,8 @@ import numpy as np
 
 
 def _white_reference() -> np.ndarray:
-    from bionav.spectral.bands import band_integrate
-    from bionav.spectral.sky import SkyState, illumination
+    from bionav.light.bands import band_integrate
+    from bionav.light.daylight import SkyState, illumination
 
     state = SkyState(sun_elevation=np.deg2rad(50.0), sun_azimuth=0.0)
     return band_integrate(illumination(state).global_horizontal) / np.pi

@@ -7,7 +7,7 @@
 * :class:`Scene` -- boxes, vertical frusta (cylinders, cones), ellipsoids,
   materials with procedural textures (:mod:`bionav.world.textures`), lights
   (:mod:`bionav.world.lights`) and an optional sky function
-  (:mod:`bionav.world.sky`).
+  (:mod:`bionav.light.simple_sky`).
 * World builders (:mod:`bionav.world.worlds`): the laboratory and its seven
   variants, the hall, the living rooms, the outdoor campus and the apartment
   of the cleaning-robot experiments; each returns a :class:`World` (scene plus

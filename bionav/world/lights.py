@@ -111,20 +111,6 @@ def light_band(start, end, *, n: int = 4, intensity: float | tuple[float, ...] =
     return out
 
 
-def sun_direction(elevation: float, azimuth: float) -> tuple[float, float, float]:
-    """Unit vector towards the sun, world frame.
-
-    Parameters
-    ----------
-    elevation : float
-        Radians above the horizon.
-    azimuth : float
-        Radians counter-clockwise from world ``+x``.
-    """
-    ce = np.cos(elevation)
-    return (float(ce * np.cos(azimuth)), float(ce * np.sin(azimuth)), float(np.sin(elevation)))
-
-
 def pack_lights(lights, n_channels: int) -> tuple[np.ndarray, np.ndarray]:
     """Pack lights into kernel arrays.
 

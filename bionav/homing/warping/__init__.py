@@ -4,16 +4,16 @@
 * :func:`warping2d` - 2D-warping under the equal-distance assumption (Möller 2009).
 * :func:`minwarping` - min-warping (Möller, Krzykawski & Gerstmayr 2010).
 
-Per-image work: :func:`resize_panorama`, :func:`butterworth_lowpass`,
-:func:`scale_plane_stack` (2D methods) and :func:`horizon_strip` (1D).
+Per-image work: :func:`scale_plane_stack` (2D methods), after
+:func:`bionav.homing.imageops.resize_panorama`,
+:func:`~bionav.homing.imageops.butterworth_lowpass` and (1D)
+:func:`~bionav.homing.imageops.horizon_strip`.
 Conventions: :mod:`bionav.homing.warping.search`.
 """
 
-from bionav.homing.warping.preprocess import butterworth_lowpass, horizon_strip, resize_panorama
 from bionav.homing.warping.scaleplanes import (
     default_scales,
     default_thresholds,
-    edge_filter,
     magnify_vertical,
     scale_plane_stack,
 )
@@ -28,15 +28,11 @@ from bionav.homing.warping.warping1d import warping1d, warping1d_scores
 
 __all__ = [
     "WarpingResult",
-    "butterworth_lowpass",
     "default_scales",
     "default_thresholds",
-    "edge_filter",
-    "horizon_strip",
     "magnify_vertical",
     "minwarping",
     "minwarping_scores",
-    "resize_panorama",
     "scale_plane_stack",
     "warping1d",
     "warping1d_scores",

@@ -9,6 +9,8 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
+from bionav.homing.imageops import check_image_size
+from bionav.validation import Range, bounded
 
 
 class HissHoming(HomingMethod):
@@ -35,23 +37,19 @@ class HissHoming(HomingMethod):
         n_features, contrast_threshold, edge_threshold, sigma: OpenCV SIFT parameters.
         """
 
-        image_size: list[int] | None = None
-        wrap_pad: float = 0.1
-        ratio: float = 0.8
-        scale_threshold: float = 0.0
-        n_features: int = 0
-        contrast_threshold: float = 0.04
-        edge_threshold: float = 10.0
-        sigma: float = 1.6
+        image_size: list[int] | None = bounded(None, length=2, item=Range(ge=8, le=8192))
+        wrap_pad: float = bounded(0.1, ge=0.0, le=0.5)
+        ratio: float = bounded(0.8, gt=0.0, le=1.0)
+        scale_threshold: float = bounded(0.0, ge=0.0, le=10.0)
+        n_features: int = bounded(0, ge=0, le=100_000)
+        contrast_threshold: float = bounded(0.04, ge=0.0, le=1.0)
+        edge_threshold: float = bounded(10.0, gt=0.0, le=1000.0)
+        sigma: float = bounded(1.6, gt=0.0, le=10.0)
 
     def __init__(self, config: Any, *, geometry) -> None:
         super().__init__(config, geometry=geometry)
         cfg = self.config
-        if cfg.image_size is not None and (len(cfg.image_size) != 2 or min(cfg.image_size) < 8):
-            raise UserError(
-                f"homing.image_size={list(cfg.image_size)} is not a usable [W, H] size for SIFT; "
-                "give two integers of at least 8, or null to keep the database's size"
-            )
+        check_image_size(cfg.image_size, name="homing.image_size", minimum=(8, 8))
         if not (0.0 <= cfg.wrap_pad <= 1.0):
             raise UserError(f"homing.wrap_pad={cfg.wrap_pad} must lie in [0, 1] (a fraction of the width)")
         if not (0.0 < cfg.ratio <= 1.0):
@@ -62,7 +60,7 @@ class HissHoming(HomingMethod):
     def prepare(self, image):
         """SIFT features of the (resized) panorama: dict of arrays (see :func:`bionav.homing.hiss.sift_features`)."""
         from bionav.homing.hiss import sift_features
-        from bionav.homing.warping.preprocess import resize_panorama
+        from bionav.homing.imageops import resize_panorama
 
         img = np.asarray(image, dtype=np.float32)
         if img.ndim == 3:

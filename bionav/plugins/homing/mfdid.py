@@ -8,6 +8,7 @@ from typing import Optional
 import numpy as np
 
 from bionav.homing.base import HomeVector, HomingMethod
+from bionav.validation import Range, bounded
 
 
 @dataclass
@@ -30,9 +31,9 @@ class MfdidConfig:
         floor and ceiling close to the robot.
     """
 
-    image_size: Optional[list[int]] = None
-    lowpass_sigma: float = 0.04
-    vertical_sigma: float = 0.0
+    image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=8, le=8192))
+    lowpass_sigma: float = bounded(0.04, ge=0.0, le=1.0)
+    vertical_sigma: float = bounded(0.0, ge=0.0, le=1.0)
     vertical_flow: bool = False
 
 
@@ -47,17 +48,18 @@ class MfdidHoming(HomingMethod):
 
     def __init__(self, config: MfdidConfig, *, geometry) -> None:
         super().__init__(config, geometry=geometry)
-        from bionav.homing.imageops import resize_panorama
+        from bionav.homing.imageops import check_image_size, resize_panorama
 
+        check_image_size(config.image_size, name="homing.image_size")
         _, self.work_geometry = resize_panorama(
-            np.zeros((geometry.height, geometry.width), np.float32), geometry, config.image_size
+            np.zeros((geometry.height, geometry.width), np.float32), geometry=geometry, size=config.image_size
         )
 
     def prepare(self, image: np.ndarray) -> dict:
         from bionav.homing.imageops import gaussian_lowpass, resize_panorama
         from bionav.homing.mfdid import azimuthal_derivative, elevation_derivative
 
-        image, geometry = resize_panorama(image, self.geometry, self.config.image_size)
+        image, geometry = resize_panorama(image, geometry=self.geometry, size=self.config.image_size)
         smooth = gaussian_lowpass(
             image,
             sigma_azimuth=self.config.lowpass_sigma * geometry.width,

@@ -26,6 +26,7 @@ import numpy as np
 
 from bionav.errors import DeviceError
 from bionav.plugins.sensors.base import SensorPlugin
+from bionav.validation import bounded
 
 #: MCAP topic of raw readings (the convention of ``sensor=replay``: one message per ``read()``).
 RAW_TOPIC = "/sensor/raw"
@@ -104,10 +105,10 @@ class Spectral5Serial(_Spectral5Base):
         """
 
         port: str = "/dev/ttyUSB0"
-        baudrate: int = 9600
-        timeout_s: float = 2.0
-        retries: int = 1
-        readings_per_point: int = 1
+        baudrate: int = bounded(9600, ge=50, le=4_000_000)
+        timeout_s: float = bounded(2.0, gt=0.0, le=3600.0)
+        retries: int = bounded(1, ge=0, le=1000)
+        readings_per_point: int = bounded(1, ge=1, le=100_000)
 
     def __init__(self, config: "Spectral5Serial.Config | None" = None, **_ignored) -> None:
         self.config = config or self.Config()
@@ -278,9 +279,9 @@ class Spectral5Sim(_Spectral5Base):
             Seed of the noise until an experiment attaches its generator.
         """
 
-        noise_counts: float = 4.0
-        readings_per_point: int = 1
-        seed: int = 0
+        noise_counts: float = bounded(4.0, ge=0.0, le=1e6)
+        readings_per_point: int = bounded(1, ge=1, le=100_000)
+        seed: int = bounded(0, ge=0)
 
     def __init__(self, config: "Spectral5Sim.Config | None" = None, **_ignored) -> None:
         from bionav.spectral.sensor_model import LogSensorModel
@@ -331,9 +332,9 @@ class OpenField:
     """
 
     def __init__(self) -> None:
-        from bionav.spectral.bands import band_integrate
-        from bionav.spectral.materials import MATERIALS
-        from bionav.spectral.sky import SkyState, illumination
+        from bionav.light.bands import band_integrate
+        from bionav.light.daylight import SkyState, illumination
+        from bionav.light.materials import MATERIALS
 
         self.sky = SkyState(sun_elevation=np.deg2rad(45.0), sun_azimuth=np.deg2rad(200.0))
         grass = np.asarray(MATERIALS["grass"].reflectance)
@@ -344,9 +345,10 @@ class OpenField:
         self.pose = (float(pan), float(tilt))
 
     def band_radiance(self) -> np.ndarray:
-        from bionav.spectral.sky import band_sky_radiance, direction
+        from bionav.geometry import direction_from_angles
+        from bionav.light.daylight import band_sky_radiance
 
         pan, tilt = self.pose
         if tilt > 0:
-            return band_sky_radiance(self.sky, direction(tilt, pan))
+            return band_sky_radiance(self.sky, direction_from_angles(pan, tilt))
         return self._ground

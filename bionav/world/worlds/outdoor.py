@@ -7,7 +7,7 @@ bike racks, benches and bollards stand around it at 2-80 m.
 
 Channels are pluggable: pass band names plus per-kind albedos and a sky
 callable to render multi-band (e.g. UV, B, G, R, IR) images; the defaults of
-:mod:`bionav.world.sky` are used otherwise.
+:mod:`bionav.light.materials` and :mod:`bionav.light.simple_sky` are used otherwise.
 """
 
 from __future__ import annotations
@@ -16,10 +16,12 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from bionav.geometry import direction_from_angles
+from bionav.light.materials import band_albedos
+from bionav.light.simple_sky import SKY_GAIN, SUN_GAIN, SimpleSky
 from bionav.world import textures as tx
-from bionav.world.lights import Ambient, DirectionalLight, sun_direction
+from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.scene import Scene, SkyFunction
-from bionav.world.sky import SKY_GAIN, SUN_GAIN, SimpleSky, band_albedos
 from bionav.world.worlds.common import World, stream
 from bionav.world.worlds.furniture import tree
 
@@ -44,17 +46,17 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     albedos : mapping, optional
         Material kind -> per-band albedo (length ``len(channels)``). Kinds used:
         ``concrete brick glass foliage bark grass paving asphalt metal paint
-        wood soil``. Default :func:`bionav.world.sky.band_albedos`.
+        wood soil``. Default :func:`bionav.light.materials.band_albedos`.
     sky : callable, optional
         ``sky(directions (N, 3)) -> radiance (N, C)``; default
-        :class:`~bionav.world.sky.SimpleSky` for the sun position.
+        :class:`~bionav.light.simple_sky.SimpleSky` for the sun position.
     sun_elevation, sun_azimuth : float
         Sun position in radians (azimuth CCW from world ``+x``; ``-pi/2`` is
         south, so the grid north of the main building lies in its shadow).
     sun_irradiance, sky_irradiance : float or sequence, optional
         Per-band direct-sun irradiance and diffuse sky irradiance (ambient on
-        upward faces); defaults scale :data:`~bionav.world.sky.SUN_GAIN` /
-        :data:`~bionav.world.sky.SKY_GAIN`.
+        upward faces); defaults scale :data:`~bionav.light.simple_sky.SUN_GAIN` /
+        :data:`~bionav.light.simple_sky.SKY_GAIN`.
     exposure : float
         Camera gain.
 
@@ -69,7 +71,7 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     for k, v in table.items():
         if np.asarray(v).reshape(-1).size not in (1, c):
             raise ValueError(f"albedo of {k!r} must have 1 or {c} values")
-    sun = sun_direction(sun_elevation, sun_azimuth)
+    sun = tuple(float(v) for v in direction_from_angles(sun_azimuth, sun_elevation))
     if sky is None:
         sky = SimpleSky(sun_direction=sun, channels=channels, seed=int(seed))
     if sun_irradiance is None:

@@ -18,13 +18,13 @@ import time
 def _polcompass_fakes(args) -> dict:
     import numpy as np
 
+    from bionav.light import SkyModel, SunPosition, max_degree_from_turbidity
     from bionav.plugins.sensors.fakes.dlpio8 import CompassCounts, FakeDLPIO8
     from bionav.plugins.sensors.fakes.ptu46 import FakePTU46
     from bionav.plugins.sensors.fakes.tcm2 import FakeTCM2
     from bionav.plugins.sensors.polcompass_sim import PolCompassSimConfig, build_hardware
     from bionav.plugins.sensors.tcm2_sim import simulated_attitude
     from bionav.polcompass import CompassScene
-    from bionav.sky import SkyModel, SunPosition, max_degree_from_turbidity
 
     sky = SkyModel(
         SunPosition(np.deg2rad(args.sun_azimuth_deg), np.deg2rad(args.sun_elevation_deg)),
@@ -41,13 +41,14 @@ def _polcompass_fakes(args) -> dict:
 
 
 def _spectral_fakes(args) -> dict:
+    from bionav.light.clouds import CloudLayer
+    from bionav.light.daylight import SkyState
     from bionav.plugins.sensors.fakes.ptu46 import FakePTU46
     from bionav.plugins.sensors.spectral5 import Spectral5Sim
     from bionav.spectral.fake_device import FakeSpectral5
     from bionav.spectral.scene import backyard_scene
-    from bionav.spectral.sky import CloudField, SkyState
 
-    clouds = CloudField(cover=args.cloud_cover, optical_depth=args.cloud_optical_depth, seed=args.seed)
+    clouds = CloudLayer(cover=args.cloud_cover, optical_depth=args.cloud_optical_depth, seed=args.seed)
     scene = backyard_scene(SkyState.from_time(args.time, clouds=clouds), seed=args.seed)
     sim = Spectral5Sim(Spectral5Sim.Config(seed=args.seed))
     sim.attach_simulation(scene, None)

@@ -1,0 +1,55 @@
+"""Where light comes from: the sun, the sky, clouds, spectral daylight, bands and materials.
+
+Modules
+-------
+* :mod:`~bionav.light.sun` -- the one :func:`sun_position` (PyEphem) and the
+  one time parser :func:`parse_time`.
+* :mod:`~bionav.light.rayleigh`, :mod:`~bionav.light.neutral_points`,
+  :mod:`~bionav.light.radiance`, :mod:`~bionav.light.polarized_sky` -- sky
+  polarization for the polarized-light compass (thesis chapter 4; Lambrinos
+  et al. 2000, doi:10.1016/S0921-8890(99)00064-0; Berry et al. 2004,
+  doi:10.1088/1367-2630/6/1/162).
+* :mod:`~bionav.light.clouds` -- :class:`CloudMap` (cloudiness on the sky
+  hemisphere, chapter 4) and :class:`CloudLayer` (a drifting cloud layer of
+  given optical depth, chapter 6).
+* :mod:`~bionav.light.daylight` -- spectral sun, sky and cloud radiance and
+  the irradiance they give on the ground (chapter 6).
+* :mod:`~bionav.light.bands` -- the five sensor channels and their features.
+* :mod:`~bionav.light.materials` -- material reflectance tables.
+* :mod:`~bionav.light.simple_sky` -- the rendered outdoor worlds' default sky.
+
+Frame: east-north-up; azimuths are radians counter-clockwise from east,
+elevations radians above the horizon.
+"""
+
+from bionav.light.clouds import CloudLayer, CloudMap, random_cloud_map
+from bionav.light.neutral_points import berry_polarization
+from bionav.light.polarized_sky import PolarizerLamp, SkyLight, SkyModel
+from bionav.light.radiance import cie_relative_radiance
+from bionav.light.rayleigh import (
+    angle_in_frame,
+    max_degree_from_turbidity,
+    rayleigh_degree,
+    rayleigh_polarization,
+    scattering_angle,
+)
+from bionav.light.sun import SunPosition, parse_time, sun_position
+
+__all__ = [
+    "CloudLayer",
+    "CloudMap",
+    "PolarizerLamp",
+    "SkyLight",
+    "SkyModel",
+    "SunPosition",
+    "angle_in_frame",
+    "berry_polarization",
+    "cie_relative_radiance",
+    "max_degree_from_turbidity",
+    "parse_time",
+    "random_cloud_map",
+    "rayleigh_degree",
+    "rayleigh_polarization",
+    "scattering_angle",
+    "sun_position",
+]

@@ -1,0 +1,232 @@
+"""Clouds, in two models for two uses.
+
+* :class:`CloudMap` (polarized-light compass, thesis chapter 4): cloudiness
+  and e-vector noise on a map of the sky hemisphere, drawn by
+  :func:`random_cloud_map`.
+* :class:`CloudLayer` (spectral daylight, thesis chapter 6): optical depth of a
+  drifting cloud layer at a given height, seen along any line of sight
+  (parallax, wind, anti-aliasing), used by :mod:`bionav.light.daylight`.
+
+Cloud map
+---------
+A cloud map is a smooth Gaussian random field on a square grid covering the
+azimuthal-equidistant projection of the upper hemisphere (zenith at the
+centre, the horizon on the unit circle: ``r = zenith_angle / (pi / 2)``),
+thresholded at the quantile that gives the requested cloud cover. Its value,
+the *cloudiness* in ``[0, 1]``, ramps from 0 (clear) to 1 (overcast) over a
+soft edge. A second independent field supplies the e-vector angle noise that
+scattering in and under clouds adds. All randomness comes from the numpy
+``Generator`` passed in.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import ndtr, ndtri
+
+
+@dataclass(frozen=True)
+class CloudMap:
+    """A sampled cloud field.
+
+    Attributes
+    ----------
+    cloudiness : ndarray, shape ``(N, N)``
+        Cloudiness in ``[0, 1]`` on the projection grid; row index grows with
+        the projection's ``y`` (north), column index with ``x`` (east), both
+        from -1 to 1.
+    angle_noise : ndarray, shape ``(N, N)``
+        Standard-normal correlated field used for the e-vector angle noise.
+    angle_noise_sigma : float
+        Angle noise (radians, one standard deviation) under full cloud.
+    depolarization : float
+        Fraction by which full cloud lowers the degree of polarization.
+    brightness : float
+        Radiance of full cloud relative to the clear zenith.
+    """
+
+    cloudiness: np.ndarray
+    angle_noise: np.ndarray
+    angle_noise_sigma: float = np.deg2rad(20.0)
+    depolarization: float = 0.9
+    brightness: float = 1.5
+
+    def _sample(self, grid, view):
+        from scipy.ndimage import map_coordinates
+
+        view = np.asarray(view, float)
+        zen = np.arccos(np.clip(view[..., 2], -1.0, 1.0))
+        r = np.minimum(zen / (np.pi / 2.0), 1.0)
+        az = np.arctan2(view[..., 1], view[..., 0])
+        n = grid.shape[0]
+        col = (r * np.cos(az) + 1.0) * (n - 1) / 2.0
+        row = (r * np.sin(az) + 1.0) * (n - 1) / 2.0
+        coords = np.stack([row.ravel(), col.ravel()])
+        return map_coordinates(grid, coords, order=1, mode="nearest").reshape(zen.shape)
+
+    def cloudiness_at(self, view):
+        """Cloudiness in ``[0, 1]`` at unit viewing directions, shape ``(..., 3)`` -> ``(...)``."""
+        return np.clip(self._sample(self.cloudiness, view), 0.0, 1.0)
+
+    def angle_noise_at(self, view):
+        """E-vector rotation (radians) added at the viewing directions: cloudiness x sigma x field."""
+        return self.cloudiness_at(view) * self.angle_noise_sigma * self._sample(self.angle_noise, view)
+
+    def clear_fraction(self, *, min_elevation: float = 0.0) -> float:
+        """Solid-angle fraction of the sky above ``min_elevation`` (radians) with cloudiness < 0.5."""
+        n = self.cloudiness.shape[0]
+        u = np.linspace(-1.0, 1.0, n)
+        x, y = np.meshgrid(u, u)
+        r = np.hypot(x, y)
+        zen = r * np.pi / 2.0
+        inside = zen <= np.pi / 2.0 - min_elevation
+        # Area element of the equidistant projection: sin(zen)/zen per unit plane area.
+        weight = np.where(inside, np.sinc(zen / np.pi), 0.0)
+        return float(np.sum(weight * (self.cloudiness < 0.5)) / np.sum(weight))
+
+
+def random_cloud_map(
+    rng: np.random.Generator,
+    *,
+    cover: float,
+    correlation_length: float = np.deg2rad(15.0),
+    edge: float = 0.2,
+    resolution: int = 96,
+    angle_noise_sigma: float = np.deg2rad(20.0),
+    depolarization: float = 0.9,
+    brightness: float = 1.5,
+) -> CloudMap:
+    """Draw a cloud field with a given cloud cover.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of randomness.
+    cover : float
+        Fraction of the projection disk (approximately of the sky) covered by
+        cloud, ``0`` (clear) to ``1`` (overcast).
+    correlation_length : float, optional
+        Standard deviation of the Gaussian smoothing kernel, as an angle on the
+        sky (radians); sets the size of cloud patches.
+    edge : float, optional
+        Width of the clear-to-cloud ramp in standard deviations of the field.
+    resolution : int, optional
+        Grid size ``N``.
+    angle_noise_sigma, depolarization, brightness : float, optional
+        See :class:`CloudMap`.
+
+    Returns
+    -------
+    CloudMap
+    """
+    from scipy.ndimage import gaussian_filter
+
+    if not 0.0 <= cover <= 1.0:
+        raise ValueError(f"cloud cover must be in [0, 1], got {cover}")
+    sigma_px = correlation_length / (np.pi / 2.0) * (resolution - 1) / 2.0
+    u = np.linspace(-1.0, 1.0, resolution)
+    x, y = np.meshgrid(u, u)
+    disk = np.hypot(x, y) <= 1.0
+
+    def smooth_field():
+        f = gaussian_filter(rng.standard_normal((resolution, resolution)), sigma_px, mode="wrap")
+        return (f - f[disk].mean()) / f[disk].std()
+
+    field = smooth_field()
+    noise = smooth_field()
+    if cover <= 0.0:
+        cloudiness = np.zeros_like(field)
+    elif cover >= 1.0:
+        cloudiness = np.ones_like(field)
+    else:
+        threshold = np.quantile(field[disk], 1.0 - cover)
+        cloudiness = np.clip(0.5 + (field - threshold) / edge, 0.0, 1.0)
+    return CloudMap(cloudiness, noise, angle_noise_sigma, depolarization, brightness)
+
+
+@dataclass(frozen=True)
+class CloudLayer:
+    """Smooth random cloud layer: optical depth as a function of viewing direction.
+
+    Parameters
+    ----------
+    cover : float
+        Fraction of the layer covered by cloud, 0 (clear) .. 1 (overcast).
+    optical_depth : float
+        Optical depth ``tau_c`` of a cloud's core (cirrus ~1, cumulus ~20,
+        stratus ~40, nimbostratus ~100).
+    seed : int
+        Seed of the random field (the field is a pure function of it).
+    height_m : float
+        Cloud-base height.
+    scale_m : float
+        Typical cloud size (wavelength of the plane waves).
+    wind_mps : tuple of float
+        Drift of the field (east, north) in m/s; ``time_s`` in :meth:`optical_depth_at` moves it.
+    softness : float
+        Width of the cloud edge in units of the field's standard deviation.
+    resolution : float
+        Angular resolution (radians) of a line of sight; cloud detail finer than
+        its footprint on the layer is averaged (no aliasing near the horizon,
+        where distant clouds merge into a uniform cover).
+    """
+
+    cover: float = 0.0
+    optical_depth: float = 20.0
+    seed: int = 0
+    height_m: float = 1500.0
+    scale_m: float = 1500.0
+    wind_mps: tuple = (5.0, 2.0)
+    softness: float = 0.15
+    n_waves: int = 24
+    resolution: float = float(np.deg2rad(1.0))
+
+    def _waves(self):
+        r = np.random.default_rng(self.seed)
+        ang = r.uniform(0, 2 * np.pi, self.n_waves)
+        k = 2 * np.pi / (self.scale_m * r.uniform(0.5, 2.0, self.n_waves))
+        kvec = np.c_[k * np.cos(ang), k * np.sin(ang)]
+        phase = r.uniform(0, 2 * np.pi, self.n_waves)
+        amp = r.uniform(0.5, 1.0, self.n_waves)
+        return kvec, phase, amp / np.sqrt(0.5 * np.sum(amp**2))
+
+    def optical_depth_at(self, directions, *, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
+        """Cloud optical depth along each viewing direction.
+
+        Parameters
+        ----------
+        directions : array_like, shape (..., 3)
+            Unit viewing directions (east-north-up).
+        time_s : float
+            Seconds since the field's epoch (wind drift).
+        origin_m : tuple of float
+            Observer position (east, north) in metres (parallax of the layer).
+
+        Returns
+        -------
+        ndarray, shape (...)
+            0 where the line of sight misses clouds (or looks below 2 degrees).
+        """
+        d = np.asarray(directions, dtype=float)
+        if self.cover <= 0:
+            return np.zeros(d.shape[:-1])
+        if self.cover >= 1:
+            return np.full(d.shape[:-1], float(self.optical_depth))
+        dz = np.maximum(d[..., 2], np.sin(np.deg2rad(1.0)))
+        reach = self.height_m / dz
+        px = origin_m[0] + d[..., 0] * reach - self.wind_mps[0] * time_s
+        py = origin_m[1] + d[..., 1] * reach - self.wind_mps[1] * time_s
+        kvec, phase, amp = self._waves()
+        # anti-aliasing: a line of sight averages the layer over a footprint that
+        # grows with distance and obliquity; waves much smaller than it are damped
+        footprint = reach * self.resolution / dz
+        damp = np.exp(-0.5 * (np.linalg.norm(kvec, axis=1) * footprint[..., None]) ** 2)
+        a = amp * damp
+        f = np.sum(a * np.cos(px[..., None] * kvec[:, 0] + py[..., None] * kvec[:, 1] + phase), axis=-1)
+        lost = np.clip(1.0 - 0.5 * np.sum(a**2, axis=-1), 0.0, 1.0)  # variance no longer resolved
+        thr = ndtri(1.0 - self.cover)
+        # probability that the resolved field plus unresolved detail exceeds the threshold
+        density = ndtr((f - thr) / np.sqrt(self.softness**2 + lost))
+        return self.optical_depth * density

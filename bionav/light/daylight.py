@@ -1,0 +1,286 @@
+"""Spectral daylight: sun, clear sky, clouds, and the irradiance they give on the ground.
+
+A deliberately small, documented model, good enough to reproduce *why* a UV
+channel separates sky from terrestrial objects (thesis ch. 6; Möller 2002):
+
+* **Sun**: extraterrestrial spectrum of a 5778 K black body scaled to the solar
+  constant (Planck's law); direct beam attenuated by Beer-Lambert extinction
+  along the relative air mass of Kasten & Young (1989).
+* **Extinction**: Rayleigh optical depth of Hansen & Travis (1974),
+  ``0.008569 lambda^-4 (1 + 0.0113 lambda^-2 + 0.00013 lambda^-4)`` (lambda in
+  micrometres), plus aerosol of Angstrom turbidity ``beta`` and exponent
+  ``alpha`` (``beta lambda^-alpha``). Ozone and water vapour absorption are
+  ignored (their bands barely touch the five channels; the Huggins ozone band
+  starts below 340 nm).
+* **Clear sky**: single scattering in a homogeneous plane-parallel atmosphere
+  viewed from the ground (e.g. Liou 2002, *An Introduction to Atmospheric
+  Radiation*, eq. 6.3.5):
+  ``L = E0 * P_eff(gamma) / (4 pi) * m_v / (m_v - m_s) * (exp(-tau m_s) - exp(-tau m_v))``
+  with the Rayleigh phase function ``3/4 (1 + cos^2 gamma)`` and a
+  Henyey-Greenstein aerosol phase function (g = 0.7, single-scattering albedo
+  0.9), weighted by their optical depths. This gives the lambda^-4 blue/UV sky,
+  brightest near the sun and the horizon, dimming as the sun sets.
+* **Clouds**: spectrally grey scatterers. A cloud of optical depth ``tau_c`` seen
+  from below has radiance ``E_top mu_s T(tau_c) / pi`` with the two-stream
+  diffuse transmittance ``T = 1 / (1 + 0.75 (1 - g) tau_c)``, g = 0.85; broken
+  clouds add sunlit sides ``(1 - T)`` in proportion to the clear fraction;
+  ``E_top`` is the sun attenuated by the air above the cloud base (80 % of the
+  Rayleigh and 30 % of the aerosol optical depth), and the air below adds a
+  little blue path radiance. So overcast skies are grey and dim, while cloud
+  cover *flattens* the sky spectrum relative to the blue sky.
+* **Spatial clouds**: a cloud layer at height ``cloud_height_m`` carrying a
+  smooth random field (sum of random plane waves), thresholded to the requested
+  cover fraction, drifting with the wind (see :class:`CloudLayer`).
+
+Frames: directions are unit vectors in a local east-north-up frame (x east,
+y north, z up). Azimuths in this module are radians counter-clockwise from
+east (x), elevations radians above the horizon.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from bionav.geometry import direction_from_angles
+from bionav.light.bands import WAVELENGTHS_NM, band_integrate
+from bionav.light.clouds import CloudLayer
+from bionav.light.sun import BIELEFELD_LAT_DEG, BIELEFELD_LON_DEG, parse_time, sun_position
+
+_H = 6.62607015e-34
+_C = 2.99792458e8
+_KB = 1.380649e-23
+_SOLID_ANGLE_FACTOR = (6.957e8 / 1.495978707e11) ** 2  # (R_sun / AU)^2
+_HG_G_AEROSOL = 0.7
+_AEROSOL_SSA = 0.9
+_CLOUD_G = 0.85
+
+
+def solar_spectrum(wavelengths_nm=WAVELENGTHS_NM, *, temperature_k: float = 5778.0) -> np.ndarray:
+    """Extraterrestrial solar spectral irradiance, W m^-2 nm^-1, shape ``(L,)`` (black-body sun)."""
+    wl = np.asarray(wavelengths_nm, dtype=float) * 1e-9
+    radiance = 2 * _H * _C**2 / wl**5 / np.expm1(_H * _C / (wl * _KB * temperature_k))  # W m^-2 sr^-1 m^-1
+    return np.pi * radiance * _SOLID_ANGLE_FACTOR * 1e-9
+
+
+def rayleigh_optical_depth(wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
+    """Vertical Rayleigh optical depth at sea level (Hansen & Travis 1974), shape ``(L,)``."""
+    lam = np.asarray(wavelengths_nm, dtype=float) / 1000.0
+    return 0.008569 * lam**-4 * (1 + 0.0113 * lam**-2 + 0.00013 * lam**-4)
+
+
+def aerosol_optical_depth(wavelengths_nm=WAVELENGTHS_NM, *, beta: float = 0.1, alpha: float = 1.3) -> np.ndarray:
+    """Angstrom aerosol optical depth ``beta * lambda_um^-alpha``, shape ``(L,)``."""
+    lam = np.asarray(wavelengths_nm, dtype=float) / 1000.0
+    return beta * lam ** (-alpha)
+
+
+def relative_air_mass(elevation) -> np.ndarray:
+    """Kasten & Young (1989) relative optical air mass for an elevation in radians (clipped at -1 deg)."""
+    h = np.maximum(np.asarray(elevation, dtype=float), np.deg2rad(-1.0))
+    h_deg = np.rad2deg(h)
+    return 1.0 / (np.sin(h) + 0.50572 * (h_deg + 6.07995) ** -1.6364)
+
+
+@dataclass(frozen=True)
+class SkyState:
+    """Illumination conditions: sun position, aerosol, clouds.
+
+    Parameters
+    ----------
+    sun_elevation : float
+        Radians above the horizon.
+    sun_azimuth : float
+        Radians counter-clockwise from east.
+    turbidity : float
+        Angstrom ``beta`` (0.05 very clear .. 0.3 hazy).
+    angstrom_alpha : float
+        Angstrom exponent.
+    clouds : CloudLayer
+        Cloud layer (``cover = 0`` for a clear sky).
+    time_s : float
+        Time since the cloud field's epoch (drift), seconds.
+    """
+
+    sun_elevation: float
+    sun_azimuth: float = 0.0
+    turbidity: float = 0.1
+    angstrom_alpha: float = 1.3
+    clouds: CloudLayer = CloudLayer()
+    time_s: float = 0.0
+
+    @classmethod
+    def from_time(cls, time, *, latitude_deg=None, longitude_deg=None, **kwargs) -> "SkyState":
+        """Sky state with the sun where it stands at ``time`` (see :func:`bionav.light.sun.sun_position`).
+
+        ``time`` must carry its time zone; the place defaults to Bielefeld
+        (:data:`~bionav.light.sun.BIELEFELD_LAT_DEG`, :data:`~bionav.light.sun.BIELEFELD_LON_DEG`).
+        """
+        sun = sun_position(
+            parse_time(time, what="the sky's time", naive_utc=False),
+            latitude_deg=BIELEFELD_LAT_DEG if latitude_deg is None else latitude_deg,
+            longitude_deg=BIELEFELD_LON_DEG if longitude_deg is None else longitude_deg,
+        )
+        return cls(sun_elevation=sun.elevation, sun_azimuth=sun.azimuth, **kwargs)
+
+    def with_clouds(self, **changes) -> "SkyState":
+        """A copy with cloud-field parameters changed."""
+        return replace(self, clouds=replace(self.clouds, **changes))
+
+    @property
+    def sun_direction(self) -> np.ndarray:
+        """Unit vector towards the sun, shape ``(3,)``."""
+        return direction_from_angles(self.sun_azimuth, self.sun_elevation)
+
+
+def _optical_depths(state: SkyState, wl):
+    tr = rayleigh_optical_depth(wl)
+    ta = aerosol_optical_depth(wl, beta=state.turbidity, alpha=state.angstrom_alpha)
+    return tr, ta
+
+
+def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
+    """Single-scattering clear-sky spectral radiance, W m^-2 sr^-1 nm^-1.
+
+    Parameters
+    ----------
+    state : SkyState
+    directions : array_like, shape (..., 3)
+        Unit viewing directions (east-north-up); directions below the horizon
+        are treated as looking 1 degree below it (horizon haze).
+    wavelengths_nm : array_like, shape (L,)
+
+    Returns
+    -------
+    ndarray, shape (..., L)
+    """
+    wl = np.asarray(wavelengths_nm, dtype=float)
+    d = np.asarray(directions, dtype=float)
+    e0 = solar_spectrum(wl)
+    tr, ta = _optical_depths(state, wl)
+    tau = tr + ta
+    m_s = float(relative_air_mass(state.sun_elevation))
+    m_v = relative_air_mass(np.arcsin(np.clip(d[..., 2], -1, 1)))[..., None]
+    cos_g = np.clip(d @ state.sun_direction, -1, 1)[..., None]
+    p_r = 0.75 * (1 + cos_g**2)
+    g = _HG_G_AEROSOL
+    p_a = (1 - g**2) / (1 + g**2 - 2 * g * cos_g) ** 1.5
+    p_eff = (tr * p_r + _AEROSOL_SSA * ta * p_a) / tau
+    delta = m_v - m_s
+    small = np.abs(delta) < 1e-6
+    safe = np.where(small, 1.0, delta)
+    path = np.where(small, tau, -np.expm1(-tau * safe) / safe)  # (1 - exp(-tau delta)) / delta
+    if state.sun_elevation <= np.deg2rad(-1.0):
+        return np.zeros(d.shape[:-1] + wl.shape)
+    return e0 * p_eff / (4 * np.pi) * m_v * np.exp(-tau * m_s) * path
+
+
+def _cloud_transmittance(tau_c):
+    return 1.0 / (1.0 + 0.75 * (1 - _CLOUD_G) * np.asarray(tau_c, dtype=float))
+
+
+def sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.0, 0.0)) -> np.ndarray:
+    """Spectral sky radiance with clouds, W m^-2 sr^-1 nm^-1, shape ``(..., L)``.
+
+    Cloud-free lines of sight get :func:`clear_sky_radiance`; cloudy ones the
+    grey cloud radiance of the module docstring, blended by the cloud's opacity
+    ``1 - exp(-tau_c / 2)``.
+    """
+    wl = np.asarray(wavelengths_nm, dtype=float)
+    d = np.asarray(directions, dtype=float)
+    clear = clear_sky_radiance(state, d, wl)
+    if state.clouds.cover <= 0:
+        return clear
+    tau_c = state.clouds.optical_depth_at(d, time_s=state.time_s, origin_m=origin_m)[..., None]
+    opacity = -np.expm1(-0.5 * tau_c)
+    e0 = solar_spectrum(wl)
+    tr, ta = _optical_depths(state, wl)
+    mu_s = max(np.sin(state.sun_elevation), 0.0)
+    m_s = float(relative_air_mass(state.sun_elevation))
+    e_top = e0 * np.exp(-(0.8 * tr + 0.3 * ta) * m_s)
+    t_c = _cloud_transmittance(tau_c)
+    sides = (1.0 - state.clouds.cover) * (1.0 - t_c)
+    base = e_top * mu_s * (t_c + sides) / np.pi
+    below = 0.2 * clear  # the air between the observer and the cloud base
+    cloud = base * np.exp(-(0.2 * tr + 0.7 * ta) * relative_air_mass(np.arcsin(np.clip(d[..., 2], 0.02, 1)))[..., None]) + below
+    return (1 - opacity) * clear + opacity * cloud
+
+
+@dataclass(frozen=True)
+class Illumination:
+    """Irradiance spectra at the ground (W m^-2 nm^-1).
+
+    Attributes
+    ----------
+    direct_normal : ndarray, shape (L,)
+        Direct solar beam on a plane facing the sun (after cloud attenuation).
+    diffuse_horizontal : ndarray, shape (L,)
+        Sky (and cloud) irradiance on a horizontal plane.
+    sun_direction : ndarray, shape (3,)
+    """
+
+    direct_normal: np.ndarray
+    diffuse_horizontal: np.ndarray
+    sun_direction: np.ndarray
+
+    @property
+    def global_horizontal(self) -> np.ndarray:
+        """Direct plus diffuse irradiance on a horizontal plane, shape ``(L,)``."""
+        return self.direct_normal * max(self.sun_direction[2], 0.0) + self.diffuse_horizontal
+
+    def on_surface(self, normals, *, sunlit=1.0, ground_albedo: float = 0.15) -> np.ndarray:
+        """Irradiance on tilted surfaces, shape ``(..., L)``.
+
+        Parameters
+        ----------
+        normals : array_like, shape (..., 3)
+            Unit surface normals (east-north-up).
+        sunlit : float or array_like, shape (...)
+            1 in the sun, 0 in shadow (or any fraction: penumbra, foliage).
+        ground_albedo : float
+            Grey albedo of the ground that lights downward-facing surfaces.
+
+        Notes
+        -----
+        Isotropic diffuse sky and ground (view factors ``(1 +- n_z)/2``).
+        """
+        n = np.asarray(normals, dtype=float)
+        cos_i = np.clip(n @ self.sun_direction, 0, None)[..., None]
+        sky_view = (1 + n[..., 2:3]) / 2
+        lit = np.asarray(sunlit, dtype=float)[..., None]
+        return (lit * cos_i * self.direct_normal + sky_view * self.diffuse_horizontal
+                + (1 - sky_view) * ground_albedo * self.global_horizontal)
+
+
+def illumination(state: SkyState, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.0, 0.0),
+                 n_elevation: int = 8, n_azimuth: int = 24) -> Illumination:
+    """Direct and diffuse irradiance at the ground under a sky state.
+
+    The diffuse part integrates :func:`sky_radiance` over the upper hemisphere
+    (midpoint rule, ``n_elevation x n_azimuth`` cells, cosine weighted), so it
+    is consistent with what a sensor pointed at the sky sees. The direct beam is
+    attenuated by the cloud optical depth in the sun's direction.
+    """
+    wl = np.asarray(wavelengths_nm, dtype=float)
+    if state.sun_elevation <= np.deg2rad(-1.0):
+        z = np.zeros_like(wl)
+        return Illumination(z, z, state.sun_direction)
+    el = (np.arange(n_elevation) + 0.5) * (np.pi / 2) / n_elevation
+    az = (np.arange(n_azimuth) + 0.5) * 2 * np.pi / n_azimuth
+    ee, aa = np.meshgrid(el, az, indexing="ij")
+    dirs = direction_from_angles(aa, ee)
+    rad = sky_radiance(state, dirs, wl, origin_m=origin_m)
+    d_omega = np.cos(ee) * (np.pi / 2 / n_elevation) * (2 * np.pi / n_azimuth)
+    weight = (np.sin(ee) * d_omega)[..., None]
+    diffuse = np.sum(rad * weight, axis=(0, 1))
+    tr, ta = _optical_depths(state, wl)
+    m_s = float(relative_air_mass(state.sun_elevation))
+    tau_sun = float(state.clouds.optical_depth_at(state.sun_direction, time_s=state.time_s, origin_m=origin_m))
+    direct = solar_spectrum(wl) * np.exp(-(tr + ta) * m_s - tau_sun * m_s)
+    return Illumination(direct, diffuse, state.sun_direction)
+
+
+def band_sky_radiance(state: SkyState, directions, *, origin_m=(0.0, 0.0)) -> np.ndarray:
+    """Sky radiance integrated over the five channels, shape ``(..., 5)``."""
+    return band_integrate(sky_radiance(state, directions, WAVELENGTHS_NM, origin_m=origin_m))

@@ -1,0 +1,172 @@
+"""Material reflectances: the one home of bionav's material tables.
+
+* :data:`MATERIALS`: five-band reflectance spectra with sample-to-sample
+  variability of natural and artificial materials (thesis chapter 6 sample
+  sets and spectral scenes).
+* :data:`BAND_ALBEDO`: the coarse per-band albedos of the *rendered* outdoor
+  worlds (``sim_uni``), including a ``grey`` channel (see the end of this
+  module). They are kept as they are because every rendered stand-in
+  database's pixels depend on them.
+
+Spectral reflectances
+---------------------
+
+Values are diffuse (Lambertian) reflectance factors at the five channels
+(UV 350, B 440, G 500, R 680, IR 800 nm), read off typical spectra of the USGS
+Spectral Library (splib07) and the ECOSTRESS library for 440-800 nm: green
+vegetation with the chlorophyll trough at 680 nm and the red edge to a high
+near-infrared plateau; soils, sand and rock rising monotonically with
+wavelength; paints and plastics with their pigment colour in the visible.
+
+**UV assumption** (no package or library ships 350 nm reflectances for these
+materials): natural materials reflect little UV-A. Green leaves 2-4 % (epidermal
+flavonoids absorb UV-A; field measurements of leaves give 3-6 % at 350 nm), dead
+plant material 4-5 %, and soils/rocks/sand about 0.55-0.6 of their 440 nm value
+(continuing the monotone decrease of their spectra below 400 nm). Paints and
+plastics are assumed to absorb UV-A strongly (titanium-dioxide white pigment
+absorbs below about 380 nm, binders and UV stabilisers absorb too): 4-8 %
+whatever their visible colour. Bare (galvanised) metal is the exception, a
+grey reflector also in the UV. Glossy surfaces (lacquer, plastic) add a
+specular reflection of the sky of a few per cent (Fresnel reflectance of a
+clear coat, ~4 % at normal incidence).
+
+Per-sample variability: each sample multiplies the base spectrum by a
+log-normal brightness factor (``brightness_sd``, natural log) and each band by
+a log-normal jitter (``band_sd``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Material:
+    """A material's five-band reflectance and its variability.
+
+    Attributes
+    ----------
+    name : str
+    category : str
+        ``"natural"`` or ``"artificial"``.
+    reflectance : tuple of float
+        Diffuse reflectance at UV, B, G, R, IR.
+    gloss : tuple of float
+        Range ``(low, high)`` of the specular (sky-mirroring) reflectance.
+    brightness_sd, band_sd : float
+        Log-normal sample-to-sample variation of the whole spectrum and of each band.
+    """
+
+    name: str
+    category: str
+    reflectance: tuple
+    gloss: tuple = (0.0, 0.0)
+    brightness_sd: float = 0.25
+    band_sd: float = 0.08
+
+    def sample(self, rng: np.random.Generator, n: int = 1) -> np.ndarray:
+        """``n`` random reflectance spectra of this material, shape ``(n, 5)``, clipped to [0.005, 0.98]."""
+        base = np.asarray(self.reflectance, dtype=float)
+        bright = np.exp(rng.normal(0.0, self.brightness_sd, (n, 1)))
+        jitter = np.exp(rng.normal(0.0, self.band_sd, (n, base.size)))
+        return np.clip(base * bright * jitter, 0.005, 0.98)
+
+
+def _m(name, cat, refl, **kw):
+    return Material(name, cat, tuple(float(v) for v in refl), **kw)
+
+
+#: Every material bionav knows, keyed by name. Natural kinds follow thesis 6.2.1's
+#: sample list, artificial kinds 6.3.1's (plastic, lacquered metal, painted surfaces).
+MATERIALS: dict[str, Material] = {
+    m.name: m
+    for m in (
+        # natural: vegetation (low UV, chlorophyll trough at R, high IR)
+        _m("grass", "natural", (0.030, 0.050, 0.090, 0.050, 0.450)),
+        _m("shrub", "natural", (0.028, 0.042, 0.075, 0.042, 0.380)),
+        _m("tree", "natural", (0.025, 0.038, 0.070, 0.040, 0.400)),
+        _m("conifer", "natural", (0.020, 0.030, 0.050, 0.030, 0.250)),
+        _m("dead_leaves", "natural", (0.040, 0.070, 0.100, 0.250, 0.400)),
+        _m("dead_wood", "natural", (0.050, 0.090, 0.120, 0.230, 0.300)),
+        # natural: minerals and ground
+        _m("tar", "natural", (0.045, 0.060, 0.065, 0.075, 0.085), band_sd=0.05),
+        _m("rock", "natural", (0.120, 0.200, 0.230, 0.280, 0.300)),
+        _m("gravel", "natural", (0.095, 0.160, 0.190, 0.240, 0.270)),
+        _m("sand", "natural", (0.120, 0.200, 0.260, 0.380, 0.430)),
+        _m("soil", "natural", (0.040, 0.070, 0.090, 0.150, 0.190)),
+        # artificial: paints (UV-absorbing pigments and binders)
+        _m("paint_white", "artificial", (0.080, 0.800, 0.850, 0.870, 0.870), gloss=(0.0, 0.02), brightness_sd=0.1),
+        _m("paint_red", "artificial", (0.050, 0.060, 0.070, 0.550, 0.700), gloss=(0.0, 0.02)),
+        _m("paint_green", "artificial", (0.050, 0.100, 0.250, 0.060, 0.500), gloss=(0.0, 0.02)),
+        _m("paint_blue", "artificial", (0.060, 0.400, 0.250, 0.050, 0.450), gloss=(0.0, 0.02)),
+        _m("paint_yellow", "artificial", (0.050, 0.100, 0.550, 0.750, 0.780), gloss=(0.0, 0.02)),
+        _m("paint_grey", "artificial", (0.060, 0.300, 0.300, 0.300, 0.310), gloss=(0.0, 0.02)),
+        _m("paint_black", "artificial", (0.040, 0.040, 0.040, 0.040, 0.050), gloss=(0.0, 0.02), brightness_sd=0.1),
+        # artificial: plastics (UV stabilisers) and lacquered metal (clear coat: specular sky)
+        _m("plastic_white", "artificial", (0.060, 0.700, 0.750, 0.780, 0.800), gloss=(0.02, 0.06), brightness_sd=0.1),
+        _m("plastic_red", "artificial", (0.050, 0.070, 0.080, 0.500, 0.650), gloss=(0.02, 0.06)),
+        _m("plastic_blue", "artificial", (0.055, 0.350, 0.200, 0.050, 0.400), gloss=(0.02, 0.06)),
+        _m("plastic_green", "artificial", (0.050, 0.080, 0.220, 0.060, 0.350), gloss=(0.02, 0.06)),
+        _m("plastic_black", "artificial", (0.040, 0.040, 0.040, 0.045, 0.050), gloss=(0.02, 0.06), brightness_sd=0.1),
+        _m("lacquered_metal", "artificial", (0.050, 0.200, 0.220, 0.300, 0.350), gloss=(0.03, 0.10), brightness_sd=0.5),
+        _m("metal_bare", "artificial", (0.450, 0.520, 0.540, 0.560, 0.570), gloss=(0.05, 0.15), brightness_sd=0.15),
+        # building materials (for scenes, not in the sample sets)
+        _m("brick", "artificial", (0.050, 0.080, 0.100, 0.300, 0.380)),
+        _m("roof_tile", "artificial", (0.040, 0.060, 0.070, 0.220, 0.300)),
+        _m("concrete", "artificial", (0.150, 0.250, 0.280, 0.320, 0.340)),
+        _m("wood_painted", "artificial", (0.060, 0.350, 0.380, 0.420, 0.450), gloss=(0.0, 0.02)),
+        _m("glass", "artificial", (0.020, 0.050, 0.050, 0.050, 0.050), gloss=(0.06, 0.12)),
+    )
+}
+
+#: Natural sample kinds and their share in ``sim_natural`` (thesis 6.2.1 list).
+NATURAL_MIX: dict[str, float] = {
+    "grass": 0.20, "shrub": 0.14, "tree": 0.18, "conifer": 0.06, "dead_leaves": 0.08,
+    "dead_wood": 0.08, "tar": 0.05, "rock": 0.06, "gravel": 0.05, "sand": 0.04, "soil": 0.06,
+}
+
+#: Artificial sample kinds and their share in ``sim_artificial`` (thesis 6.3.1).
+ARTIFICIAL_MIX: dict[str, float] = {
+    "paint_white": 0.08, "paint_red": 0.07, "paint_green": 0.07, "paint_blue": 0.07,
+    "paint_yellow": 0.06, "paint_grey": 0.07, "paint_black": 0.05, "plastic_white": 0.07,
+    "plastic_red": 0.06, "plastic_blue": 0.06, "plastic_green": 0.05, "plastic_black": 0.05,
+    "lacquered_metal": 0.20, "metal_bare": 0.04,
+}
+
+
+def band_reflectance_table() -> tuple[list[str], np.ndarray]:
+    """Names and base reflectances ``(M, 5)`` of every material (documentation and plots)."""
+    names = list(MATERIALS)
+    return names, np.array([MATERIALS[n].reflectance for n in names])
+
+
+#: Relative reflectance of material kinds, per band. Rough textbook shapes
+#: (vegetation: red edge and low UV; concrete/stone: flat and slightly rising;
+#: glass: low; sky-facing metal: flat). Assumption: UV reflectance of most
+#: terrestrial materials is low (0.03-0.1), which is what makes UV a good sky
+#: separator in the thesis.
+BAND_ALBEDO: dict[str, dict[str, float]] = {
+    "grey": {"concrete": 0.45, "brick": 0.3, "glass": 0.15, "foliage": 0.3, "bark": 0.25, "grass": 0.3,
+             "paving": 0.4, "asphalt": 0.15, "metal": 0.5, "paint": 0.6, "wood": 0.35, "soil": 0.2},
+    "UV": {"concrete": 0.08, "brick": 0.05, "glass": 0.06, "foliage": 0.03, "bark": 0.04, "grass": 0.03,
+           "paving": 0.07, "asphalt": 0.04, "metal": 0.2, "paint": 0.1, "wood": 0.04, "soil": 0.04},
+    "B": {"concrete": 0.25, "brick": 0.12, "glass": 0.1, "foliage": 0.05, "bark": 0.08, "grass": 0.05,
+          "paving": 0.22, "asphalt": 0.08, "metal": 0.4, "paint": 0.5, "wood": 0.12, "soil": 0.08},
+    "G": {"concrete": 0.3, "brick": 0.18, "glass": 0.12, "foliage": 0.14, "bark": 0.12, "grass": 0.15,
+          "paving": 0.27, "asphalt": 0.09, "metal": 0.45, "paint": 0.55, "wood": 0.2, "soil": 0.12},
+    "R": {"concrete": 0.36, "brick": 0.38, "glass": 0.12, "foliage": 0.06, "bark": 0.2, "grass": 0.07,
+          "paving": 0.32, "asphalt": 0.1, "metal": 0.45, "paint": 0.6, "wood": 0.35, "soil": 0.2},
+    "IR": {"concrete": 0.42, "brick": 0.45, "glass": 0.12, "foliage": 0.5, "bark": 0.35, "grass": 0.45,
+           "paving": 0.38, "asphalt": 0.12, "metal": 0.45, "paint": 0.6, "wood": 0.45, "soil": 0.28},
+}
+
+
+def band_albedos(channels: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Albedo per material kind as arrays of shape ``(C,)`` for the given band names."""
+    unknown = [c for c in channels if c not in BAND_ALBEDO]
+    if unknown:
+        raise ValueError(f"no default albedos for bands {unknown}; pass albedos explicitly")
+    kinds = BAND_ALBEDO["grey"].keys()
+    return {k: np.array([BAND_ALBEDO[c][k] for c in channels]) for k in kinds}
