@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from bionav.geometry import wrap_angle
+from bionav.light import SkyModel, SunPosition
 from bionav.polcompass.array import (
     PolArray,
     counts_from_stokes,
@@ -20,7 +21,6 @@ from bionav.polcompass.decoders import (
     sun_from_sol,
     sun_from_two_units,
 )
-from bionav.light import SkyModel, SunPosition
 
 
 def test_thesis_array_recovers_angle_and_degree_exactly():

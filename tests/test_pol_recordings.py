@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from helpers import run_bionav
 
+from bionav.light import SkyModel, sun_position
 from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
 from bionav.polcompass.recordings import RecordingError, detect_faults, load_rotation, load_sessions
-from bionav.light import SkyModel, sun_position
 
 REPO = Path(__file__).resolve().parents[1]
 EXTERNAL = Path(os.environ.get("BIONAV_EXTERNAL_DATA", REPO.parent / "shared" / "data"))

@@ -99,7 +99,9 @@ class RecordingsConfig:
             try:
                 self.exclude_units = [int(u) for u in ex]
             except (TypeError, ValueError):
-                raise UserError(f"recordings.exclude_units={ex!r}: give auto, none or a list of unit numbers such as [5,7].") from None
+                raise UserError(
+                    f"recordings.exclude_units={ex!r}: give auto, none or a list of unit numbers such as [5,7]."
+                ) from None
 
 
 @dataclass
@@ -218,9 +220,9 @@ class SessionData:
 
 def prepare_session(session, rc: RecordingsConfig) -> SessionData:
     """Counts, validity, e-vectors and the sun position of one session."""
+    from bionav.light import sun_position
     from bionav.polcompass.array import evectors_from_counts
     from bionav.polcompass.recordings import detect_faults, sample_validity
-    from bionav.light import sun_position
 
     rots = session.rotations
     counts = np.concatenate([r.counts for r in rots])
@@ -268,8 +270,8 @@ def simulate_session(data: SessionData, exp: PolRecordingsConfig, rng) -> Sessio
     gain spread, proportional noise and the same saturation; canopy sessions
     get a cloud field of ``sim_canopy_cover``.
     """
-    from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
     from bionav.light import SkyModel, random_cloud_map
+    from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
 
     clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
     model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
@@ -295,6 +297,12 @@ def simulate_session(data: SessionData, exp: PolRecordingsConfig, rng) -> Sessio
 # ---------------------------------------------------------------------------
 # files
 # ---------------------------------------------------------------------------
+def _cell(value):
+    if value is None:
+        return ""
+    return f"{value:.4g}" if isinstance(value, float) else value
+
+
 def _write_csv(path: Path, rows: list[dict]) -> None:
     if not rows:
         path.write_text("")
@@ -306,7 +314,7 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         for r in rows:
-            w.writerow({k: ("" if r.get(k) is None else (f"{r[k]:.4g}" if isinstance(r.get(k), float) else r.get(k))) for k in keys})
+            w.writerow({k: _cell(r.get(k)) for k in keys})
 
 
 def _fmt(v, digits=1):
@@ -363,7 +371,9 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             "(e.g. recordings.path=../shared/data/celestial-compass)."
         )
     if cfg.get("decoder") is None or not cfg.decoder.get("name"):
-        raise UserError("experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them).")
+        raise UserError(
+            "experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them)."
+        )
     chosen = str(cfg.decoder.name)
     names = [chosen] + [str(n) for n in exp.compare if str(n) != chosen]
     decoders = {n: _decoder(ctx, cfg, n) for n in names}

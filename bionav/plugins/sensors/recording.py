@@ -56,7 +56,9 @@ class RecordingConfig:
         if self.azimuth_sign not in (-1.0, 1.0):
             raise UserError(f"sensor.azimuth_sign={self.azimuth_sign} must be -1 (clockwise) or 1 (counter-clockwise).")
         if self.saturation_counts <= 0 or self.dark_counts < 0 or not 0 < self.imbalance_decades <= 3:
-            raise UserError("sensor.saturation_counts must be > 0, sensor.dark_counts >= 0 and sensor.imbalance_decades in (0, 3].")
+            raise UserError(
+                "sensor.saturation_counts must be > 0, sensor.dark_counts >= 0 and sensor.imbalance_decades in (0, 3]."
+            )
 
 
 class Recording(SensorPlugin):
