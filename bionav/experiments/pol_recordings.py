@@ -394,7 +394,12 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     n_rotations = 0
     decode_times = []
     for session in ctx.progress(sessions, desc="sessions", total=len(sessions)):
-        data = prepare_session(session, rc)
+        try:
+            data = prepare_session(session, rc)
+        except UserError as exc:  # e.g. a folder name without the recording time: skip that session, keep the rest
+            bad_files.append((Path(session.name), str(exc)))
+            log.warning("%s", exc)
+            continue
         n_rotations += len(session.rotations)
         for f in data.faults:
             row = {"session": session.name, **f.to_dict()}
@@ -450,6 +455,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             session_rows.append(row)
             ctx.log.write(SESSION_TOPIC, row, schema_name="bionav.PolRecordingSession")
 
+    if not session_rows:
+        raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
     pooled_rows = []
     for name in names:
         for g in GROUPS:
@@ -479,7 +486,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "heading_rmse_deg": stats["rmse_deg"],
         "n_samples": stats["n_samples"],
         "n_rotations": int(n_rotations),
-        "n_sessions": len(sessions),
+        "n_sessions": len({r["session"] for r in session_rows}),
         "ambiguity_resolved_fraction": float(np.mean(np.concatenate(chosen_res))),
         "decode_ms_per_session_max": float(1000.0 * max(decode_times)),
         "n_bad_files": len(bad_files),
@@ -496,7 +503,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         listed = " ".join(m for _p, m in bad_files[:3])
         more = f" ({len(bad_files) - 3} more, see the log)" if len(bad_files) > 3 else ""
         raise UserError(
-            f"{len(bad_files)} recording file(s) are unusable; the other {n_rotations} rotations were scored and "
+            f"{len(bad_files)} recording file(s) or session(s) are unusable; the other {n_rotations} rotations were scored and "
             f"sessions.csv is written. {listed}{more} Set recordings.on_bad_file=skip to only warn."
         )
     return metrics
