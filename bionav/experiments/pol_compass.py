@@ -41,6 +41,7 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
+from bionav.experiments.configs import experiment_config
 from bionav.experiments.pol_compass_session import (
     SESSION_SCHEMA,
     SESSION_TOPIC,
@@ -136,7 +137,7 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir):
     elif how == "rotation":
         cal = calibrate_from_rotation(volts, pans, nominal=nominal)
     elif how == "file":
-        if not exp.get("calibration_path"):
+        if not exp.calibration_path:
             raise UserError("experiment.calibration=file needs experiment.calibration_path=<calibration.json of a rotation run>.")
         cal = UnitCalibration.load(exp.calibration_path)
     else:
@@ -148,7 +149,7 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir):
 
 def _pan_grid(session: Session, exp, step_deg: float):
     lo, hi, tlo, thi = session.pantilt.limits()
-    rng = exp.get("pan_range_deg")
+    rng = exp.pan_range_deg
     if rng is not None:
         lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
     step = np.deg2rad(step_deg)
@@ -234,7 +235,7 @@ def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) 
     from bionav.polcompass import counts_to_volts, heading_errors, zenith_heading
 
     lo, hi, tlo, thi = session.pantilt.limits()
-    rng = exp.get("pan_range_deg")
+    rng = exp.pan_range_deg
     if rng is not None:
         lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
     positions = np.linspace(lo, hi, int(exp.vs_em.positions))
@@ -429,6 +430,8 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
         Where figures and tables go (``None``: none written).
     progress : callable, optional
     """
+    if not (isinstance(exp, DictConfig) and OmegaConf.get_type(exp) is not dict):  # defaults and ranges
+        exp = experiment_config(OmegaConf.create({"experiment": exp}), "pol_compass")
     mode = str(exp.mode)
     if mode not in MODES:
         raise UserError(f"mode {mode!r} is unknown; choose one of {', '.join(MODES)} (mode=<name>).")
@@ -516,7 +519,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     """Entry point called by :func:`bionav.experiments.runner.run_experiment`."""
     from bionav.polcompass import CompassScene
 
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "pol_compass")
     if cfg.get("sensor") is None or not cfg.sensor.get("name"):
         raise UserError("experiment=pol_compass needs a compass: sensor=polcompass_sim, polcompass_serial or replay.")
     nodes = {
@@ -533,7 +536,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
 
     classes = {role: registry.load_plugin("sensor", node["name"]) for role, node in nodes.items() if node is not None}
     simulated = any(getattr(c, "simulated", False) for c in classes.values())
-    fake_devices = bool(exp.get("fake_devices", False))
+    fake_devices = bool(exp.fake_devices)
     needs_scene = simulated or fake_devices or str(exp.mode) == "partial_sky"
     scene = None
     if needs_scene:
