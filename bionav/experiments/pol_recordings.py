@@ -432,6 +432,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "n_rotations": int(n_rotations),
         "n_sessions": len({r["session"] for r in session_rows}),
         "ambiguity_resolved_fraction": float(np.mean(np.concatenate(chosen_res))),
+        "decode_ms_per_session_median": float(1000.0 * np.median(decode_times)),
         "decode_ms_per_session_max": float(1000.0 * max(decode_times)),
         "n_bad_files": len(bad_files),
     }
