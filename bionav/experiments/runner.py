@@ -47,7 +47,8 @@ def plugin_versions(cfg: DictConfig) -> dict[str, str]:
     from bionav import registry
 
     out = {"bionav": __version__}
-    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller", "decoder": "decoder"}
+    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller"}
+    kinds["decoder"] = "decoder"
     for group, kind in kinds.items():
         node = cfg.get(group)
         if not node or not node.get("name"):
