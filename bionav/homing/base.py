@@ -65,7 +65,9 @@ class HomingMethod:
     uses_test_steps: ClassVar[bool] = False
 
     def __init__(self, config: Any, *, geometry: PanoramaGeometry) -> None:
-        self.config = config
+        from bionav.validation import check_config
+
+        self.config = check_config(config, prefix="homing")
         self.geometry = geometry
 
     def prepare(self, image: np.ndarray) -> Any:
