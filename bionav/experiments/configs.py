@@ -425,6 +425,94 @@ class PolRecordingsConfig:
     record_samples: bool = True
 
 
+@dataclass
+class LayoutConfig:
+    """``layout=<name>`` of ``experiment=cleaning`` (``bionav/conf/layout/*.yaml``: thesis fig. 7.2).
+
+    n_lanes, lane_length, spacing : the meander's lanes (m); unit_width : cleaning width (m).
+    turn : side of the next lane seen from the first lane. wall_offset : first lane's distance from the
+    wall on its right (m). start, start_heading_deg : ``[x, y]`` in the world (m) and heading; None:
+    placed along a wall automatically.
+    """
+
+    name: str = "long_lanes"
+    n_lanes: int = bounded(7, ge=1, le=1000)
+    lane_length: float = bounded(4.0, gt=0.0, le=1000.0)
+    spacing: float = bounded(0.30, gt=0.0, le=100.0)
+    unit_width: float = bounded(0.30, gt=0.0, le=100.0)
+    turn: str = bounded("left", choices=("left", "right"))
+    wall_offset: float = bounded(0.25, ge=0.0, le=100.0)
+    start: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-1e4, le=1e4))
+    start_heading_deg: Optional[float] = bounded(None, ge=-360.0, le=360.0)
+
+
+@dataclass
+class DataConfig:
+    """``data=<name>`` of ``experiment=contrast_lda``: simulated labelled samples or a CSV file."""
+
+    name: str = bounded("sim_natural", choices=("sim_natural", "sim_artificial", "csv"))
+    path: Optional[str] = None
+    seed: int = bounded(0, ge=0, le=2**32 - 1)
+    n_objects: Optional[int] = bounded(None, ge=2, le=1_000_000)
+    n_sky: int = bounded(233, ge=2, le=1_000_000)
+    noise_counts: float = bounded(4.0, ge=0.0, le=1e6)
+    n_average: int = bounded(10, ge=1, le=100_000)
+
+
+#: other option groups with a typed schema: group -> dataclass (checked by :func:`check_group_nodes`)
+GROUP_CONFIGS: dict[str, type] = {"layout": LayoutConfig, "data": DataConfig}
+
+
+def typed_node(node: Any, schema: type, *, prefix: str, what: str) -> DictConfig:
+    """``node`` merged onto ``schema``: unknown keys and wrong types named, every value range-checked.
+
+    Parameters
+    ----------
+    node : DictConfig or Mapping
+        The (resolved) config node.
+    schema : type
+        Its dataclass.
+    prefix : str
+        The key users type for the node (``layout``).
+    what : str
+        Said in messages (``layout=short_lanes``).
+    """
+    from omegaconf.errors import OmegaConfBaseException
+
+    from bionav.config import unknown_key_message
+    from bionav.errors import UserError
+
+    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
+    try:
+        typed = OmegaConf.merge(OmegaConf.structured(schema), plain)
+        instance = OmegaConf.to_object(typed)
+    except OmegaConfBaseException as exc:
+        key = str(getattr(exc, "full_key", "") or "")
+        if type(exc).__name__ in ("ConfigKeyError", "ConfigAttributeError") and key:
+            parent, bad = key.rsplit(".", 1) if "." in key else ("", key)
+            where = OmegaConf.select(OmegaConf.structured(schema), parent) if parent else OmegaConf.structured(schema)
+            valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
+            full_parent = f"{prefix}.{parent}" if parent else prefix
+            raise UserError(unknown_key_message(full_parent, bad, valid, what=what)) from None
+        if type(exc).__name__ == "MissingMandatoryValue" and key:
+            raise UserError(f"{prefix}.{key} has no value ({what} needs it); add {prefix}.{key}=<value> "
+                            "on the command line.") from None
+        raise UserError(
+            f"bad value for {prefix}.{key or '<key>'} ({what}): {str(exc).splitlines()[0]}. "
+            f"Give it a value of the declared type (see {schema.__name__} in bionav/experiments/configs.py)."
+        ) from None
+    check_config(instance, prefix=prefix)
+    return typed
+
+
+def check_group_nodes(cfg: DictConfig) -> None:
+    """Check the ``layout`` and ``data`` nodes (when present) against :data:`GROUP_CONFIGS`."""
+    for group, schema in GROUP_CONFIGS.items():
+        node = cfg.get(group) if isinstance(cfg, DictConfig) else None
+        if node is not None:
+            typed_node(node, schema, prefix=group, what=f"{group}={node.get('name', '?')}")
+
+
 # --------------------------------------------------------------------------- top-level run settings
 @dataclass
 class RunSettings:
@@ -526,6 +614,9 @@ def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
                 else OmegaConf.structured(schema)
             valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
             raise UserError(unknown_key_message(parent, bad, valid, what=f"experiment={name}")) from None
+        if kind == "MissingMandatoryValue" and key:
+            raise UserError(f"{key} has no value (experiment={name} needs it); add {key}=<value> "
+                            "on the command line.") from None
         raise UserError(
             f"bad value for {key or 'experiment'} (experiment={name}): {str(exc).splitlines()[0]}. "
             f"Give it a value of the declared type (see {schema.__name__} in bionav/experiments/configs.py)."
