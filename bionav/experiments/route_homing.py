@@ -51,9 +51,9 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
-from bionav.experiments.configs import ROUTE_METHODS as METHODS
 from bionav.experiments.configs import RouteHomingConfig, experiment_config
 from bionav.geometry import angular_difference, wrap_angle
+
 PATH_TOPIC = "/route_homing/agent_path"
 PATH_SCHEMA = {
     "type": "object",
