@@ -38,6 +38,7 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
+from bionav.experiments.configs import experiment_config
 from bionav.robot.controller import LanePlan
 from bionav.robot.kinematics import Pose
 
@@ -115,7 +116,7 @@ def rendered_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
     from bionav.robot.floorplan import floorplan_from_scene
     from bionav.robot.worldview import load_world, place_plan, render_camera
 
-    ex = cfg.experiment
+    ex = experiment_config(cfg, "cleaning")
     world = load_world(str(ex.world), seed=int(ex.world_seed))
     cam = ex.camera
     geometry = PanoramaGeometry.square_pixels(
@@ -183,7 +184,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
     from bionav.robot.recording import RESULT_TOPIC, EpisodeRecorder
     from bionav.robot.simulator import SimulatedRobot, run_episode
 
-    ex = cfg.experiment
+    ex = experiment_config(cfg, "cleaning")
     runs = int(ex.runs)
     if runs < 1:
         raise UserError(f"runs must be at least 1, got {runs}; set runs=10 as in the thesis.")
@@ -291,7 +292,7 @@ def make_oracle_homing(cfg: DictConfig):
     """The oracle homing method of ``experiment.oracle`` (noisy home vectors from true geometry)."""
     from bionav.robot.oracle import GeometricHoming, GeometricHomingConfig
 
-    node = cfg.experiment.oracle
+    node = experiment_config(cfg, "cleaning").oracle
     return GeometricHoming(GeometricHomingConfig(angle_noise_deg=float(node.angle_noise_deg),
                                                  compass_noise_deg=float(node.compass_noise_deg),
                                                  seed=int(cfg.seed)))
@@ -299,7 +300,7 @@ def make_oracle_homing(cfg: DictConfig):
 
 def make_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
     """The :class:`CleaningWorld` that ``cfg.experiment.vision`` asks for."""
-    vision = str(cfg.experiment.vision)
+    vision = str(experiment_config(cfg, "cleaning").vision)
     if vision not in ("render", "oracle"):
         raise UserError(f"experiment.vision must be 'render' or 'oracle', got {vision!r}.")
     return rendered_world(cfg, plan) if vision == "render" else oracle_world(plan)
@@ -307,7 +308,7 @@ def make_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
 
 def make_vision_homing(cfg: DictConfig, world: CleaningWorld):
     """The homing method of a run: ``cfg.homing`` on rendered images, or the oracle."""
-    if str(cfg.experiment.vision) == "oracle":
+    if str(experiment_config(cfg, "cleaning").vision) == "oracle":
         return make_oracle_homing(cfg)
     from bionav.config import plugin_config
 
@@ -363,7 +364,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.robot.coverage import Raster, coverage_fractions, sweep_counts
     from bionav.robot.lanes import ideal_meander
 
-    ex = cfg.experiment
+    ex = experiment_config(cfg, "cleaning")
     if cfg.get("layout") is None:
         raise UserError("experiment=cleaning needs a layout; choose layout=long_lanes or layout=short_lanes.")
     if cfg.get("controller") is None or not cfg.controller.get("name"):
