@@ -174,14 +174,24 @@ def _module(cmd: Command) -> str:
 def _expand_sweeps(args: list[str]) -> list[list[str]]:
     """One override list per combination of the sweep values (the jobs of ``-m``)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.core.override_parser.types import IntervalSweep
 
+    args = list(args)
+    for flag in ("--cfg", "-c", "--package", "-p"):  # `--cfg job`: composing is what is checked anyway
+        while flag in args:
+            i = args.index(flag)
+            del args[i:i + 2]
     opts = [a for a in args if a.startswith("-")]
     overrides = OverridesParser.create().parse_overrides([a for a in args if not a.startswith("-")])
     choices = []
     for o in overrides:
         if o.is_sweep_override():
             prefix = o.get_key_element()
-            choices.append([f"{prefix}={v}" for v in o.sweep_string_iterator()])
+            value = o.value()
+            if isinstance(value, IntervalSweep):  # an optimiser's search interval (Optuna): compose both bounds
+                choices.append([f"{prefix}={value.start}", f"{prefix}={value.end}"])
+            else:
+                choices.append([f"{prefix}={v}" for v in o.sweep_string_iterator()])
         else:
             choices.append([o.input_line])
     return [[*[x for x in opts if x not in ("-m", "--multirun")], *combo] for combo in itertools.product(*choices)]
