@@ -148,7 +148,8 @@ def test_check_config_names_key_value_and_range(field, value, needle):
 
 
 #: string options that are free text (paths, ports, names resolved elsewhere, times)
-FREE_TEXT = {"port", "path", "topic", "signature", "time", "name", "calibration_path", "world", "grid"}
+FREE_TEXT = {"port", "path", "topic", "signature", "time", "name", "calibration_path", "world", "grid", "route",
+             "routes_path"}
 
 
 def _all_config_classes():
