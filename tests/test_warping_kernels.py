@@ -249,3 +249,21 @@ def test_quantised_search_agrees_with_float_on_random_panoramas(seed, options):
         ip = int(np.flatnonzero(p_cols == round(q.psi * w / (2 * np.pi)) % w)[0])
         quantum, _ = distance_quantum(w)
         assert table[ip, ia] <= table.min() + 2 * w * (0.5 + 0.02 * quantum) / quantum
+
+
+@pytest.mark.parametrize("step", [1, 3])
+def test_single_hypothesis_scores_equal_the_reference(step):
+    # the fine search's kernel: any (alpha, psi) in columns, also off the alpha grid
+    from bionav.homing.warping.kernels import minwarp_scores_at
+    from bionav.homing.warping.search import _window_minima
+
+    snap, cur = _pair(41)
+    tau = default_thresholds(SCALES)
+    windows = minwarp_windows(minwarp_template(W, SCALES, tau))
+    levels = _window_minima(snap, cur, step, windows, False).copy()
+    rng = np.random.default_rng(2)
+    a_cols, p_cols = rng.integers(0, W, 12), rng.integers(0, W, 12)
+    fast = minwarp_scores_at(levels, a_cols, p_cols, *windows)
+    for t in range(12):
+        ref = minwarping_scores_reference(snap, cur, a_cols=[a_cols[t]], p_cols=[p_cols[t]], thresholds=tau)
+        assert fast[t] == pytest.approx(ref[0, 0], rel=1e-5)
