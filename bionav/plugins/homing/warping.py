@@ -164,9 +164,9 @@ class MinWarping(_PlaneWarping):
         n_alpha, n_psi: search steps over 360 degrees for movement direction and rotation.
         scales: scale factors of the planes; null = 2 ** ((k - 4) / 4), k = 0..8.
         thresholds: upper scale thresholds per plane; null = by threshold_rule.
-        threshold_rule: thresholds when none are given: geometric (geometric means of
-            neighbouring scales, no largest ratio) or reference (arithmetic means, largest
-            scale ratio max_scale_ratio, as the SIMD reference implementation WarpingSIMD).
+        threshold_rule: thresholds when none are given: reference (default: arithmetic means
+            of neighbouring scales and a largest scale ratio max_scale_ratio, as WarpingSIMD and
+            the thesis' table 5.2) or geometric (geometric means, no largest ratio).
         max_scale_ratio: largest allowed scale ratio of the reference rule.
         compass_acceleration: search only compass_fraction of the rotations, those the
             visual compass measure ranks best.
@@ -185,7 +185,7 @@ class MinWarping(_PlaneWarping):
         n_psi: int = 96
         scales: list[float] | None = None
         thresholds: list[float] | None = None
-        threshold_rule: str = "geometric"
+        threshold_rule: str = "reference"
         max_scale_ratio: float = 2.5
         compass_acceleration: bool = False
         compass_fraction: float = 0.25
