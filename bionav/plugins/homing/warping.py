@@ -174,7 +174,7 @@ class MinWarping(_PlaneWarping):
         fine_search: refine alpha and psi at one-column resolution.
         double_search: also search with snapshot and current view exchanged.
         quantised: 8-bit column distances summed in 16 bits, as the SIMD reference
-            implementation (fast); false searches float32 distances (about 2x slower,
+            implementation (fast); false searches float32 distances (about 3x slower,
             home directions agree within one search step).
         """
 
