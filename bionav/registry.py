@@ -10,7 +10,7 @@ registered through the same entry points as third-party plugins.
   (:func:`load_plugin`) or when all of a kind are listed (:func:`plugins_of`).
 * A plugin that fails to import is a warning when listing and an error naming
   its distribution only when it is selected.
-* Two distributions claiming one name in one group is an error naming both.
+* Two distributions claiming one name in one group make that name (only) an error naming both.
 * Lookup accepts a registry name or the plugin class itself.
 """
 
@@ -31,6 +31,7 @@ GROUPS: dict[str, str] = {
     "signature": "bionav.signatures",
     "sensor": "bionav.sensors",
     "controller": "bionav.controllers",
+    "decoder": "bionav.decoders",
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"
@@ -116,33 +117,49 @@ def _all_entry_points() -> dict[str, tuple[importlib_metadata.EntryPoint, ...]]:
 def clear_cache() -> None:
     """Forget cached entry points and loaded plugins (after installing a plugin at run time)."""
     _all_entry_points.cache_clear()
+    _scan.cache_clear()
     entry_points_of.cache_clear()
     _load_entry.cache_clear()
+
+
+@functools.cache
+def _scan(kind: str) -> tuple[dict[str, PluginEntry], dict[str, str]]:
+    group = _check_kind(kind)
+    found: dict[str, PluginEntry] = {}
+    claims: dict[str, list[PluginEntry]] = {}
+    for ep in _all_entry_points()[group]:
+        dist, version = _distribution_of(ep)
+        entry = PluginEntry(kind, ep.name, ep.value, dist, version)
+        same = [c for c in claims.get(ep.name, []) if (c.distribution, c.value) == (dist, ep.value)]
+        if not same:  # one distribution seen twice on sys.path is one claim
+            claims.setdefault(ep.name, []).append(entry)
+        found.setdefault(ep.name, entry)
+    conflicts = {}
+    for name, entries in claims.items():
+        if len(entries) > 1:
+            listed = " and ".join(e.describe() for e in entries)
+            conflicts[name] = (
+                f"{len(entries)} installed distributions register the {kind} plugin {name!r}: {listed}. "
+                f"Uninstall one of them (e.g. pip uninstall {entries[-1].distribution}) or rename its entry "
+                f"point in group {group!r}; the other {kind} plugins are not affected."
+            )
+    return found, conflicts
 
 
 @functools.cache
 def entry_points_of(kind: str) -> dict[str, PluginEntry]:
     """Registered plugins of one kind, keyed by name, without importing them.
 
-    Raises
-    ------
-    PluginError
-        When two different distributions declare the same name.
+    A name that two distributions claim is listed (with the first claim) but
+    cannot be loaded: :func:`load_plugin` raises the message of
+    :func:`conflicts_of`; every other name stays usable.
     """
-    group = _check_kind(kind)
-    found: dict[str, PluginEntry] = {}
-    for ep in _all_entry_points()[group]:
-        dist, version = _distribution_of(ep)
-        entry = PluginEntry(kind, ep.name, ep.value, dist, version)
-        previous = found.get(ep.name)
-        if previous is not None and (previous.distribution, previous.value) != (dist, ep.value):
-            raise PluginError(
-                f"two installed distributions register the {kind} plugin {ep.name!r}: "
-                f"{previous.describe()} and {entry.describe()}. Uninstall one of them "
-                f"(pip uninstall {entry.distribution}) or rename its entry point in group {group!r}."
-            )
-        found[ep.name] = entry
-    return found
+    return dict(_scan(kind)[0])
+
+
+def conflicts_of(kind: str) -> dict[str, str]:
+    """Names of one kind claimed by several distributions -> a message naming them and the fix."""
+    return dict(_scan(kind)[1])
 
 
 @functools.cache
@@ -177,7 +194,9 @@ def plugins_of(kind: str, *, warn: bool = True) -> dict[str, LoadedPlugin]:
     warn : bool
         Emit a :class:`PluginWarning` for each plugin that failed to load.
     """
-    loaded = {name: _load_entry(entry) for name, entry in entry_points_of(kind).items()}
+    conflicts = conflicts_of(kind)
+    loaded = {name: (LoadedPlugin(entry, None, conflicts[name]) if name in conflicts else _load_entry(entry))
+              for name, entry in entry_points_of(kind).items()}
     if warn:
         for plugin in loaded.values():
             if plugin.error:
@@ -213,6 +232,9 @@ def load_plugin(kind: str, name_or_class: str | type) -> type:
             f"there is no {kind} plugin named {name!r}. Available: {available}. "
             f"Install the package that provides it, or pick one of these."
         )
+    conflict = conflicts_of(kind).get(name)
+    if conflict:
+        raise PluginError(conflict)
     plugin = _load_entry(entries[name])
     if plugin.cls is None:
         raise PluginError(

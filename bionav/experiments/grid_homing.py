@@ -18,6 +18,7 @@ from bionav.evaluation.agent import run_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
+from bionav.experiments.configs import experiment_config
 
 HOME_VECTOR_SCHEMA = {
     "type": "object",
@@ -29,6 +30,21 @@ HOME_VECTOR_SCHEMA = {
         "success": {"type": "array", "description": "agent reached the snapshot"},
     },
 }
+
+HOME_VECTOR_ROW_SCHEMA = {
+    "type": "object",
+    "description": "one snapshot's home vectors, logged as soon as computed (currents: every cell in database order)",
+    "properties": {
+        "snapshot": {"type": "array", "items": {"type": "integer"}, "description": "snapshot cell (x, y)"},
+        "angles": {"type": "array", "description": "home directions, radians CCW in the grid frame (null: none)"},
+        "ae": {"type": "array", "description": "angular errors, radians (null: none)"},
+        "compass_error": {"type": "array", "description": "estimated minus true rotation, radians (null: none)"},
+    },
+}
+
+
+def _finite_or_none(values) -> list[float | None]:
+    return [float(a) if np.isfinite(a) else None for a in np.asarray(values, dtype=float)]
 
 
 def evaluate_agents(db, hv, *, step_length: float, success_radius: float, record: set[int] = frozenset()):
@@ -58,13 +74,32 @@ def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.homing_plots import plot_home_vector_field, plot_per_snapshot_maps
 
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "grid_homing")
     db = load_configured_database(cfg)
     method = make_homing(cfg, ctx, db.geometry)
-    snapshots = None if exp.get("snapshots") is None else list(exp.snapshots)
+    snapshots = None if exp.snapshots is None else list(exp.snapshots)
+    if snapshots is not None and max(snapshots) >= len(db):
+        from bionav.errors import UserError
+
+        raise UserError(
+            f"bad value experiment.snapshots={snapshots}: database {db.name!r} has {len(db)} images, so the "
+            f"snapshot indices must be 0..{len(db) - 1}; drop the larger ones (null = every image)."
+        )
+
+    def log_row(si: int, angles: np.ndarray, compass: np.ndarray) -> None:
+        """Each snapshot's home vectors as soon as they are computed (a crash loses no finished row)."""
+        ae_row = angular_errors(angles[None], ideal_home_angles(db.positions[[si]], db.positions))[0]
+        ctx.log.write(
+            "/grid_homing/snapshot_rows",
+            {"snapshot": db.positions[si], "angles": _finite_or_none(angles), "ae": _finite_or_none(ae_row),
+             "compass_error": _finite_or_none(compass)},
+            schema_name="bionav.HomeVectorRow",
+            schema=HOME_VECTOR_ROW_SCHEMA,
+        )
+
     hv = home_vector_matrix(
         method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
-        cache=prepared_cache(cfg),
+        cache=prepared_cache(cfg), on_row=log_row,
     )
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
@@ -81,8 +116,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             {
                 "snapshot": db.positions[si],
                 "currents": db.positions,
-                "angles": [None if not np.isfinite(a) else float(a) for a in hv.angles[row]],
-                "ae": [None if not np.isfinite(a) else float(a) for a in ae[row]],
+                "angles": _finite_or_none(hv.angles[row]),
+                "ae": _finite_or_none(ae[row]),
                 "success": success[row],
             },
             schema_name="bionav.HomeVectorField",
@@ -119,6 +154,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "n_pairs": hv.n_pairs,
         "ms_per_home_vector": hv.ms_per_home_vector,
     }
+    metrics.update({f"{k}_per_image": v for k, v in hv.prepared_stats.items()})
     if hv.compass_error is not None:
         metrics["compass_aae"] = float(np.nanmean(np.abs(hv.compass_error)))
     return metrics
