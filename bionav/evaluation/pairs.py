@@ -88,6 +88,7 @@ def home_vector_matrix(
     progress: Progress = _no_progress,
     prepared: tuple[list[Any], list[Any]] | None = None,
     cache: Any = None,
+    on_row: Callable[[int, np.ndarray, np.ndarray], None] | None = None,
 ) -> HomeVectorMatrix:
     """Home vectors from every current view to every (selected) snapshot.
 
@@ -110,6 +111,12 @@ def home_vector_matrix(
         Already prepared snapshot and current images (skips the per-image work).
     cache : PreparedCache, optional
         On-disk cache of per-image work.
+    on_row : callable, optional
+        ``on_row(snapshot, angles, compass)`` is called (in the caller's
+        thread, in order) as soon as a snapshot's row is finished:
+        ``snapshot`` is its index into ``snapshots``, ``angles`` and
+        ``compass`` have shape (C,), radians in the grid frame (NaN: none).
+        Experiments log rows here, so a crash loses no finished row.
 
     Returns
     -------
@@ -160,7 +167,11 @@ def home_vector_matrix(
         return wrap_angle(angles), wrap_angle(compass)
 
     with ThreadPoolExecutor(max(1, workers)) as pool:
-        rows = list(progress(pool.map(row, s_idx), desc="home vectors", total=len(s_idx)))
+        rows = []
+        for si, r in zip(s_idx, progress(pool.map(row, s_idx), desc="home vectors", total=len(s_idx))):
+            rows.append(r)
+            if on_row is not None:
+                on_row(int(si), r[0], r[1])
     t2 = time.perf_counter()
 
     angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))
