@@ -27,7 +27,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import registry
 
 #: config groups users select plugins in
-PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller")
+PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
 
 
 def config_dirs() -> list[tuple[str, Path]]:
@@ -56,8 +56,18 @@ class BionavSearchPathPlugin(SearchPathPlugin):
     """Adds every ``bionav.configs`` folder to Hydra's config search path."""
 
     def manipulate_search_path(self, search_path: ConfigSearchPath) -> None:
-        for name, folder in config_dirs():
-            search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
+        dirs = config_dirs()
+        own = dict(dirs).get("bionav")
+        for element in search_path.get_path():
+            # ``python -m bionav`` (config_path=None) searches the package itself, where an installed
+            # ``bionav/conf`` would show up as a second set of groups named ``conf/...`` in --help and
+            # completion: search bionav's own config folder there instead, and only there.
+            if element.provider == "main" and own is not None and element.path != f"file://{own}":
+                element.path = f"file://{own}"
+        present = {element.path for element in search_path.get_path()}
+        for name, folder in dirs:
+            if f"file://{folder}" not in present:
+                search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
 
 
 def plugin_node_class(name: str, config_cls: type) -> type:
@@ -99,6 +109,12 @@ def register_configs() -> dict[str, list[str]]:
 
     # every experiment preset is merged onto its typed schema (experiment_schema/<name>)
     register_experiment_configs(store)
+    try:  # hydra/launcher=submitit_slurm records cancelled/killed jobs as failed (bionav/launcher.py)
+        from bionav.launcher import register as register_launcher
+    except ImportError:  # the slurm extra is not installed
+        pass
+    else:
+        register_launcher()
     names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
     for kind in registry.GROUPS:
         with warnings.catch_warnings():

@@ -31,6 +31,7 @@ GROUPS: dict[str, str] = {
     "signature": "bionav.signatures",
     "sensor": "bionav.sensors",
     "controller": "bionav.controllers",
+    "decoder": "bionav.decoders",
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
@@ -41,6 +41,8 @@ class HomeVectorMatrix:
         Wall time of the per-image work and of the pair computations.
     n_pairs : int
         Number of home vectors computed.
+    prepared_stats : dict
+        :meth:`HomingMethod.describe_prepared` averaged over the current views.
     """
 
     snapshot_index: np.ndarray
@@ -49,6 +51,7 @@ class HomeVectorMatrix:
     prepare_s: float
     pairs_s: float
     n_pairs: int
+    prepared_stats: dict = field(default_factory=dict)
 
     @property
     def ms_per_home_vector(self) -> float:
@@ -85,6 +88,7 @@ def home_vector_matrix(
     progress: Progress = _no_progress,
     prepared: tuple[list[Any], list[Any]] | None = None,
     cache: Any = None,
+    on_row: Callable[[int, np.ndarray, np.ndarray], None] | None = None,
 ) -> HomeVectorMatrix:
     """Home vectors from every current view to every (selected) snapshot.
 
@@ -107,6 +111,12 @@ def home_vector_matrix(
         Already prepared snapshot and current images (skips the per-image work).
     cache : PreparedCache, optional
         On-disk cache of per-image work.
+    on_row : callable, optional
+        ``on_row(snapshot, angles, compass)`` is called (in the caller's
+        thread, in order) as soon as a snapshot's row is finished:
+        ``snapshot`` is its index into ``snapshots``, ``angles`` and
+        ``compass`` have shape (C,), radians in the grid frame (NaN: none).
+        Experiments log rows here, so a crash loses no finished row.
 
     Returns
     -------
@@ -157,13 +167,19 @@ def home_vector_matrix(
         return wrap_angle(angles), wrap_angle(compass)
 
     with ThreadPoolExecutor(max(1, workers)) as pool:
-        rows = list(progress(pool.map(row, s_idx), desc="home vectors", total=len(s_idx)))
+        rows = []
+        for si, r in zip(s_idx, progress(pool.map(row, s_idx), desc="home vectors", total=len(s_idx))):
+            rows.append(r)
+            if on_row is not None:
+                on_row(int(si), r[0], r[1])
     t2 = time.perf_counter()
 
     angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))
     compass = np.array([r[1] for r in rows]).reshape(len(s_idx), len(currents))
     n_pairs = int(np.sum(~np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)))
     has_compass = bool(np.any(np.isfinite(compass)))
+    described = [method.describe_prepared(p) for p in cur_prep]
+    stats = {k: float(np.mean([d[k] for d in described])) for k in (described[0] if described else {})}
     return HomeVectorMatrix(
         snapshot_index=s_idx,
         angles=angles,
@@ -171,4 +187,5 @@ def home_vector_matrix(
         prepare_s=t1 - t0,
         pairs_s=t2 - t1,
         n_pairs=n_pairs,
+        prepared_stats=stats,
     )

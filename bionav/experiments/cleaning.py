@@ -42,8 +42,8 @@ from bionav.experiments.configs import experiment_config
 from bionav.robot.controller import LanePlan
 from bionav.robot.kinematics import Pose
 
-#: seconds between the log times of consecutive runs' first ticks (runs are laid end to end)
-RUN_SPACING_NS = 100_000 * 1_000_000_000
+#: log time between one run's last tick and the next run's first (runs are laid end to end after the log's start)
+RUN_GAP_NS = 1_000_000_000
 
 
 @dataclass
@@ -197,6 +197,8 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
     errors = wheel_errors(runs, float(ex.wheel_error))
     seeds = ctx.rng.integers(0, 2**31 - 1, size=(runs, 3))
     results = []
+    # log times: the log's wall-clock start plus simulated time (Foxglove shows real dates, not 1970)
+    offset_ns = int(getattr(ctx.log, "start_ns", None) or time.time_ns())
     for k in ctx.progress(range(runs), desc="cleaning runs", total=runs):
         controller = make_controller()
         controller_seed, camera_seed, sim_seed = (int(s) for s in seeds[k])
@@ -212,7 +214,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
             radius=float(ex.robot_radius), confine=confine, camera=camera, rng=sim_rng)
         controller.reset(plan, homing=homing if controller.uses_camera else None,
                          rng=np.random.default_rng(controller_seed))
-        recorder = EpisodeRecorder(ctx.log, k, time_offset_ns=k * RUN_SPACING_NS, log_images=bool(ex.log_images))
+        recorder = EpisodeRecorder(ctx.log, k, time_offset_ns=offset_ns, log_images=bool(ex.log_images))
         recorder.start({
             "controller": str(cfg.controller.name),
             "controller_config": asdict(controller.config),
@@ -243,6 +245,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
                                      "fixes": len(fixes), "accepted_fixes": len(accepted), "seconds": seconds},
                       schema_name="bionav.CleaningResult", log_time_ns=recorder.last_time_ns)
         results.append(RunResult(k, errors[k], episode, counts, fractions, fixes, truth, seconds))
+        offset_ns = recorder.last_time_ns + RUN_GAP_NS
     return results
 
 

@@ -468,6 +468,13 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
         schema=SESSION_SCHEMA,
     )
     session.record_pantilt_info()
+    if devices.get("decoder") is not None:  # recorded POL-OP array counts (sensor=recording, or its replay)
+        from bionav.experiments.pol_compass_recorded import recorded_rotation_mode
+
+        if mode != "rotation":
+            raise UserError(f"recorded array counts support mode=rotation only, not mode={mode}.")
+        return recorded_rotation_mode(session, exp, sensor_config=devices["array_config"], decoder=devices["decoder"],
+                                      plots=plots)
     unit_angles = np.deg2rad(np.asarray(list(exp.unit_angles_deg), float))
     if scene is not None and mode != "partial_sky":
         from bionav.light import PolarizerLamp
@@ -492,6 +499,22 @@ def _node_dict(node) -> dict | None:
     return OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
 
 
+def _recorded_array(node: dict) -> bool:
+    """Whether the sensor plays recorded POL-OP array counts (``sensor=recording`` or a replay of such a run)."""
+    if node.get("name") == "recording":
+        return True
+    if node.get("name") == "replay":
+        from bionav.experiments.pol_compass_recorded import is_array_reading
+        from bionav.plugins.sensors.replay import read_topics
+
+        try:
+            first = read_topics(node.get("path", "run.mcap")).get(node.get("topic") or "/sensor/raw", [None])[0]
+        except UserError:
+            return False  # the replay plugin reports the missing log itself
+        return is_array_reading(first)
+    return False
+
+
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     """Entry point called by :func:`bionav.experiments.runner.run_experiment`."""
     from bionav.polcompass import CompassScene
@@ -506,6 +529,10 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     }
     rng_scene, rng_sensor, rng_reference, rng_fakes = ctx.rng.spawn(4)
     from bionav import registry
+
+    recorded_array = _recorded_array(nodes["sensor"])
+    if recorded_array:
+        nodes["pantilt"] = None  # the recorded robot turned itself; its yaw is the reference
 
     classes = {role: registry.load_plugin("sensor", node["name"]) for role, node in nodes.items() if node is not None}
     simulated = any(getattr(c, "simulated", False) for c in classes.values())
@@ -537,6 +564,13 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             plugin.open()
             stack.callback(plugin.close)
             devices[role] = plugin
+        if recorded_array:
+            from bionav.plugins.sensors.recording import RecordingConfig
+
+            cfg_dec = cfg.get("decoder")
+            node = cfg_dec if cfg_dec is not None and cfg_dec.get("name") else {"name": "sky_fit"}
+            devices["decoder"] = ctx.plugin("decoder", node)
+            devices["array_config"] = devices["sensor"].config if nodes["sensor"]["name"] == "recording" else RecordingConfig()
         metrics = run_session(
             exp,
             devices,

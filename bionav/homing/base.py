@@ -86,6 +86,14 @@ class HomingMethod:
         """
         return image
 
+    def describe_prepared(self, prepared: Any) -> Mapping[str, float]:
+        """Numbers describing one prepared image (e.g. ``{"keypoints": 413.0}``).
+
+        Experiments average them over a database's images and report them as
+        ``<name>_per_image`` metrics. The default describes nothing.
+        """
+        return {}
+
     def home_vector(
         self,
         snapshot: Any,

@@ -77,6 +77,11 @@ class SiftHoming(HomingMethod):
             sigma=c.sigma,
         )
 
+    def describe_prepared(self, prepared) -> dict[str, float]:
+        """``keypoints``: the number of SIFT keypoints of the image (thesis tables B.1-B.4, "Keys")."""
+        xy = prepared["xy"] if isinstance(prepared, dict) else prepared.xy
+        return {"keypoints": float(len(xy))}
+
     def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
         from bionav.homing.sift_homing import sift_home_vector
 

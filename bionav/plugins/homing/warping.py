@@ -18,6 +18,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
 from bionav.homing.imageops import check_image_size
+from bionav.homing.warping.scaleplanes import THRESHOLD_RULES
 from bionav.validation import Range, bounded
 
 
@@ -71,17 +72,24 @@ class _PlaneWarping(HomingMethod):
         self._template_width = None
 
     def _scales(self):
-        from bionav.homing.warping.scaleplanes import check_scales, default_scales
+        from bionav.homing.warping.scaleplanes import check_scales, default_scales, reference_thresholds
 
         cfg = self.config
         scales = default_scales() if cfg.scales is None else [float(x) for x in cfg.scales]
         thresholds = None if cfg.thresholds is None else [float(x) for x in cfg.thresholds]
+        if thresholds is None and getattr(cfg, "threshold_rule", "geometric") == "reference":
+            thresholds = reference_thresholds(scales, max_ratio=cfg.max_scale_ratio)
         return check_scales(scales, thresholds)
 
     def _check(self) -> None:
         cfg = self.config
         name = self.name
         _check_common(name, cfg)
+        rule = getattr(cfg, "threshold_rule", "geometric")
+        if rule not in THRESHOLD_RULES:
+            raise UserError(
+                f"homing.threshold_rule={rule!r} is not one of {', '.join(THRESHOLD_RULES)}"
+            )
         try:
             self._scales()
         except ValueError as exc:
@@ -155,12 +163,19 @@ class MinWarping(_PlaneWarping):
         butterworth_order: order of that filter.
         n_alpha, n_psi: search steps over 360 degrees for movement direction and rotation.
         scales: scale factors of the planes; null = 2 ** ((k - 4) / 4), k = 0..8.
-        thresholds: upper scale thresholds per plane; null = geometric midpoints.
+        thresholds: upper scale thresholds per plane; null = by threshold_rule.
+        threshold_rule: thresholds when none are given: geometric (geometric means of
+            neighbouring scales, no largest ratio) or reference (arithmetic means, largest
+            scale ratio max_scale_ratio, as the SIMD reference implementation WarpingSIMD).
+        max_scale_ratio: largest allowed scale ratio of the reference rule.
         compass_acceleration: search only compass_fraction of the rotations, those the
             visual compass measure ranks best.
         compass_fraction: fraction of rotations searched with compass acceleration.
         fine_search: refine alpha and psi at one-column resolution.
         double_search: also search with snapshot and current view exchanged.
+        quantised: 8-bit column distances summed in 16 bits, as the SIMD reference
+            implementation (fast); false searches float32 distances (about 2x slower,
+            home directions agree within one search step).
         """
 
         image_size: list[int] | None = bounded([288, 50], length=2, item=Range(ge=8, le=8192))
@@ -170,10 +185,13 @@ class MinWarping(_PlaneWarping):
         n_psi: int = bounded(96, ge=4, le=4096)
         scales: list[float] | None = bounded(None, gt=0.0, le=100.0)
         thresholds: list[float] | None = bounded(None, gt=0.0, le=100.0)
+        threshold_rule: str = bounded("geometric", choices=THRESHOLD_RULES)
+        max_scale_ratio: float = bounded(2.5, gt=1.0, le=100.0)
         compass_acceleration: bool = False
         compass_fraction: float = bounded(0.25, gt=0.0, le=1.0)
         fine_search: bool = False
         double_search: bool = False
+        quantised: bool = True
 
     def _check(self) -> None:
         super()._check()
@@ -211,6 +229,7 @@ class MinWarping(_PlaneWarping):
             double_search=cfg.double_search,
             template=template,
             windows=windows,
+            quantised=cfg.quantised,
         )
         return self._to_home_vector(result)
 

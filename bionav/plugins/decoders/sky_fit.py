@@ -1,0 +1,88 @@
+"""``decoder=sky_fit`` (default) and ``decoder=two_unit``: bionav's own decoders."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bionav.plugins.decoders.base import Decoder
+from bionav.polcompass.decoders import sky_table, sun_from_sky_fit, sun_from_two_units
+from bionav.validation import bounded
+
+
+@dataclass
+class SkyFitConfig:
+    """Parameters of ``decoder=sky_fit``.
+
+    residual : ``perpendicular`` (every e-vector perpendicular to the sun, elevation from time and
+        place) or ``angle`` (the tabulated model e-vector angles of any sky model).
+    n_grid : solar azimuths tried, then refined by a parabola.
+    weight_power : unit weight = measured degree ** weight_power.
+    robust_iterations, robust_scale_deg : Cauchy re-weighting rounds and their residual scale.
+    margin : normalised error gap for a resolved eq. 4.6 pair (else the brighter side decides).
+    max_degree, neutral_point_separation_deg : the sky model of ``residual=angle`` (0: Rayleigh).
+    """
+
+    residual: str = bounded("perpendicular", choices=("perpendicular", "angle"))
+    n_grid: int = bounded(720, ge=36, le=7200)
+    weight_power: float = bounded(1.0, ge=0.0, le=4.0)
+    robust_iterations: int = bounded(2, ge=0, le=10)
+    robust_scale_deg: float = bounded(10.0, gt=0.0, le=90.0)
+    margin: float = bounded(0.01, ge=0.0, le=1.0)
+    max_degree: float = bounded(0.76, gt=0.0, le=1.0)
+    neutral_point_separation_deg: float = bounded(0.0, ge=0.0, le=60.0)
+
+
+class SkyFit(Decoder):
+    """Least squares over all units against the sky model's e-vector pattern (bionav's default)."""
+
+    Config = SkyFitConfig
+    needs_sun_elevation = True
+
+    def __init__(self, config: SkyFitConfig) -> None:
+        super().__init__(config)
+        self._tables: dict = {}
+
+    def table(self, array, sun_elevation: float):
+        key = (id(array), round(float(sun_elevation), 6))
+        if key not in self._tables:
+            self._tables[key] = sky_table(
+                array,
+                sun_elevation,
+                n_grid=self.config.n_grid,
+                max_degree=self.config.max_degree,
+                neutral_point_separation=np.deg2rad(self.config.neutral_point_separation_deg),
+            )
+        return self._tables[key]
+
+    def decode(self, evectors, valid, *, array, sun_elevation: float):
+        return sun_from_sky_fit(
+            evectors,
+            valid,
+            table=self.table(array, sun_elevation),
+            array=array,
+            sun_elevation=float(sun_elevation),
+            residual=self.config.residual,
+            weight_power=self.config.weight_power,
+            robust_iterations=self.config.robust_iterations,
+            robust_scale=np.deg2rad(self.config.robust_scale_deg),
+            margin=self.config.margin,
+        )
+
+
+@dataclass
+class TwoUnitConfig:
+    """Parameters of ``decoder=two_unit``: elevation-error gap (degrees) for a resolved eq. 4.6 pair."""
+
+    margin_deg: float = bounded(2.0, ge=0.0, le=90.0)
+
+
+class TwoUnit(Decoder):
+    """The thesis' two-unit solution (eqs. 4.4-4.6) generalised to tilted units."""
+
+    Config = TwoUnitConfig
+    needs_sun_elevation = True
+
+    def decode(self, evectors, valid, *, array, sun_elevation: float):
+        return sun_from_two_units(evectors, valid, sun_elevation=sun_elevation, margin=np.deg2rad(self.config.margin_deg))
