@@ -38,7 +38,7 @@ class DatabaseConfig:
     """
 
     name: str = "sim_original"
-    source: str = bounded("synthetic", choices=("synthetic", "folder"))
+    source: str = bounded("synthetic", choices=("synthetic", "folder", "mesh", "route"))
     path: Optional[str] = None  # folder databases: the directory
     image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=2, le=MAX_IMAGE_SIDE))  # [W, H]; None: native
     seed: int = bounded(0, ge=0, le=2**32 - 1)  # synthetic worlds: which world of this kind
@@ -59,11 +59,14 @@ class DatabaseConfig:
     extra: dict[str, Any] = field(default_factory=dict)
     # mesh worlds (source: mesh | route; see bionav/db/mesh.py and docs/worlds.md)
     world: Optional[str] = None  # a packaged world (seville2009) when no path is given
-    origin_m: Optional[list[float]] = None  # world (x, y) in metres of grid cell (0, 0); None = centred
-    camera_height_m: float = 0.01  # camera height over the local terrain, metres
-    ground: str = "auto"  # plane | mesh | auto (.mat: plane at z = 0, .obj/.ply: the mesh)
-    channels: str = "grey"  # grey | spectral (UV B G R IR)
-    clearance_m: Optional[float] = None  # a cell is missing if a triangle lies this close above it; None = any
+    # world (x, y) in metres of grid cell (0, 0); None = centred
+    origin_m: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-1e7, le=1e7))
+    camera_height_m: float = bounded(0.01, gt=0.0, le=1000.0)  # camera height over the local terrain, metres
+    # plane | mesh | auto (.mat: plane at z = 0, .obj/.ply: the mesh)
+    ground: str = bounded("auto", choices=("auto", "plane", "mesh"))
+    channels: str = bounded("grey", choices=("grey", "spectral"))  # spectral: UV B G R IR
+    # a cell is missing if a triangle lies this close above it; None = any
+    clearance_m: Optional[float] = bounded(None, ge=0.0, le=1000.0)
     route: Optional[str] = None  # route databases: Ant<a>_Route<r>
     routes_path: Optional[str] = None  # .mat of routes; None = the packaged Seville routes
-    step_m: float = 0.1  # route databases: distance between views along the route, metres
+    step_m: float = bounded(0.1, gt=0.0, le=100.0)  # route databases: distance between views along the route, metres
