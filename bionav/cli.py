@@ -302,9 +302,12 @@ def main(argv: list[str] | None = None) -> None:
         from bionav.config import register_configs
 
         names = register_configs()
-        if not any(a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv):
+        completion = any(a in ("-sc", "--shell-completion") for a in argv)  # `query=...` is not an override
+        if not completion and not any(
+            a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
+        ):
             _precheck(argv, names)
-        if not any(a in ("--help", "-h", "--hydra-help") or a.startswith("--info") for a in argv):
+        if not completion and not any(a in ("--help", "-h", "--hydra-help") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
     except UserError as exc:
         _fail(str(exc))
