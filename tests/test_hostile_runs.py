@@ -215,8 +215,8 @@ def test_ctrl_c_during_a_sweep_writes_the_summary(tmp_path, render_cache):
 
     with open(sweep / "summary.csv") as f:
         rows = {r["job"]: r for r in csv.DictReader(f)}
-    assert rows["0"]["status"] == "completed" and float(rows["0"]["aae"]) > 0
-    assert rows["1"]["status"] == "failed" and "KeyboardInterrupt" in rows["1"]["error"]
+    assert rows["0"]["status"] == "completed" and float(rows["0"]["aae"]) > 0, (rows, err)
+    assert rows["1"]["status"] == "failed" and "KeyboardInterrupt" in rows["1"]["error"], (rows, err)
     assert "2 runs, 1 failed" in (sweep / "summary.md").read_text()
 
 
