@@ -19,6 +19,8 @@ from bionav.errors import UserError
 
 EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
+#: a run directory with less free space is refused before Hydra writes its files there
+MIN_FREE_BYTES = 2**20
 
 log = logging.getLogger("bionav")
 
@@ -182,6 +184,15 @@ def _check_writable(path: Path, *, sweep: bool = False) -> None:
             pass
     except OSError as exc:
         raise UserError(f"cannot write the output directory {path}: {exc.strerror or exc}. {fix}") from None
+    free = os.statvfs(path)
+    if free.f_bavail * free.f_frsize < MIN_FREE_BYTES:
+        from bionav.experiments.runner import mount_point
+
+        raise UserError(
+            f"no space left on {mount_point(path)} (only {free.f_bavail * free.f_frsize // 1024} kB free, a run "
+            f"needs at least {MIN_FREE_BYTES // 2**20} MB for its config, log and metrics); free space or choose "
+            f"hydra.run.dir=... on another disk."
+        )
     check_free(path)
     if sweep:
         for job in sorted(p.parent for p in path.glob("*/.bionav.lock")):
@@ -305,9 +316,12 @@ def main(argv: list[str] | None = None) -> None:
 
         names = register_configs()
         output_dirs: list[tuple[Path, bool]] = []
-        if not any(a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv):
+        completion = any(a in ("-sc", "--shell-completion") for a in argv)  # `query=...` is not an override
+        if not completion and not any(
+            a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
+        ):
             output_dirs = _precheck(argv, names)
-        if not any(a in ("--help", "-h", "--hydra-help") or a.startswith("--info") for a in argv):
+        if not completion and not any(a in ("--help", "-h", "--hydra-help") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
         # only after every value passed: a refused run leaves no directory behind
         for path, sweep in output_dirs:
