@@ -33,14 +33,15 @@ def _fail(message: str, code: int = EXIT_USER_ERROR) -> None:
     sys.exit(code)
 
 
-def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
-    """Catch unknown plugin names and unwritable output dirs before Hydra starts."""
+def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, bool]]:
+    """Catch unknown plugin names before Hydra starts; return the output dirs given (path, is_sweep)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
     try:
         overrides = OverridesParser.create().parse_overrides([a for a in argv if not a.startswith("-")])
     except Exception:
-        return  # Hydra reports syntax errors itself
+        return []  # Hydra reports syntax errors itself
+    dirs: list[tuple[Path, bool]] = []
     groups = {g: list(v) for g, v in names.items()}
     for group in YAML_GROUPS:
         if _yaml_options(group):  # only groups that exist; otherwise `key=value` is a plain value
@@ -60,7 +61,8 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
                         f"Run `python -m bionav.plugins` to see every installed plugin."
                     )
         if key in ("hydra.run.dir", "hydra.sweep.dir"):
-            _check_writable(Path(str(override.value())), sweep=key == "hydra.sweep.dir")
+            dirs.append((Path(str(override.value())), key == "hydra.sweep.dir"))
+    return dirs
 
 
 def _concrete_overrides(argv: list[str]) -> list[str] | None:
@@ -313,13 +315,17 @@ def main(argv: list[str] | None = None) -> None:
         from bionav.config import register_configs
 
         names = register_configs()
+        output_dirs: list[tuple[Path, bool]] = []
         completion = any(a in ("-sc", "--shell-completion") for a in argv)  # `query=...` is not an override
         if not completion and not any(
             a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
         ):
-            _precheck(argv, names)
+            output_dirs = _precheck(argv, names)
         if not completion and not any(a in ("--help", "-h", "--hydra-help") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
+        # only after every value passed: a refused run leaves no directory behind
+        for path, sweep in output_dirs:
+            _check_writable(path, sweep=sweep)
     except UserError as exc:
         _fail(str(exc))
 

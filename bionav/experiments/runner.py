@@ -47,7 +47,8 @@ def plugin_versions(cfg: DictConfig) -> dict[str, str]:
     from bionav import registry
 
     out = {"bionav": __version__}
-    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller", "decoder": "decoder"}
+    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller"}
+    kinds["decoder"] = "decoder"
     for group, kind in kinds.items():
         node = cfg.get(group)
         if not node or not node.get("name"):
@@ -95,9 +96,10 @@ def validate_run_config(cfg: DictConfig) -> None:
     """
     from bionav.config import plugin_config
     from bionav.db.loading import as_database_config
-    from bionav.experiments.configs import check_run_settings, experiment_config
+    from bionav.experiments.configs import check_group_nodes, check_run_settings, experiment_config
 
     check_run_settings(cfg)
+    check_group_nodes(cfg)
     for group, kind in PLUGIN_NODES.items():
         node = cfg.get(group)
         if node and node.get("name"):

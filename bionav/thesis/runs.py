@@ -183,9 +183,16 @@ def sweep_jobs(sweep_dir: Path) -> list[tuple[Path, dict | None]]:
 
 
 def _sweep_metrics(sweep_dir: Path) -> dict:
+    """A multirun is complete when Hydra finished it (``summary.csv`` written) and every job completed."""
     jobs = sweep_jobs(sweep_dir)
     done = sum(1 for _, m in jobs if m and m.get("status") == "completed")
-    return {"status": "completed" if jobs and done == len(jobs) else "failed", "n_jobs": len(jobs), "n_completed": done}
+    finished = (Path(sweep_dir) / "summary.csv").is_file()
+    ok = finished and jobs and done == len(jobs)
+    out = {"status": "completed" if ok else "failed", "n_jobs": len(jobs), "n_completed": done}
+    if not ok:
+        out["error"] = (f"{done} of {len(jobs)} jobs completed" if finished else
+                        f"the multirun did not finish ({done} jobs completed; see its log)")
+    return out
 
 
 def _move_aside(path: Path) -> None:
@@ -339,6 +346,12 @@ class Runner:
             if self.dry_run:
                 self.echo(f"python {cmd}")
                 results[spec.key] = RunResult(spec, None, None, "dry run")
+                continue
+            done = index_runs(self.out / "runs" / spec.group).get(spec.key)  # finished meanwhile by another invocation
+            if done is not None:
+                metrics = _sweep_metrics(done) if spec.multirun else read_json(done / "metrics.json")
+                results[spec.key] = RunResult(spec, done, metrics, reused=True)
+                self.echo(f"[{i}/{len(todo)}] completed meanwhile: {done}")
                 continue
             self.echo(f"[{i}/{len(todo)}] python {cmd}")
             res = execute_local(spec, self.out, env=self.env)
