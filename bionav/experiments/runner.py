@@ -165,6 +165,11 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
         metrics.update(result or {})
         metrics["status"] = "completed"
     except BaseException as exc:
+        if not isinstance(exc, KeyboardInterrupt) and _caused_by_interrupt(exc):
+            # Ctrl-C inside compiled code (numba) surfaces as SystemError caused by KeyboardInterrupt
+            metrics.update(status="failed", error=f"KeyboardInterrupt: (inside {type(exc).__name__}: {exc})")
+            _finish(run_dir, mcap, metrics, started, failing=True)
+            raise KeyboardInterrupt from None
         full = disk_full_error(exc, run_dir)
         metrics["status"] = "failed"
         metrics["error"] = str(full or exc) if isinstance(full or exc, UserError) else f"{type(exc).__name__}: {exc}"
@@ -197,6 +202,17 @@ def _finish(run_dir: Path, mcap: McapLog | None, metrics: dict[str, Any], starte
         if full is not None:
             raise full from None
         raise
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """True if a KeyboardInterrupt is among the causes/contexts of ``exc``."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def mount_point(path: Path) -> Path:
