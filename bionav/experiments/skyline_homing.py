@@ -111,10 +111,10 @@ def render_campus_counts(world, geometry, cells, *, sensor_model, rng, progress=
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
     from bionav.db.database import ImageDatabase
+    from bionav.evaluation.agent import evaluate_agents
     from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
     from bionav.evaluation.pairs import home_vector_matrix, prepare_images
     from bionav.experiments.common import make_homing
-    from bionav.experiments.grid_homing import evaluate_agents
     from bionav.geometry import PanoramaGeometry
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
