@@ -24,8 +24,7 @@ import csv
 import numpy as np
 
 from bionav.errors import UserError
-from bionav.experiments.contrast_lda import _get
-from bionav.experiments.contrast_scan import learn_discriminants
+from bionav.experiments.common import _get, load_samples
 from bionav.light.sun import parse_time
 from bionav.report.figures import pyplot, save_figure
 
@@ -118,6 +117,7 @@ def run(cfg, ctx) -> dict:
     from bionav.geometry import PanoramaGeometry
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
+    from bionav.spectral.lda_analysis import learn_discriminants
     from bionav.spectral.representations import check_representation, representation_image
     from bionav.spectral.scene import garden_scene
     from bionav.spectral.sensor_model import LogSensorModel
@@ -146,8 +146,8 @@ def run(cfg, ctx) -> dict:
     seed = int(_get(exp, "world_seed", 0))
     extent = max(nx - 1, ny - 1) * spacing
     sensor_model = LogSensorModel(noise_counts=float(_get(exp, "noise_counts", 4.0)))
-    disc = learn_discriminants(_get(exp, "learn", None) or {"name": "sim_natural", "seed": int(_get(cfg, "seed", 0))},
-                               sigma=float(_get(exp, "sigma", 30.0)))
+    learn = _get(exp, "learn", None) or {"name": "sim_natural", "seed": int(_get(cfg, "seed", 0))}
+    disc = learn_discriminants(load_samples(learn), sigma=float(_get(exp, "sigma", 30.0)))
 
     gx, gy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     positions = np.c_[gx.ravel(), gy.ravel()]
