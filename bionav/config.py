@@ -91,10 +91,16 @@ def register_configs() -> dict[str, list[str]]:
     """
     Plugins.instance().register(BionavSearchPathPlugin)
     store = ConfigStore.instance()
-    from bionav.db.config import DatabaseConfig
+    # typed schemas of config nodes, registered by the rooms that own them (entry points
+    # ``bionav.schemas``); e.g. every db preset is merged onto ``db_schema``
+    schemas = registry.config_schemas()
+    if "db_schema" not in schemas:
+        from bionav.errors import UserError
 
-    # every db preset is merged onto this schema: all db.* keys exist and are typed
-    store.store(name="db_schema", node=DatabaseConfig, provider="bionav")
+        raise UserError("bionav's entry points are out of date (no 'db_schema' in bionav.schemas); "
+                        "re-install it: pip install -e . (or pip install .) in the bionav checkout.")
+    for name, schema in schemas.items():
+        store.store(name=name, node=schema, provider="bionav")
     names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
     for kind in registry.GROUPS:
         with warnings.catch_warnings():
