@@ -59,6 +59,96 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
             _check_writable(Path(str(override.value())))
 
 
+def _concrete_overrides(argv: list[str]) -> list[str] | None:
+    """The command line's overrides with each sweep replaced by its first value (None: unparsable)."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    args = [a for a in argv if not a.startswith("-")]
+    try:
+        overrides = OverridesParser.create().parse_overrides(args)
+    except Exception:
+        return None  # Hydra reports syntax errors itself
+    out = []
+    for override in overrides:
+        key = override.key_or_group
+        if key == "hydra" or key.startswith(("hydra.", "hydra/")):
+            continue
+        if override.is_sweep_override():
+            if not override.is_discrete_sweep():
+                continue  # range/interval sweeps: Hydra checks them per job
+            values = list(override.sweep_string_iterator())
+            if not values:
+                continue
+            out.append(f"{override.get_key_element()}={values[0]}")
+        else:
+            out.append(override.input_line)
+    return out
+
+
+def _node_keys(overrides: list[str], node: str) -> list[str]:
+    """Keys of config node ``node`` when composed with the group choices among ``overrides``."""
+    from omegaconf import DictConfig, OmegaConf
+
+    from bionav.config import compose
+
+    groups = [o for o in overrides if "." not in o.split("=", 1)[0].lstrip("+~")]
+    try:
+        cfg = compose(groups)
+    except Exception:
+        return []
+    value = OmegaConf.select(cfg, node) if node else cfg
+    return [str(k) for k in value.keys()] if isinstance(value, DictConfig) else []
+
+
+def composition_message(exc: BaseException, overrides: list[str]) -> str:
+    """One paragraph for a Hydra composition error (misspelt key, wrong type, unknown option)."""
+    from bionav.config import unknown_key_message
+
+    cause = exc.__cause__ or exc.__context__
+    full_key = str(getattr(cause, "full_key", "") or "")
+    first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    name = type(cause).__name__ if cause is not None else ""
+    if name in ("ConfigAttributeError", "ConfigKeyError") and full_key:
+        if "." in full_key:
+            node, bad = full_key.rsplit(".", 1)
+        else:
+            node, bad = "", full_key
+        message = unknown_key_message(node, bad, _node_keys(overrides, node))
+        return f"{message} Fix the spelling on the command line (`python -m bionav --cfg job` shows the whole config)."
+    if name == "ValidationError" and full_key:
+        given = next((o.split("=", 1)[1] for o in overrides if o.split("=", 1)[0].lstrip("+~") == full_key), "?")
+        reason = str(cause).splitlines()[0]
+        return (f"bad value {full_key}={given}: {reason}. Give {full_key} a value of its declared type "
+                f"(`python -m bionav --cfg job` shows the current value).")
+    if type(exc).__name__ == "MissingConfigException":
+        return (f"{first}. Pick one of the available options (`python -m bionav --help` lists them, "
+                "`python -m bionav.plugins` the installed plugins).")
+    return f"the configuration cannot be composed: {first}. Check the overrides on the command line."
+
+
+def _check_composition(argv: list[str], *, validate: bool = True) -> None:
+    """Compose the configuration once before Hydra runs; turn its errors into one paragraph.
+
+    With ``validate``, also check every value against its declared range
+    (:func:`bionav.experiments.runner.validate_run_config`), so a bad value is
+    reported before a run directory is created. A sweep is checked with the
+    first value of each swept key (each job checks its own values again).
+    """
+    from bionav.config import compose
+
+    overrides = _concrete_overrides(argv)
+    if overrides is None:
+        return
+    try:
+        cfg = compose(overrides)
+    except Exception as exc:
+        raise UserError(composition_message(exc, overrides)) from None
+    if validate:
+        from bionav.experiments.runner import validate_run_config
+
+        validate_run_config(cfg)
+
+
 def _yaml_options(group: str) -> list[str]:
     from bionav.config import config_options
 
@@ -82,27 +172,32 @@ def _check_writable(path: Path) -> None:
 
 
 def _task(cfg) -> float | None:
+    """One job; returns the run's objective (config ``objective``) for sweepers, worst on failure."""
     from hydra.core.hydra_config import HydraConfig
     from hydra.types import RunMode
 
     from bionav.experiments.runner import run_experiment
 
+    from bionav.experiments.objective import objective_from_config
+
     hc = HydraConfig.get()
     run_dir = Path(hc.runtime.output_dir)
     multirun = hc.mode == RunMode.MULTIRUN
+    objective = None
     try:
+        objective = objective_from_config(cfg.get("objective"))
         metrics = run_experiment(cfg, run_dir, show_progress=sys.stderr.isatty() or not multirun)
     except UserError as exc:
         if multirun:
             log.error("job %s failed: %s", hc.job.num, exc)
-            return None
+            return objective.worst if objective else None
         _fail(f"{exc} (run directory: {run_dir})")
     except KeyboardInterrupt:
         _fail(f"interrupted; what was recorded so far is in {run_dir} (metrics.json says failed).", 130)
     except Exception as exc:
         if multirun:
             log.error("job %s failed with an internal error: %s (see %s/error.log)", hc.job.num, exc, run_dir)
-            return None
+            return objective.worst if objective else None
         _fail(
             f"internal error: {type(exc).__name__}: {exc}. This is a bug in bionav or a plugin; the traceback is "
             f"in {run_dir / 'error.log'} and the run's log in {run_dir / 'run.mcap'}.",
@@ -117,7 +212,7 @@ def _task(cfg) -> float | None:
         )
     else:
         _print_result(metrics)
-    return None
+    return objective.value(metrics) if objective else None
 
 
 def _print_result(metrics: dict) -> None:
@@ -142,12 +237,20 @@ def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
     argv = list(sys.argv[1:] if argv is None else argv)
     limit_blas_threads()
+    from bionav.completion import BASH_SCRIPT, rewrite_query_line, wants_bash_install
+
+    if wants_bash_install(argv):  # Hydra's script does not know `python -m bionav`
+        print(BASH_SCRIPT, end="")
+        return
+    rewrite_query_line()
     try:
         from bionav.config import register_configs
 
         names = register_configs()
         if not any(a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv):
             _precheck(argv, names)
+        if not any(a in ("--help", "-h", "--hydra-help") or a.startswith("--info") for a in argv):
+            _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
     except UserError as exc:
         _fail(str(exc))
 

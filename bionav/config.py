@@ -27,7 +27,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import registry
 
 #: config groups users select plugins in
-PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller")
+PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
 
 
 def config_dirs() -> list[tuple[str, Path]]:
@@ -56,8 +56,18 @@ class BionavSearchPathPlugin(SearchPathPlugin):
     """Adds every ``bionav.configs`` folder to Hydra's config search path."""
 
     def manipulate_search_path(self, search_path: ConfigSearchPath) -> None:
-        for name, folder in config_dirs():
-            search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
+        dirs = config_dirs()
+        own = dict(dirs).get("bionav")
+        for element in search_path.get_path():
+            # ``python -m bionav`` (config_path=None) searches the package itself, where an installed
+            # ``bionav/conf`` would show up as a second set of groups named ``conf/...`` in --help and
+            # completion: search bionav's own config folder there instead, and only there.
+            if element.provider == "main" and own is not None and element.path != f"file://{own}":
+                element.path = f"file://{own}"
+        present = {element.path for element in search_path.get_path()}
+        for name, folder in dirs:
+            if f"file://{folder}" not in present:
+                search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
 
 
 def plugin_node_class(name: str, config_cls: type) -> type:
@@ -100,7 +110,10 @@ def register_configs() -> dict[str, list[str]]:
         raise UserError("bionav's entry points are out of date (no 'db_schema' in bionav.schemas); "
                         "re-install it: pip install -e . (or pip install .) in the bionav checkout.")
     for name, schema in schemas.items():
-        store.store(name=name, node=schema, provider="bionav")
+        if isinstance(schema, type):
+            store.store(name=name, node=schema, provider="bionav")
+        else:  # a registration function: experiment_schema/<name>, hydra/launcher=submitit_slurm, ...
+            schema(store)
     names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
     for kind in registry.GROUPS:
         with warnings.catch_warnings():
@@ -145,8 +158,11 @@ def compose(overrides: Sequence[str] = (), *, config_name: str = "config") -> Di
         return hydra_compose(config_name=config_name, overrides=list(overrides))
 
 
-def plugin_config(kind: str, node: Any) -> Any:
-    """Validate a config node against its plugin's ``Config`` and return the dataclass instance.
+def plugin_config(kind: str, node: Any, *, key: str | None = None) -> Any:
+    """Validate a config node against its plugin's ``Config``: ``(plugin class, config instance)``.
+
+    Types come from the dataclass, ranges from its fields' :func:`bionav.validation.bounded`
+    declarations (:func:`bionav.validation.check_config`).
 
     Parameters
     ----------
@@ -154,8 +170,14 @@ def plugin_config(kind: str, node: Any) -> Any:
         Plugin kind (``homing``, ``signature``, ``sensor``, ``controller``).
     node : DictConfig or Mapping
         Config node with a ``name`` key and the plugin's parameters.
+    key : str, optional
+        The config key users type for this node (``pantilt`` for a sensor
+        selected in the ``pantilt`` group); default ``kind``.
     """
     from bionav.errors import UserError
+    from bionav.validation import check_config
+
+    key = key or kind
 
     plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
     name = plain.pop("name", None)
@@ -164,12 +186,37 @@ def plugin_config(kind: str, node: Any) -> Any:
     valid = {f.name for f in dataclasses.fields(cls.Config)}
     unknown = sorted(set(plain) - valid)
     if unknown:
-        raise UserError(
-            f"the {kind} plugin {name!r} has no parameter(s) {', '.join(unknown)}; "
-            f"its parameters are {', '.join(sorted(valid)) or '(none)'}."
-        )
+        raise UserError(unknown_key_message(key, unknown[0], sorted(valid), what=f"the {kind} plugin {name!r}"))
     try:
         merged = OmegaConf.merge(OmegaConf.structured(cls.Config), plain)
-        return cls, OmegaConf.to_object(merged)
+        config = OmegaConf.to_object(merged)
     except Exception as exc:  # omegaconf validation errors
-        raise UserError(f"bad value for the {kind} plugin {name!r}: {exc}") from None
+        where = getattr(exc, "full_key", None)
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise UserError(
+            f"bad value for {key}.{where or '<parameter>'} (the {kind} plugin {name!r}): {first}. "
+            f"Give {key}.{where or '<parameter>'} a value of the declared type."
+        ) from None
+    return cls, check_config(config, prefix=key)
+
+
+def unknown_key_message(node: str, bad: str, valid: Sequence[str], *, what: str | None = None) -> str:
+    """One paragraph for a misspelt key: the key, the valid keys of its node, the closest one.
+
+    Parameters
+    ----------
+    node : str
+        Dotted key of the node (``homing``, ``db``, ``experiment.camera``).
+    bad : str
+        The unknown key (last component).
+    valid : sequence of str
+        The keys the node has.
+    """
+    import difflib
+
+    full = f"{node}.{bad}" if node else bad
+    close = difflib.get_close_matches(bad, list(valid), n=1, cutoff=0.6)
+    hint = f" Did you mean {node + '.' if node else ''}{close[0]}?" if close else ""
+    owner = f" ({what})" if what else ""
+    keys = ", ".join(valid) or "(none)"
+    return f"unknown key {full}: {node or 'the config'}{owner} has no key {bad!r}; its keys are {keys}.{hint}"

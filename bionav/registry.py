@@ -10,7 +10,7 @@ registered through the same entry points as third-party plugins.
   (:func:`load_plugin`) or when all of a kind are listed (:func:`plugins_of`).
 * A plugin that fails to import is a warning when listing and an error naming
   its distribution only when it is selected.
-* Two distributions claiming one name in one group is an error naming both.
+* Two distributions claiming one name in one group make that name (only) an error naming both.
 * Lookup accepts a registry name or the plugin class itself.
 """
 
@@ -31,6 +31,7 @@ GROUPS: dict[str, str] = {
     "signature": "bionav.signatures",
     "sensor": "bionav.sensors",
     "controller": "bionav.controllers",
+    "decoder": "bionav.decoders",
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"
@@ -118,33 +119,49 @@ def _all_entry_points() -> dict[str, tuple[importlib_metadata.EntryPoint, ...]]:
 def clear_cache() -> None:
     """Forget cached entry points and loaded plugins (after installing a plugin at run time)."""
     _all_entry_points.cache_clear()
+    _scan.cache_clear()
     entry_points_of.cache_clear()
     _load_entry.cache_clear()
+
+
+@functools.cache
+def _scan(kind: str) -> tuple[dict[str, PluginEntry], dict[str, str]]:
+    group = _check_kind(kind)
+    found: dict[str, PluginEntry] = {}
+    claims: dict[str, list[PluginEntry]] = {}
+    for ep in _all_entry_points()[group]:
+        dist, version = _distribution_of(ep)
+        entry = PluginEntry(kind, ep.name, ep.value, dist, version)
+        same = [c for c in claims.get(ep.name, []) if (c.distribution, c.value) == (dist, ep.value)]
+        if not same:  # one distribution seen twice on sys.path is one claim
+            claims.setdefault(ep.name, []).append(entry)
+        found.setdefault(ep.name, entry)
+    conflicts = {}
+    for name, entries in claims.items():
+        if len(entries) > 1:
+            listed = " and ".join(e.describe() for e in entries)
+            conflicts[name] = (
+                f"{len(entries)} installed distributions register the {kind} plugin {name!r}: {listed}. "
+                f"Uninstall one of them (e.g. pip uninstall {entries[-1].distribution}) or rename its entry "
+                f"point in group {group!r}; the other {kind} plugins are not affected."
+            )
+    return found, conflicts
 
 
 @functools.cache
 def entry_points_of(kind: str) -> dict[str, PluginEntry]:
     """Registered plugins of one kind, keyed by name, without importing them.
 
-    Raises
-    ------
-    PluginError
-        When two different distributions declare the same name.
+    A name that two distributions claim is listed (with the first claim) but
+    cannot be loaded: :func:`load_plugin` raises the message of
+    :func:`conflicts_of`; every other name stays usable.
     """
-    group = _check_kind(kind)
-    found: dict[str, PluginEntry] = {}
-    for ep in _all_entry_points()[group]:
-        dist, version = _distribution_of(ep)
-        entry = PluginEntry(kind, ep.name, ep.value, dist, version)
-        previous = found.get(ep.name)
-        if previous is not None and (previous.distribution, previous.value) != (dist, ep.value):
-            raise PluginError(
-                f"two installed distributions register the {kind} plugin {ep.name!r}: "
-                f"{previous.describe()} and {entry.describe()}. Uninstall one of them "
-                f"(pip uninstall {entry.distribution}) or rename its entry point in group {group!r}."
-            )
-        found[ep.name] = entry
-    return found
+    return dict(_scan(kind)[0])
+
+
+def conflicts_of(kind: str) -> dict[str, str]:
+    """Names of one kind claimed by several distributions -> a message naming them and the fix."""
+    return dict(_scan(kind)[1])
 
 
 @functools.cache
@@ -179,7 +196,9 @@ def plugins_of(kind: str, *, warn: bool = True) -> dict[str, LoadedPlugin]:
     warn : bool
         Emit a :class:`PluginWarning` for each plugin that failed to load.
     """
-    loaded = {name: _load_entry(entry) for name, entry in entry_points_of(kind).items()}
+    conflicts = conflicts_of(kind)
+    loaded = {name: (LoadedPlugin(entry, None, conflicts[name]) if name in conflicts else _load_entry(entry))
+              for name, entry in entry_points_of(kind).items()}
     if warn:
         for plugin in loaded.values():
             if plugin.error:
@@ -215,6 +234,9 @@ def load_plugin(kind: str, name_or_class: str | type) -> type:
             f"there is no {kind} plugin named {name!r}. Available: {available}. "
             f"Install the package that provides it, or pick one of these."
         )
+    conflict = conflicts_of(kind).get(name)
+    if conflict:
+        raise PluginError(conflict)
     plugin = _load_entry(entries[name])
     if plugin.cls is None:
         raise PluginError(
@@ -239,20 +261,29 @@ def config_packages() -> list[tuple[str, str, str]]:
     return out
 
 
-def config_schemas() -> dict[str, type]:
-    """Structured config schemas declared in ``bionav.schemas``: name -> dataclass.
+def config_schemas() -> dict[str, Any]:
+    """Structured config schemas declared in ``bionav.schemas``: name -> dataclass or registration function.
 
     A room that owns a config node registers its schema here (bionav's
-    ``db_schema`` is :class:`bionav.db.config.DatabaseConfig`), so the Hydra
-    wiring stores it without importing that room.
+    ``db_schema`` is :class:`bionav.db.config.DatabaseConfig`; the experiment
+    schemas come from :func:`bionav.experiments.configs.register`), so the
+    Hydra wiring stores them without importing that room. An entry whose
+    optional dependency is not installed (e.g. the SLURM launcher without the
+    ``slurm`` extra) is skipped.
     """
-    out: dict[str, type] = {}
+    out: dict[str, Any] = {}
     for ep in _all_entry_points()[SCHEMA_GROUP]:
         if ep.name in out:
             dist, _ = _distribution_of(ep)
             raise PluginError(f"the config schema {ep.name!r} is declared twice (again by {dist}); uninstall one.")
         try:
             out[ep.name] = ep.load()
+        except ModuleNotFoundError as exc:
+            if exc.name and exc.name.split(".")[0] != "bionav":
+                continue  # it needs an optional dependency (an extra) that is not installed
+            dist, _ = _distribution_of(ep)
+            raise PluginError(f"the config schema {ep.name!r} of {dist} cannot be loaded ({exc}); "
+                              f"reinstall {dist}.") from None
         except Exception as exc:  # a broken third-party schema
             dist, _ = _distribution_of(ep)
             raise PluginError(f"the config schema {ep.name!r} of {dist} cannot be loaded ({exc}); "

@@ -142,17 +142,17 @@ def write_moeller(folder: Path, *, xmin=1, xmax=4, ymin=2, ymax=4, vert_res="0.0
                 write(folder / f"cv_{x}_{y}_bw{cutoff}.pgm", cell_image(x, y))
 
 
-def test_moeller_mirrored_x_and_db_metadata(tmp_path):
+def test_moeller_indices_shift_by_min_and_db_metadata(tmp_path):
     write_moeller(tmp_path, skip={(2, 3)})
     db = load(tmp_path, naming="auto")
     assert db.meta["naming"] == "moeller"
     assert db.grid_shape == (4, 3)  # xmax - xmin + 1, ymax - ymin + 1
     assert len(db) == 11
     for i, (gx, gy) in enumerate(db.positions):
-        x_file, y_file = 4 - gx, gy + 2  # gx = xmax - x, gy = y - ymin
+        x_file, y_file = gx + 1, gy + 2  # gx = x - xmin, gy = y - ymin (issue 13 item 11: no mirroring)
         expected = canonical_of_disk(cell_image(x_file, y_file)).astype(np.float32) / 255
         np.testing.assert_array_equal(db.images[i], expected)
-    assert db.index_of(4 - 2, 3 - 2) is None  # the missing file cv_2_3 is grid cell (2, 1)
+    assert db.index_of(2 - 1, 3 - 2) is None  # the missing file cv_2_3 is grid cell (1, 1)
     assert db.geometry.horizon_row == 2.5 and db.geometry.rad_per_row == pytest.approx(0.0218)
 
 
@@ -170,7 +170,7 @@ def test_moeller_several_cutoffs_need_a_choice(tmp_path):
     with pytest.raises(UserError, match=r"db.extra.bw_cutoff"):
         load(tmp_path)
     db = load(tmp_path, extra={"bw_cutoff": 1.0})
-    assert len(db) == 1 and tuple(db.positions[0]) == (3, 0)
+    assert len(db) == 1 and tuple(db.positions[0]) == (0, 0)  # cv_1_2 with xmin=1, ymin=2
 
 
 def test_moeller_bad_db_file(tmp_path):

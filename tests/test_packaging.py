@@ -73,3 +73,15 @@ def test_example_plugin_selected_from_the_cli(tmp_path):
     preset = run_bionav("homing=alv_bright", "--cfg", "job", cwd=tmp_path, env=env)
     assert preset.returncode == 0, preset.stderr
     assert "quantile: 0.9" in preset.stdout and "dark_landmarks: false" in preset.stdout
+
+
+def test_installed_wheel_help_lists_each_group_once(wheel, tmp_path):
+    """An installed bionav/conf must not appear a second time as `conf/<group>` groups (issue 20)."""
+    target = tmp_path / "site"
+    assert _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path).returncode == 0
+    proc = run_bionav("--help", cwd=tmp_path, env={"PYTHONPATH": str(target), "BIONAV_CACHE": str(tmp_path / "c")})
+    assert proc.returncode == 0, proc.stderr
+    section = proc.stdout.split("== Configuration groups ==", 1)[1].split("== Config ==", 1)[0]
+    groups = [line.split(":", 1)[0] for line in section.splitlines() if ": " in line]
+    assert "experiment" in groups and len(groups) == len(set(groups)), groups
+    assert not [g for g in groups if g.startswith("conf")], groups

@@ -106,6 +106,8 @@ def test_prepare_resizes_to_the_configured_size():
         (MinWarping, {"compass_fraction": 0.0}),
         (MinWarping, {"image_size": [287, 50], "double_search": True}),
         (MinWarping, {"butterworth_cutoff": 2.0}),
+        (MinWarping, {"threshold_rule": "median"}),
+        (MinWarping, {"threshold_rule": "reference", "max_scale_ratio": 1.5}),
         (Warping2D, {"rho_max": 1.0}),
         (Warping1D, {"strip_rows": 0}),
         (HissHoming, {"ratio": 1.5}),
@@ -183,3 +185,37 @@ def test_methods_home_in_the_rendered_lab(lab_views, cls, max_home_deg, mean_hom
         if psi_tol_deg is not None:
             assert np.degrees(angular_difference(hv.compass, heading)) < psi_tol_deg
     assert max(errors) < max_home_deg and np.mean(errors) < mean_home_deg
+
+
+@pytest.mark.parametrize("options", [{}, {"compass_acceleration": True, "compass_fraction": 0.3},
+                                     {"fine_search": True, "double_search": True}])
+def test_quantised_minwarping_agrees_with_the_float_search(views, lab_views, options):
+    # the 8-bit search (default) against the float32 one on rendered pairs:
+    # home direction and compass within one search step (360 / 96 degrees)
+    step_deg = 360.0 / 96
+    for geometry, snap, currents in (views, lab_views):
+        fast = MinWarping(MinWarping.Config(**options), geometry=geometry)
+        slow = MinWarping(MinWarping.Config(quantised=False, **options), geometry=geometry)
+        s_fast, s_slow = fast.prepare(snap), slow.prepare(snap)
+        for cur in currents:
+            a = fast.home_vector(s_fast, fast.prepare(cur))
+            b = slow.home_vector(s_slow, slow.prepare(cur))
+            assert np.degrees(angular_difference(a.angle, b.angle)) <= step_deg + 1e-9
+            assert np.degrees(angular_difference(a.compass, b.compass)) <= step_deg + 1e-9
+
+
+def test_reference_threshold_rule_gives_arithmetic_midpoints_and_a_largest_ratio():
+    from bionav.homing.warping.scaleplanes import default_scales
+
+    s = default_scales()
+    g = PanoramaGeometry.square_pixels(288, 50)
+    _, tau = MinWarping(MinWarping.Config(threshold_rule="reference"), geometry=g)._scales()
+    # by hand: (2**((k-4)/4) + 2**((k-3)/4)) / 2, then the largest ratio 2.5
+    assert tau[:-1] == pytest.approx([(s[k] + s[k + 1]) / 2 for k in range(8)])
+    assert tau[3] == pytest.approx((2 ** -0.25 + 1.0) / 2) and tau[-1] == 2.5
+    _, tau_g = MinWarping(MinWarping.Config(), geometry=g)._scales()
+    assert tau_g[3] == pytest.approx(2 ** -0.125) and np.isinf(tau_g[-1])
+    # explicit thresholds win over the rule
+    explicit = [float(x) for x in tau_g[:-1]] + [3.0]
+    _, tau_e = MinWarping(MinWarping.Config(threshold_rule="reference", thresholds=explicit), geometry=g)._scales()
+    assert tau_e == pytest.approx(explicit)

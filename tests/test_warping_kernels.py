@@ -11,8 +11,8 @@ from bionav.homing.warping import (
     warping1d_scores,
     warping2d_scores,
 )
-from bionav.homing.warping.distance import column_distance_matrix, diagonal_distances
-from bionav.homing.warping.kernels import fill_window_minima
+from bionav.homing.warping.distance import column_distance_matrix, diagonal_distances, distance_quantum
+from bionav.homing.warping.kernels import fill_window_minima, swap_roles
 from bionav.homing.warping.reference import (
     minwarping_scores_reference,
     warping1d_scores_reference,
@@ -125,7 +125,7 @@ def test_warping1d_scores_fast_equals_reference():
 
 def test_minwarping_picks_the_reference_minimum():
     snap, cur = _pair(7)
-    result = minwarping(snap, cur, n_alpha=12, n_psi=12)
+    result = minwarping(snap, cur, n_alpha=12, n_psi=12, quantised=False)
     a_cols, p_cols, _ = minwarping_scores(snap, cur, n_alpha=12, n_psi=12)
     ref = minwarping_scores_reference(
         snap, cur, a_cols=a_cols, p_cols=p_cols, thresholds=default_thresholds(SCALES)
@@ -146,15 +146,106 @@ def test_compass_acceleration_searches_a_subset_of_the_same_scores():
     assert fine.score <= full.score + 1e-6
 
 
-def test_double_search_adds_the_swapped_search():
-    snap, cur = _pair(9)
-    a_cols, p_cols, s1 = minwarping_scores(snap, cur, n_alpha=12, n_psi=12)
-    _, _, s2 = minwarping_scores(cur, snap, n_alpha=12, n_psi=12)
+@pytest.mark.parametrize("scales", [SCALES, default_scales(5)])  # asymmetric: recomputed; symmetric: transposed
+@pytest.mark.parametrize("quantised", [False, True])
+def test_double_search_adds_the_swapped_search(scales, quantised):
+    rng = np.random.default_rng(9)
+    geometry = PanoramaGeometry.square_pixels(W, H)
+    snap, cur = (scale_plane_stack(rng.random((H, W)).astype(np.float32), geometry=geometry, scales=scales)
+                 for _ in range(2))
+    a_cols, p_cols, s1 = minwarping_scores(snap, cur, n_alpha=12, n_psi=12, quantised=quantised)
+    _, _, s2 = minwarping_scores(cur, snap, n_alpha=12, n_psi=12, quantised=quantised)
     col = {int(c): i for i, c in enumerate(a_cols)}
     total = np.empty_like(s1)
     for ip, pc in enumerate(p_cols):
         for ia, ac in enumerate(a_cols):
             ip2 = int(np.flatnonzero(p_cols == (-pc) % W)[0])
             total[ip, ia] = s1[ip, ia] + s2[ip2, col[int((ac + W // 2 - pc) % W)]]
-    result = minwarping(snap, cur, n_alpha=12, n_psi=12, double_search=True)
-    assert result.score == pytest.approx(total.min(), rel=1e-5)
+    result = minwarping(snap, cur, n_alpha=12, n_psi=12, double_search=True, quantised=quantised)
+    assert result.score == pytest.approx(total.min(), rel=1e-6)
+
+
+def test_swap_roles_is_the_distance_stack_of_the_swapped_pair():
+    rng = np.random.default_rng(5)
+    geometry = PanoramaGeometry.square_pixels(W, H)
+    scales = default_scales(5)
+    a, b = (scale_plane_stack(rng.random((H, W)).astype(np.float32), geometry=geometry, scales=scales)
+            for _ in range(2))
+    for quantised in (False, True):
+        for step in (1, 3):
+            forward = diagonal_distances(a, b, step=step, quantised=quantised)
+            swapped = np.empty_like(forward)
+            swap_roles(forward, swapped)
+            direct = diagonal_distances(b, a, step=step, quantised=quantised)
+            if quantised:  # the same integers either way
+                np.testing.assert_array_equal(swapped, direct)
+            else:
+                np.testing.assert_allclose(swapped, direct, rtol=1e-5, atol=1e-6)
+
+
+@pytest.mark.parametrize("step", [1, 2, 3])
+def test_quantised_distances_are_rounded_nsad(step):
+    snap, cur = _pair(21)
+    ref = column_distance_matrix(snap, cur)
+    q, _ = distance_quantum(W)
+    fast = diagonal_distances(snap, cur, step=step, quantised=True)
+    assert fast.dtype == np.uint8
+    n = W // step
+    for i in range(W):
+        for d in range(W):
+            want = ref[:, i, (i + d) % W] * q
+            got = fast[:, d, i % step, i // step].astype(np.float64)
+            # rounding (0.5) plus the 16-bit quantisation of the edge images
+            assert np.abs(got - want).max() <= 0.5 + 0.02 * q, (i, d)
+            np.testing.assert_array_equal(fast[:, d, i % step, i // step + n], fast[:, d, i % step, i // step])
+
+
+def test_distance_quantum_keeps_sums_in_16_bits():
+    for width in (24, 288, 346, 1000):
+        q, dtype = distance_quantum(width)
+        assert dtype == np.uint16 and width * q <= 65535 and (q == 255 or width * (q + 1) > 65535)
+    assert distance_quantum(4000) == (255, np.dtype(np.uint32))
+
+
+@pytest.mark.parametrize("thresholds", THRESHOLD_SETS)
+def test_quantised_scores_are_close_to_the_reference(thresholds):
+    snap, cur = _pair(31)
+    a_cols, p_cols, fast = minwarping_scores(snap, cur, n_alpha=12, n_psi=6, thresholds=thresholds,
+                                             quantised=True)
+    tau = default_thresholds(SCALES) if thresholds is None else thresholds
+    ref = minwarping_scores_reference(snap, cur, a_cols=a_cols, p_cols=p_cols, thresholds=tau)
+    q, _ = distance_quantum(W)
+    # every column's minimum is off by at most the error of one distance
+    assert np.abs(fast - ref).max() <= W * (0.5 + 0.02 * q) / q
+    assert np.abs(fast - ref).max() > 0  # quantised: not the float values
+
+
+def _circ_steps(x, y, width, n_steps):
+    return abs((x - y + width / 2) % width - width / 2) * n_steps / width
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("options", [{}, {"double_search": True, "fine_search": True},
+                                     {"compass_fraction": 0.3}])
+def test_quantised_search_agrees_with_float_on_random_panoramas(seed, options):
+    # a random panorama seen again rotated and with noise: the rotation is
+    # determined, the movement direction is not (no translation), so the
+    # quantised search must find the rotation and a hypothesis whose float
+    # match value is as good as the float optimum up to the quantisation error
+    rng = np.random.default_rng(seed)
+    w, h = 96, 20
+    geometry = PanoramaGeometry.square_pixels(w, h)
+    scales = default_scales(9)
+    base = rng.random((h, w)).astype(np.float32)
+    other = np.roll(base, -int(rng.integers(w)), axis=1) + 0.2 * rng.random((h, w)).astype(np.float32)
+    snap = scale_plane_stack(base, geometry=geometry, scales=scales)
+    cur = scale_plane_stack(other, geometry=geometry, scales=scales)
+    f = minwarping(snap, cur, n_alpha=32, n_psi=32, quantised=False, **options)
+    q = minwarping(snap, cur, n_alpha=32, n_psi=32, quantised=True, **options)
+    assert _circ_steps(q.psi * w / (2 * np.pi), f.psi * w / (2 * np.pi), w, 32) <= 1.0
+    a_cols, p_cols, table = minwarping_scores(snap, cur, n_alpha=32, n_psi=32, quantised=False)
+    if not options:
+        ia = int(np.flatnonzero(a_cols == round(q.alpha * w / (2 * np.pi)) % w)[0])
+        ip = int(np.flatnonzero(p_cols == round(q.psi * w / (2 * np.pi)) % w)[0])
+        quantum, _ = distance_quantum(w)
+        assert table[ip, ia] <= table.min() + 2 * w * (0.5 + 0.02 * quantum) / quantum

@@ -1,105 +1,216 @@
-"""Time homing methods per home vector: ``python -m bionav.bench [--method ...]``.
+"""Time homing methods per home vector: ``python -m bionav.bench [--method ...] [--json]``.
 
-The input is a pair of ray-cast panoramas of the pillar test room
-(:mod:`bionav.testing.pillar_scene`) at a known displacement and rotation.
-Per-image work (:meth:`prepare`) is timed separately and excluded from the
-per-pair time (it is amortised over all pairs in a grid run); the first calls
-(numba compilation, caches) are excluded as warm-up. Reported: the median and
-the minimum wall time of one home vector over ``--repeat`` calls.
+The input is a ray-cast panorama of the pillar test room
+(:mod:`bionav.testing.pillar_scene`) as snapshot and three current views at
+known displacements and rotations. Per-image work (:meth:`prepare`) is timed
+separately and excluded from the per-pair time (it is amortised over all pairs
+in a grid run); the first calls (numba compilation, caches) are excluded as
+warm-up.
+
+Every measurement runs ``--batch`` home vectors on ``--threads`` worker
+threads (the kernels are single-threaded and release the GIL, as in the grid
+runner), reads the process CPU time (all threads) and the wall time, and
+divides by the number of home vectors. The variants are interleaved
+(``--repeat`` rounds of one batch per variant) so that changing load on a
+shared machine affects all alike; reported are the median and the minimum over
+the rounds, and the 1-minute load average of the machine.
+
+``--background-load N`` starts ``N`` busy processes for the duration of the
+run (to check that parallel work is not slower than serial on a loaded
+machine); they are stopped at the end.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import platform
+import subprocess
 import sys
 import time
-from functools import partial
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 METHODS = ("minwarping", "warping2d", "warping1d", "hiss")
 
+#: min-warping variants: (name, plugin options)
+MINWARPING_VARIANTS = (
+    ("single", {}),
+    ("double_fine", {"double_search": True, "fine_search": True}),
+    ("compass", {"compass_acceleration": True}),
+    ("compass_double_fine", {"compass_acceleration": True, "double_search": True, "fine_search": True}),
+)
+WARPING2D_VARIANTS = (("single", {}), ("compass", {"compass_acceleration": True}))
 
-def _plugin(name: str, size, steps: int, compass: bool, geometry):
+#: current views: (position in metres, heading in radians); the snapshot is at the origin
+POSES = (((0.5, 0.3), 0.5), ((-0.6, 0.2), -1.0), ((0.2, -0.6), 2.5))
+
+
+def _variants(name: str):
+    if name == "minwarping":
+        return MINWARPING_VARIANTS
+    if name == "warping2d":
+        return WARPING2D_VARIANTS
+    return (("single", {}),)
+
+
+def _plugin(name: str, options: dict, args, geometry):
     from bionav.plugins.homing.hiss import HissHoming
     from bionav.plugins.homing.warping import MinWarping, Warping1D, Warping2D
 
     if name == "hiss":
         return HissHoming(HissHoming.Config(), geometry=geometry), "-"
     if name == "warping1d":
-        cfg = Warping1D.Config(image_size=list(size))
+        cfg = Warping1D.Config(image_size=list(args.size))
         return Warping1D(cfg, geometry=geometry), f"{cfg.n_alpha}x{cfg.n_psi}x{cfg.n_rho}"
     cls = MinWarping if name == "minwarping" else Warping2D
-    cfg = cls.Config(image_size=list(size), n_alpha=steps, n_psi=steps, compass_acceleration=compass)
-    label = f"{steps}x{steps}" + (f"x{cfg.n_rho}" if name == "warping2d" else "")
+    cfg = cls.Config(image_size=list(args.size), n_alpha=args.steps, n_psi=args.steps,
+                     compass_fraction=args.compass_fraction, **options)
+    label = f"{args.steps}x{args.steps}" + (f"x{cfg.n_rho}" if name == "warping2d" else "")
     return cls(cfg, geometry=geometry), label
 
 
-def _time(fn, repeat: int, warmup: int = 2):
-    for _ in range(warmup):
-        fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return 1e3 * float(np.median(times)), 1e3 * float(np.min(times))
+def _batch(pool, threads: int, method, pairs, n: int):
+    """Run ``n`` home vectors on ``threads`` workers; return (cpu s, wall s)."""
+    chunks = [range(t, n, threads) for t in range(threads)]
+
+    def work(chunk):
+        for i in chunk:
+            s, c = pairs[i % len(pairs)]
+            method.home_vector(s, c)
+
+    c0, t0 = time.process_time(), time.perf_counter()
+    list(pool.map(work, chunks))
+    return time.process_time() - c0, time.perf_counter() - t0
+
+
+def _start_load(n: int) -> list[subprocess.Popen]:
+    code = "import time\nend = time.monotonic() + 3600\nx = 0\nwhile time.monotonic() < end:\n    x += 1\n"
+    return [subprocess.Popen([sys.executable, "-c", code]) for _ in range(n)]
+
+
+def _stop_load(procs: list[subprocess.Popen]) -> None:
+    for p in procs:
+        p.terminate()
+    for p in procs:
+        try:
+            p.wait(timeout=5)
+        except subprocess.TimeoutExpired:  # pragma: no cover
+            p.kill()
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m bionav.bench",
-        description="Time homing methods (ms per home vector, per-image work excluded, warm-up excluded).",
+        description="Time homing methods: CPU and wall ms per home vector (per-image work and "
+                    "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
     parser.add_argument("--method", choices=METHODS + ("all",), default="minwarping",
                         help="method to time (default: minwarping)")
+    parser.add_argument("--json", action="store_true",
+                        help="print one JSON object per line instead of a table")
+    parser.add_argument("--threads", type=int, default=1,
+                        help="worker threads computing home vectors in parallel (default: 1)")
     parser.add_argument("--size", type=int, nargs=2, default=[288, 50], metavar=("W", "H"),
                         help="image size of the warping methods (default: 288 50)")
     parser.add_argument("--steps", type=int, default=96,
                         help="alpha and psi steps of min-warping and 2D-warping (default: 96)")
-    parser.add_argument("--compass-fraction", type=float, default=0.25,
-                        help="fraction of psi searched with compass acceleration (default: 0.25)")
-    parser.add_argument("--repeat", type=int, default=30, help="timed calls per row (default: 30)")
-    parser.add_argument("--threads", type=int, default=None,
-                        help="numba threads (default: numba's default, all cores)")
+    parser.add_argument("--compass-fraction", type=float, default=0.3,
+                        help="fraction of psi searched with compass acceleration (default: 0.3)")
+    parser.add_argument("--repeat", type=int, default=15,
+                        help="interleaved rounds (default: 15)")
+    parser.add_argument("--batch", type=int, default=None,
+                        help="home vectors per round and variant (default: 6 per thread)")
+    parser.add_argument("--background-load", type=int, default=0, metavar="N",
+                        help="start N busy processes while measuring (default: 0)")
     parser.add_argument("--render-size", type=int, nargs=2, default=[576, 100], metavar=("W", "H"),
                         help="size of the rendered input panoramas (default: 576 100)")
     args = parser.parse_args(argv)
-
-    import numba
+    if args.threads < 1 or args.threads > 64:
+        parser.error("--threads must lie in 1..64")
+    if args.repeat < 1:
+        parser.error("--repeat must be >= 1")
+    if not (0.0 < args.compass_fraction <= 1.0):
+        parser.error("--compass-fraction must lie in (0, 1]")
+    if args.background_load < 0:
+        parser.error("--background-load must be >= 0")
+    batch = args.batch if args.batch is not None else 6 * args.threads
+    if batch < 1:
+        parser.error("--batch must be >= 1")
 
     from bionav.testing.pillar_scene import render_pillar_panorama
 
-    if args.threads is not None:
-        if not (1 <= args.threads <= numba.config.NUMBA_NUM_THREADS):
-            parser.error(f"--threads must lie in 1..{numba.config.NUMBA_NUM_THREADS}")
-        numba.set_num_threads(args.threads)
     rw, rh = args.render_size
     snap, geometry = render_pillar_panorama((0.0, 0.0), width=rw, height=rh, supersample=2)
-    cur, _ = render_pillar_panorama((0.5, 0.3), heading=0.5, width=rw, height=rh, supersample=2)
+    currents = [render_pillar_panorama(p, heading=h, width=rw, height=rh, supersample=2)[0] for p, h in POSES]
+
+    names = METHODS if args.method == "all" else (args.method,)
+    runs = []
+    for name in names:
+        for variant, options in _variants(name):
+            method, steps = _plugin(name, options, args, geometry)
+            t0 = time.process_time()
+            s = method.prepare(snap)
+            prep_ms = 1e3 * (time.process_time() - t0)
+            pairs = [(s, method.prepare(c)) for c in currents]
+            runs.append({"method": name, "variant": variant, "obj": method, "pairs": pairs, "steps": steps,
+                         "prepare_cpu_ms": prep_ms, "cpu": [], "wall": []})
+
+    load = _start_load(args.background_load)
+    try:
+        with ThreadPoolExecutor(args.threads) as pool:
+            for run in runs:  # warm-up: compilation, templates, caches
+                _batch(pool, args.threads, run["obj"], run["pairs"], max(args.threads, 2))
+            load_before = os.getloadavg()[0]
+            for _ in range(args.repeat):
+                for run in runs:
+                    cpu, wall = _batch(pool, args.threads, run["obj"], run["pairs"], batch)
+                    run["cpu"].append(1e3 * cpu / batch)
+                    run["wall"].append(1e3 * wall / batch)
+            load_after = os.getloadavg()[0]
+    finally:
+        _stop_load(load)
 
     rows = []
-    methods = METHODS if args.method == "all" else (args.method,)
-    for name in methods:
-        variants = [False, True] if name in ("minwarping", "warping2d") else [False]
-        for compass in variants:
-            method, steps = _plugin(name, args.size, args.steps, compass, geometry)
-            if compass:
-                method.config.compass_fraction = args.compass_fraction
-            prep_ms, _ = _time(partial(method.prepare, snap), max(3, args.repeat // 5), warmup=1)
-            s, c = method.prepare(snap), method.prepare(cur)
-            med, best = _time(partial(method.home_vector, s, c), args.repeat)
-            size = "x".join(map(str, args.size)) if name != "hiss" else "x".join(map(str, args.render_size))
-            rows.append((name, size, steps, f"{args.compass_fraction:g}" if compass else "no",
-                         f"{med:.2f}", f"{best:.2f}", f"{prep_ms:.2f}", str(numba.get_num_threads())))
-    header = ("method", "image", "steps", "compass acc.", "ms/home vector (median)", "ms (min)",
-              "prepare ms/image", "threads")
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
-    line = lambda cells: "| " + " | ".join(c.ljust(w) for c, w in zip(cells, widths)) + " |"  # noqa: E731
+    for run in runs:
+        rows.append({
+            "method": run["method"],
+            "variant": run["variant"],
+            "threads": args.threads,
+            "cpu_ms_per_home_vector": round(float(np.median(run["cpu"])), 3),
+            "wall_ms_per_home_vector": round(float(np.median(run["wall"])), 3),
+            "cpu_ms_min": round(float(np.min(run["cpu"])), 3),
+            "wall_ms_min": round(float(np.min(run["wall"])), 3),
+            "prepare_cpu_ms_per_image": round(run["prepare_cpu_ms"], 3),
+            "image": "x".join(map(str, args.size if run["method"] != "hiss" else args.render_size)),
+            "steps": run["steps"],
+            "compass_fraction": args.compass_fraction if "compass" in run["variant"] else None,
+            "rounds": args.repeat,
+            "home_vectors_per_round": batch,
+            "background_load": args.background_load,
+            "loadavg_1min": [round(load_before, 2), round(load_after, 2)],
+            "machine": f"{platform.machine()} {os.cpu_count()} cpus",
+        })
+    if args.json:
+        for row in rows:
+            print(json.dumps(row))
+        return 0
+    header = ("method", "variant", "image", "steps", "threads", "CPU ms/hv (median)", "CPU ms (min)",
+              "wall ms/hv (median)", "wall ms (min)", "prepare CPU ms/image")
+    cells = [(r["method"], r["variant"], r["image"], r["steps"], str(r["threads"]),
+              f"{r['cpu_ms_per_home_vector']:.2f}", f"{r['cpu_ms_min']:.2f}",
+              f"{r['wall_ms_per_home_vector']:.2f}", f"{r['wall_ms_min']:.2f}",
+              f"{r['prepare_cpu_ms_per_image']:.2f}") for r in rows]
+    widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
+    line = lambda cs: "| " + " | ".join(c.ljust(w) for c, w in zip(cs, widths)) + " |"  # noqa: E731
     print(line(header))
     print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
-    for r in rows:
-        print(line(r))
+    for c in cells:
+        print(line(c))
+    print(f"load average (1 min) {rows[0]['loadavg_1min'][0]} -> {rows[0]['loadavg_1min'][1]}, "
+          f"background load {args.background_load}, {rows[0]['machine']}")
     return 0
 
 

@@ -5,6 +5,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
+from bionav.validation import Range, bounded
+
+#: largest image side (pixels) a database or unfolded image may have
+MAX_IMAGE_SIDE = 16384
+#: largest grid side (cells) of a database
+MAX_GRID_SIDE = 10_000
+
 
 @dataclass
 class UnfoldConfig:
@@ -16,10 +23,10 @@ class UnfoldConfig:
     """
 
     enabled: bool = False
-    center: Optional[list[float]] = None
-    inner_radius: float = 0.0
-    outer_radius: float = 0.0
-    size: list[int] = field(default_factory=lambda: [288, 50])
+    center: Optional[list[float]] = bounded(None, length=2, item=Range(ge=0.0, le=100_000.0))
+    inner_radius: float = bounded(0.0, ge=0.0, le=100_000.0)
+    outer_radius: float = bounded(0.0, ge=0.0, le=100_000.0)
+    size: list[int] = bounded([288, 50], length=2, item=Range(ge=2, le=MAX_IMAGE_SIDE))
 
 
 @dataclass
@@ -31,20 +38,22 @@ class DatabaseConfig:
     """
 
     name: str = "sim_original"
-    source: str = "synthetic"  # synthetic | folder
+    source: str = bounded("synthetic", choices=("synthetic", "folder"))
     path: Optional[str] = None  # folder databases: the directory
-    image_size: Optional[list[int]] = None  # [W, H]; None keeps the native size
-    seed: int = 0  # synthetic worlds: which world of this kind
-    noise: float = 0.01  # synthetic: camera noise std before 8-bit quantisation
-    naming: str = "auto"  # auto | vardy | moeller | csv
-    azimuth: str = "clockwise"  # how azimuth grows with the column index on disk
-    x_axis_column: float = 0.0  # on-disk column that looks along the grid's +x axis
-    horizon_row: Optional[float] = None  # on-disk horizon row; None = middle row
-    rad_per_row: Optional[float] = None  # vertical angle per pixel; None = same as horizontal
-    spacing_m: float = 0.3
-    grid_shape: Optional[list[int]] = None  # [nx, ny]; None = bounding box of the cells found
-    on_bad_image: str = "error"  # error | skip
+    image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=2, le=MAX_IMAGE_SIDE))  # [W, H]; None: native
+    seed: int = bounded(0, ge=0, le=2**32 - 1)  # synthetic worlds: which world of this kind
+    noise: float = bounded(0.01, ge=0.0, le=1.0)  # synthetic: camera noise std before 8-bit quantisation
+    naming: str = bounded("auto", choices=("auto", "vardy", "moeller", "csv"))
+    # how azimuth grows with the column index on disk
+    azimuth: str = bounded("clockwise", choices=("clockwise", "counterclockwise", "cw", "ccw", "anticlockwise",
+                                                 "counter-clockwise"))
+    x_axis_column: float = bounded(0.0, ge=-100_000.0, le=100_000.0)  # on-disk column along the grid's +x axis
+    horizon_row: Optional[float] = bounded(None, ge=-100_000.0, le=100_000.0)  # on-disk horizon row; None = middle
+    rad_per_row: Optional[float] = bounded(None, gt=0.0, le=1.0)  # vertical angle per pixel; None = horizontal's
+    spacing_m: float = bounded(0.3, gt=0.0, le=1000.0)
+    grid_shape: Optional[list[int]] = bounded(None, length=2, item=Range(ge=1, le=MAX_GRID_SIDE))  # None: bounding box
+    on_bad_image: str = bounded("error", choices=("error", "skip"))
     rotate_current: bool = False  # Vardy's protocol: random rotation of each current view
-    rotation_seed: int = 0
+    rotation_seed: int = bounded(0, ge=0, le=2**32 - 1)
     unfold: UnfoldConfig = field(default_factory=UnfoldConfig)
     extra: dict[str, Any] = field(default_factory=dict)

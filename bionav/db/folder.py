@@ -26,7 +26,7 @@ from bionav.db.config import DatabaseConfig
 from bionav.db.conventions import azimuth_sign, to_canonical
 from bionav.db.database import ImageDatabase
 from bionav.db.imageio import ImageReadError, read_image
-from bionav.db.naming import Entry, scan_folder
+from bionav.db.naming import Entry, not_a_file_reason, scan_folder
 from bionav.db.unfold import unfold_panorama
 from bionav.errors import UserError
 from bionav.geometry import TWO_PI, PanoramaGeometry
@@ -104,6 +104,7 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
 
     entries = sorted(scan.entries, key=lambda e: (e.x, e.y, e.path.name))
     nx, ny = _grid_shape(cfg, scan, entries)
+    _check_grid_extent(cfg, folder, entries, nx, ny)
     skipped: list[str] = []
 
     def bad(entry: Entry, problem: str, fix: str) -> None:
@@ -133,6 +134,10 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
     unfold = cfg.unfold
     frames, kept = [], []
     for entry in inside:
+        not_file = not_a_file_reason(entry.path)
+        if not_file:
+            bad(entry, not_file, "replace it by the image file or remove it")
+            continue
         try:
             frames.append(read_image(entry.path))
             kept.append(entry)
@@ -177,8 +182,19 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
     if scan.meta.get("w") not in (None, width) and not (unfold is not None and unfold.enabled):
         log.warning("%s: the .db file says w=%s but the images are %d pixels wide",
                     folder, scan.meta.get("w"), width)
+    n_cells = nx * ny
+    n_present = len({(e.x, e.y) for e in kept})
+    missing_text = (f", {n_cells - n_present} missing (the agent uses the nearest existing cell)"
+                    if n_present < n_cells else ", none missing")
+    (log.warning if n_present < n_cells or skipped else log.info)(
+        "database %r from %s: %d of %d grid cells (%d x %d) have an image%s%s",
+        cfg.name, folder, n_present, n_cells, nx, ny, missing_text,
+        f"; {len(skipped)} file(s) skipped: {', '.join(skipped[:5])}" if skipped else "",
+    )
     meta = {
         "source": "folder",
+        "n_cells": n_cells,
+        "n_missing_cells": n_cells - n_present,
         "path": str(folder),
         "naming": scan.scheme,
         "files": [e.path.name for e in kept],
@@ -198,6 +214,29 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
         raw=raw,
         meta=meta,
     )
+
+
+#: largest number of grid cells a database may span (arrays of one value per cell are allocated)
+MAX_GRID_CELLS = 4_000_000
+
+
+def _check_grid_extent(cfg: DatabaseConfig, folder: Path, entries: list[Entry], nx: int, ny: int) -> None:
+    """Refuse a grid so large that per-cell arrays would exhaust memory (a stray ``99999_99999.png``)."""
+    from bionav.validation import check_allocation, format_bytes
+
+    cells = nx * ny
+    far = max(entries, key=lambda e: max(e.x, e.y), default=None) if entries else None
+    culprit = (f" The largest index comes from {far.path.name} (cell ({far.x}, {far.y}))"
+               if far is not None and cfg.grid_shape is None else "")
+    fix = ("remove or rename the stray file, or declare the grid with db.grid_shape=[nx,ny] "
+           "(files outside it are then an error, or skipped with db.on_bad_image=skip)")
+    if cells > MAX_GRID_CELLS:
+        raise UserError(
+            f"database {cfg.name!r} in {folder} would span a {nx} x {ny} grid ({cells} cells, "
+            f"{format_bytes(8.0 * cells)} per per-cell array), more than the {MAX_GRID_CELLS} cells bionav "
+            f"handles.{culprit}; {fix}."
+        )
+    check_allocation(64.0 * cells, what=f"the per-cell arrays of a {nx} x {ny} grid", fix=fix)
 
 
 def _unfold_all(frames, unfold, first_path: Path) -> list[np.ndarray]:

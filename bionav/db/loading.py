@@ -28,8 +28,10 @@ def as_database_config(cfg) -> DatabaseConfig:
     UserError
         Unknown keys or values of the wrong type (message names the key).
     """
+    from bionav.validation import check_config
+
     if isinstance(cfg, DatabaseConfig):
-        return cfg
+        return check_config(cfg, prefix="db")
     from omegaconf import OmegaConf
     from omegaconf.errors import OmegaConfBaseException
 
@@ -37,12 +39,13 @@ def as_database_config(cfg) -> DatabaseConfig:
         if OmegaConf.is_config(cfg):  # resolve ${data_dir} etc. against the full config first
             cfg = OmegaConf.to_container(cfg, resolve=True)
         merged = OmegaConf.merge(OmegaConf.structured(DatabaseConfig), cfg)
-        return OmegaConf.to_object(merged)
+        config = OmegaConf.to_object(merged)
     except OmegaConfBaseException as exc:
         key = getattr(exc, "full_key", None)
         where = f"db.{key}" if key else "a db.* value"
         raise UserError(f"invalid db configuration, {where}: {str(exc).splitlines()[0]}; "
                         f"fix {where} (see the DatabaseConfig fields in bionav/db/config.py).") from None
+    return check_config(config, prefix="db")
 
 
 def _missing_folder_message(cfg: DatabaseConfig, folder: Path, data_dir: Path) -> str:
@@ -121,9 +124,26 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
         db = load_folder(cfg, folder)
     else:
         raise UserError(f"db.source={cfg.source!r} is not a database source; use synthetic or folder.")
+    _check_image_memory(db, size)
     db = preprocess_database(db, preprocess)
     if size is not None:
         db = resize_database(db, size)
     if source == "folder" and cfg.rotate_current:
         db = rotate_views(db, seed=cfg.rotation_seed)
     return db
+
+
+def _check_image_memory(db: ImageDatabase, size) -> None:
+    """Refuse a ``db.image_size`` whose images would not fit in memory (before resizing)."""
+    if size is None:
+        return
+    from bionav.validation import check_allocation
+
+    w, h = size
+    # the resized stack, the native stack and one working copy (float32)
+    nbytes = 4.0 * len(db) * (w * h + 2 * db.geometry.width * db.geometry.height)
+    check_allocation(
+        nbytes,
+        what=f"resizing the {len(db)} images of database {db.name!r} to db.image_size=[{w},{h}]",
+        fix="choose a smaller db.image_size=[W,H] (the thesis uses up to [600,100])",
+    )

@@ -11,20 +11,23 @@ Three schemes are understood (``db.naming``):
     ``cv_<x>_<y>_bw<cutoff>.pgm`` (Möller's databases, e.g. *moeller1*,
     *roeben1*; ``<cutoff>`` is the Butterworth cutoff the images were filtered
     with) plus one metadata file ``*.db`` holding one line
-    ``w xmin xmax ymin ymax vertRes horizon``. The file's x index runs the
-    other way than Vardy's, so bionav's grid cell is
+    ``w xmin xmax ymin ymax vertRes horizon``. The file indices are grid
+    coordinates shifted by the declared minimum, in the same directions:
 
-        gx = xmax - x,   gy = y - ymin
+        gx = x - xmin,   gy = y - ymin
 
-    (``x = xmax`` is grid column 0, ``x = xmin`` the last one; ``y`` keeps its
-    direction). The grid is ``(xmax - xmin + 1) x (ymax - ymin + 1)`` cells.
-    ``vertRes`` is the vertical angle per pixel (taken as radians if it is
+    and the grid is ``(xmax - xmin + 1) x (ymax - ymin + 1)`` cells. This is
+    how Möller's reference min-warping program reads these databases
+    (WarpingSIMD, ``warpingSIMDTest.C``: image ``cv_<x + xmin>_<y + ymin>`` is
+    grid cell ``(x, y)``, true home direction ``atan2(y_ss - y, x_ss - x)``,
+    image columns growing with clockwise azimuth, column 0 along grid +x), so
+    the presets keep the Bielefeld column convention (``db.azimuth=clockwise``,
+    ``db.x_axis_column=0``). ``vertRes`` is the vertical angle per pixel (taken as radians if it is
     below 0.1, else as degrees: no plausible panorama has more than 0.1 rad or
     less than 0.1 degrees per row), ``horizon`` the horizon row. ``w`` is kept
     in the metadata (it is expected to equal the image width; a mismatch is
     logged). If a folder holds several cutoffs, ``db.extra.bw_cutoff`` picks one.
-    Without a ``.db`` file, ``xmax`` is the last column of ``db.grid_shape`` (or
-    the largest x found) and ``ymin = 0``.
+    Without a ``.db`` file the indices are used as they are (``xmin = ymin = 0``).
 
 ``csv``
     A file ``positions.csv`` (or the only ``*.csv`` of the folder) with rows
@@ -82,9 +85,40 @@ def _natural_key(name: str):
     return [int(tok) if tok.isdigit() else tok.lower() for tok in re.split(r"(\d+)", name)]
 
 
+def _named_like_image(path: Path) -> bool:
+    return bool(VARDY_PATTERN.match(path.name) or MOELLER_PATTERN.match(path.name))
+
+
 def _listing(folder: Path) -> list[Path]:
-    return sorted((p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")),
+    """Regular files of a folder, plus anything named like a database image.
+
+    A directory, broken symlink or symlink loop named ``1_1.png`` is kept, so
+    the loader reports it instead of silently dropping its grid cell.
+    """
+    return sorted((p for p in folder.iterdir()
+                   if not p.name.startswith(".") and (p.is_file() or _named_like_image(p))),
                   key=lambda p: _natural_key(p.name))
+
+
+def not_a_file_reason(path: Path) -> str | None:
+    """Why ``path`` is not a readable regular file (directory, symlink loop, ...), or None."""
+    import errno
+    import os
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return "is a symbolic-link loop"
+        if path.is_symlink():
+            return f"is a symbolic link to {os.readlink(path)!r}, which does not exist"
+        return f"cannot be accessed ({exc.strerror or exc})"
+    if stat.S_ISDIR(mode):
+        return "is a directory, not an image file"
+    if not stat.S_ISREG(mode):
+        return "is not a regular file (a device, pipe or socket)"
+    return None
 
 
 def describe_schemes() -> str:
@@ -104,8 +138,7 @@ def scan_folder(folder: Path, *, naming: str = "auto", grid_shape=None, bw_cutof
     naming : {"auto", "vardy", "moeller", "csv"}
         Naming scheme; ``auto`` detects it (see the module docstring).
     grid_shape : sequence of 2 int, optional
-        Declared ``(nx, ny)``; only used to mirror Möller x indices when the
-        folder has no ``.db`` file.
+        Declared ``(nx, ny)`` (kept for callers; the schemes do not need it).
     bw_cutoff : float or str, optional
         Möller naming: which Butterworth cutoff to read if several are present.
 
@@ -207,7 +240,7 @@ def read_moeller_db(path: Path) -> dict:
 
 def _scan_moeller(folder: Path, files: list[Path], *, grid_shape, bw_cutoff) -> Scan:
     matched, ignored = [], []
-    db_files = [p for p in files if p.suffix.lower() == ".db" and not _quiet(p)]
+    db_files = [p for p in files if p.suffix.lower() == ".db" and p.is_file() and not _quiet(p)]
     for path in files:
         match = MOELLER_PATTERN.match(path.name)
         if match:
@@ -243,16 +276,14 @@ def _scan_moeller(folder: Path, files: list[Path], *, grid_shape, bw_cutoff) -> 
         info = read_moeller_db(db_files[0])
         meta["db_file"] = db_files[0].name
         meta.update(info)
-        xmax, ymin = info["xmax"], info["ymin"]
+        xmin, ymin = info["xmin"], info["ymin"]
         shape = (info["xmax"] - info["xmin"] + 1, info["ymax"] - info["ymin"] + 1)
         horizon, rad_per_row = info["horizon"], info["rad_per_row"]
     else:
-        ymin = 0
-        xs = [m[1] for m in matched]
-        xmax = int(grid_shape[0]) - 1 if grid_shape is not None else (max(xs) if xs else 0)
+        xmin = ymin = 0
         meta["db_file"] = None
-    meta["x_mirror"] = f"gx = {xmax} - x, gy = y - {ymin}"
-    entries = [Entry(path, xmax - x, y - ymin) for path, x, y, _ in matched]
+    meta["index_map"] = f"gx = x - {xmin}, gy = y - {ymin}"
+    entries = [Entry(path, x - xmin, y - ymin) for path, x, y, _ in matched]
     return Scan("moeller", entries, ignored, shape, horizon, rad_per_row, meta)
 
 
@@ -306,7 +337,7 @@ def _scan_csv(folder: Path, files: list[Path]) -> Scan:
         rows = rows[1:]
     width = max(len(r) for r in rows) if rows else 0
     has_files = "filename" in columns and columns["filename"] < width
-    images = [p for p in files if p.suffix.lower() in IMAGE_EXTENSIONS]
+    images = [p for p in files if p.suffix.lower() in IMAGE_EXTENSIONS and p.is_file()]
     if not has_files and len(images) != len(rows):
         raise UserError(
             f"{table} has {len(rows)} position rows without file names, but {folder} holds "

@@ -260,6 +260,13 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     geometry = spec.geometry(w, h)
     world = spec.builder(int(seed))
     positions = np.argwhere(world.cells).astype(np.int64)
+    from bionav.validation import check_allocation
+
+    check_allocation(  # float32 render buffer plus the 8-bit images
+        5.0 * len(positions) * w * h,
+        what=f"rendering the {len(positions)} images of {name!r} at db.image_size=[{w},{h}]",
+        fix="choose a smaller db.image_size=[W,H] (the thesis uses up to [600,100])",
+    )
     if world.grid_shape != spec.grid_shape:
         raise RuntimeError(f"{name}: world grid {world.grid_shape} differs from table {spec.grid_shape}")
     compiled_digest = world.scene.compile().digest()

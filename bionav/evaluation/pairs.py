@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
@@ -41,6 +41,8 @@ class HomeVectorMatrix:
         Wall time of the per-image work and of the pair computations.
     n_pairs : int
         Number of home vectors computed.
+    prepared_stats : dict
+        :meth:`HomingMethod.describe_prepared` averaged over the current views.
     """
 
     snapshot_index: np.ndarray
@@ -49,6 +51,7 @@ class HomeVectorMatrix:
     prepare_s: float
     pairs_s: float
     n_pairs: int
+    prepared_stats: dict = field(default_factory=dict)
 
     @property
     def ms_per_home_vector(self) -> float:
@@ -197,6 +200,8 @@ def home_vector_matrix(
     angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))
     compass = np.array([r[1] for r in rows]).reshape(len(s_idx), len(currents))
     has_compass = bool(np.any(np.isfinite(compass)))
+    described = [method.describe_prepared(p) for p in cur_prep]
+    stats = {k: float(np.mean([d[k] for d in described])) for k in (described[0] if described else {})}
     return HomeVectorMatrix(
         snapshot_index=s_idx,
         angles=angles,
@@ -204,4 +209,5 @@ def home_vector_matrix(
         prepare_s=t1 - t0,
         pairs_s=t2 - t1,
         n_pairs=n_pairs,
+        prepared_stats=stats,
     )

@@ -38,11 +38,12 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
+from bionav.experiments.configs import experiment_config
 from bionav.robot.controller import LanePlan
 from bionav.robot.kinematics import Pose
 
-#: seconds between the log times of consecutive runs' first ticks (runs are laid end to end)
-RUN_SPACING_NS = 100_000 * 1_000_000_000
+#: log time between one run's last tick and the next run's first (runs are laid end to end after the log's start)
+RUN_GAP_NS = 1_000_000_000
 
 
 @dataclass
@@ -115,7 +116,7 @@ def rendered_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
     from bionav.robot.floorplan import floorplan_from_scene
     from bionav.robot.worldview import load_world, place_plan, render_camera
 
-    ex = cfg.experiment
+    ex = experiment_config(cfg, "cleaning")
     world = load_world(str(ex.world), seed=int(ex.world_seed))
     cam = ex.camera
     geometry = PanoramaGeometry.square_pixels(
@@ -183,7 +184,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
     from bionav.robot.recording import RESULT_TOPIC, EpisodeRecorder
     from bionav.robot.simulator import SimulatedRobot, run_episode
 
-    ex = cfg.experiment
+    ex = experiment_config(cfg, "cleaning")
     runs = int(ex.runs)
     if runs < 1:
         raise UserError(f"runs must be at least 1, got {runs}; set runs=10 as in the thesis.")
@@ -196,6 +197,8 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
     errors = wheel_errors(runs, float(ex.wheel_error))
     seeds = ctx.rng.integers(0, 2**31 - 1, size=(runs, 3))
     results = []
+    # log times: the log's wall-clock start plus simulated time (Foxglove shows real dates, not 1970)
+    offset_ns = int(getattr(ctx.log, "start_ns", None) or time.time_ns())
     for k in ctx.progress(range(runs), desc="cleaning runs", total=runs):
         controller = make_controller()
         controller_seed, camera_seed, sim_seed = (int(s) for s in seeds[k])
@@ -211,7 +214,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
             radius=float(ex.robot_radius), confine=confine, camera=camera, rng=sim_rng)
         controller.reset(plan, homing=homing if controller.uses_camera else None,
                          rng=np.random.default_rng(controller_seed))
-        recorder = EpisodeRecorder(ctx.log, k, time_offset_ns=k * RUN_SPACING_NS, log_images=bool(ex.log_images))
+        recorder = EpisodeRecorder(ctx.log, k, time_offset_ns=offset_ns, log_images=bool(ex.log_images))
         recorder.start({
             "controller": str(cfg.controller.name),
             "controller_config": asdict(controller.config),
@@ -242,6 +245,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
                                      "fixes": len(fixes), "accepted_fixes": len(accepted), "seconds": seconds},
                       schema_name="bionav.CleaningResult", log_time_ns=recorder.last_time_ns)
         results.append(RunResult(k, errors[k], episode, counts, fractions, fixes, truth, seconds))
+        offset_ns = recorder.last_time_ns + RUN_GAP_NS
     return results
 
 
@@ -288,7 +292,7 @@ def make_oracle_homing(cfg: DictConfig):
     """The oracle homing method of ``experiment.oracle`` (noisy home vectors from true geometry)."""
     from bionav.robot.oracle import GeometricHoming, GeometricHomingConfig
 
-    node = cfg.experiment.oracle
+    node = experiment_config(cfg, "cleaning").oracle
     return GeometricHoming(GeometricHomingConfig(angle_noise_deg=float(node.angle_noise_deg),
                                                  compass_noise_deg=float(node.compass_noise_deg),
                                                  seed=int(cfg.seed)))
@@ -296,7 +300,7 @@ def make_oracle_homing(cfg: DictConfig):
 
 def make_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
     """The :class:`CleaningWorld` that ``cfg.experiment.vision`` asks for."""
-    vision = str(cfg.experiment.vision)
+    vision = str(experiment_config(cfg, "cleaning").vision)
     if vision not in ("render", "oracle"):
         raise UserError(f"experiment.vision must be 'render' or 'oracle', got {vision!r}.")
     return rendered_world(cfg, plan) if vision == "render" else oracle_world(plan)
@@ -304,7 +308,7 @@ def make_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
 
 def make_vision_homing(cfg: DictConfig, world: CleaningWorld):
     """The homing method of a run: ``cfg.homing`` on rendered images, or the oracle."""
-    if str(cfg.experiment.vision) == "oracle":
+    if str(experiment_config(cfg, "cleaning").vision) == "oracle":
         return make_oracle_homing(cfg)
     from bionav.config import plugin_config
 
@@ -360,7 +364,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.robot.coverage import Raster, coverage_fractions, sweep_counts
     from bionav.robot.lanes import ideal_meander
 
-    ex = cfg.experiment
+    ex = experiment_config(cfg, "cleaning")
     if cfg.get("layout") is None:
         raise UserError("experiment=cleaning needs a layout; choose layout=long_lanes or layout=short_lanes.")
     if cfg.get("controller") is None or not cfg.controller.get("name"):

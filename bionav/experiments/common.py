@@ -19,12 +19,22 @@ def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageD
     node = cfg.db if node is None else node
     if isinstance(node, DictConfig):
         node = OmegaConf.to_container(node, resolve=True)  # resolve ${data_dir} against the whole config
-    return load_database(
+    db = load_database(
         node,
         data_dir=Path(str(cfg.data_dir)),
         cache_dir=Path(str(cfg.cache_dir)),
         preprocess=preprocess,
     )
+    if len(db) < 2:
+        from bionav.errors import UserError
+
+        where = db.meta.get("path") or db.name
+        raise UserError(
+            f"database {db.name!r} ({where}) has {len(db)} usable image(s); homing needs at least 2 "
+            "(a snapshot and a current view), so there are no image pairs to evaluate. Add images "
+            "(and check db.grid_shape and the warnings about skipped files)."
+        )
+    return db
 
 
 def make_homing(cfg: DictConfig, ctx, geometry):

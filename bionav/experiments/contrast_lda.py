@@ -18,6 +18,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.experiments.common import _get, load_samples
+from bionav.experiments.configs import experiment_config
 
 #: Names ``data=`` accepts.
 DATASETS = ("sim_natural", "sim_artificial", "csv")
@@ -94,7 +95,7 @@ SAMPLE_SCHEMA = {
 
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "contrast_lda")
     data = _get(cfg, "data", None)
     if data is None:
         raise UserError("experiment=contrast_lda needs a data set: data=sim_natural, data=sim_artificial or "
@@ -105,6 +106,6 @@ def run(cfg, ctx) -> dict:
                                      **{ch: float(v) for ch, v in zip(("uv", "b", "g", "r", "ir"), c)}},
                       schema_name="bionav.Spectral5Sample", schema=SAMPLE_SCHEMA)
     title = f"{samples.name}: {samples.n_objects} objects, {samples.n_sky} sky"
-    return analyse(samples, sigma=float(_get(exp, "sigma", 30.0)), n_resamples=int(_get(exp, "n_resamples", 10000)),
+    return analyse(samples, sigma=float(exp.sigma), n_resamples=int(exp.n_resamples),
                    rng=ctx.rng, out_dir=ctx.dir, plots_dir=ctx.plots, title=title,
-                   plots=bool(_get(exp, "plots", True)))
+                   plots=bool(exp.plots))

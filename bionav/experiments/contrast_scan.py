@@ -28,6 +28,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.experiments.common import _get, load_samples
+from bionav.experiments.configs import experiment_config
 from bionav.light.sun import parse_time
 
 SCAN_TOPIC = "/contrast_scan/scan"
@@ -63,16 +64,16 @@ def run(cfg, ctx) -> dict:
     from bionav.spectral.scan import DirectPanTilt, ScanGrid, run_scan
     from bionav.spectral.scene import backyard_scene
 
-    exp = cfg.experiment
-    times = [parse_time(str(t), what="experiment.times entry", naive_utc=False) for t in _get(exp, "times", [])]
+    exp = experiment_config(cfg, "contrast_scan")
+    times = [parse_time(str(t), what="experiment.times entry", naive_utc=False) for t in exp.times]
     if not times:
         raise UserError("experiment.times is empty; give the scan times, e.g. experiment.times=[2009-06-17T11:27:04+02:00].")
     n_scans = len(times)
     grid = ScanGrid.from_steps(
-        n_pan=int(_get(exp, "n_pan", 113)), pan_step=np.deg2rad(float(_get(exp, "pan_step_deg", 2.0))),
-        n_tilt=int(_get(exp, "n_tilt", 26)), tilt_step=np.deg2rad(float(_get(exp, "tilt_step_deg", 3.0))),
-        tilt_start=np.deg2rad(float(_get(exp, "tilt_start_deg", -45.0))),
-        pan_centre=np.deg2rad(float(_get(exp, "pan_centre_deg", 0.0))),
+        n_pan=int(exp.n_pan), pan_step=np.deg2rad(float(exp.pan_step_deg)),
+        n_tilt=int(exp.n_tilt), tilt_step=np.deg2rad(float(exp.tilt_step_deg)),
+        tilt_start=np.deg2rad(float(exp.tilt_start_deg)),
+        pan_centre=np.deg2rad(float(exp.pan_centre_deg)),
     )
     sensor_node = _get(cfg, "sensor")
     if not sensor_node:
@@ -86,21 +87,21 @@ def run(cfg, ctx) -> dict:
         raise UserError("A real sensor needs a real pan-tilt unit for experiment=contrast_scan: add pantilt=ptu46 "
                         "pantilt.port=/dev/ttyUSB1 (or use sensor=spectral5_sim for a simulated scan).")
 
-    covers = _get(exp, "cloud_cover", [0.5])
-    depths = _get(exp, "cloud_optical_depth", [30.0])
-    scan_s = 60.0 * float(_get(exp, "scan_minutes", 20.0))
-    cloud_seed = int(_get(exp, "cloud_seed", 0))
+    covers = exp.cloud_cover
+    depths = exp.cloud_optical_depth
+    scan_s = 60.0 * float(exp.scan_minutes)
+    cloud_seed = int(exp.cloud_seed)
     t0 = times[0]
 
     def sky_at(k, t):
         clouds = CloudLayer(cover=_per_scan(covers, k, n_scans, "cloud_cover"),
                             optical_depth=_per_scan(depths, k, n_scans, "cloud_optical_depth"), seed=cloud_seed)
         return SkyState.from_time(t, clouds=clouds, time_s=(t - t0).total_seconds(),
-                                  turbidity=float(_get(exp, "turbidity", 0.1)))
+                                  turbidity=float(exp.turbidity))
 
     scene = None
     if simulated:
-        scene = backyard_scene(sky_at(0, t0), seed=int(_get(exp, "scene_seed", 0)))
+        scene = backyard_scene(sky_at(0, t0), seed=int(exp.scene_seed))
         for device in (sensor, pantilt):
             if hasattr(device, "attach_simulation"):
                 device.attach_simulation(scene, ctx.rng)
@@ -155,10 +156,9 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     from bionav.spectral.scan import separation_images, stability_series
     from bionav.spectral.stability import MEASURES
 
-    exp = cfg.experiment
-    sigma = float(_get(exp, "sigma", 30.0))
-    learn = _get(exp, "learn", None) or {"name": "sim_natural", "seed": int(_get(cfg, "seed", 0))}
-    disc = learn_discriminants(load_samples(learn), sigma=sigma)
+    exp = experiment_config(cfg, "contrast_scan")
+    sigma = float(exp.sigma)
+    disc = learn_discriminants(load_samples(exp.learn), sigma=sigma)
     names = list(CHANNELS) + list(dual_contrasts())
     np.savez_compressed(ctx.dir / "scans.npz", counts=scans, times=np.array([t.isoformat() for t in times]),
                         pans=grid.pans, tilts=grid.tilts)
@@ -169,7 +169,7 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
         for r in rows:
             w.writerow({**r, "time": times[r["scan"]].isoformat()})
     hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
-    if bool(_get(exp, "plots", True)):
+    if bool(exp.plots):
         _plots(scans, times, hours, rows, disc, names, ctx.plots)
     metrics: dict = {"n_scans": int(len(scans)), "n_readings": int(scans.shape[0] * scans.shape[1] * scans.shape[2])}
     if len(scans) > 1:

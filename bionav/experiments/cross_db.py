@@ -19,6 +19,7 @@ from bionav.evaluation.agent import evaluate_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix, prepare_images
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
+from bionav.experiments.configs import experiment_config
 from bionav.report.figures import pyplot, save_figure
 
 #: settings of cfg.db that apply to every member of the family
@@ -40,7 +41,7 @@ def db_preset(name: str) -> dict:
 def family_nodes(cfg: DictConfig) -> list[dict]:
     shared = {k: OmegaConf.to_container(cfg.db, resolve=True).get(k) for k in SHARED_DB_KEYS}
     nodes = []
-    for name in cfg.experiment.family:
+    for name in experiment_config(cfg, "cross_db").family:
         node = db_preset(str(name))
         node.update({k: v for k, v in shared.items() if v is not None})
         if isinstance(node.get("path"), str) and "${data_dir}" in node["path"]:
@@ -73,7 +74,7 @@ def _plot(path, matrices: dict[str, np.ndarray], names: list[str], title: str) -
 
 
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "cross_db")
     nodes = family_nodes(cfg)
     names = [str(n) for n in exp.family]
     dbs = [load_configured_database(cfg, node) for node in ctx.progress(nodes, desc="databases")]

@@ -18,6 +18,7 @@ from bionav.evaluation.agent import evaluate_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
+from bionav.experiments.configs import experiment_config
 
 HOME_VECTOR_SCHEMA = {
     "type": "object",
@@ -42,10 +43,17 @@ def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.homing_plots import plot_home_vector_field, plot_per_snapshot_maps
 
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "grid_homing")
     db = load_configured_database(cfg)
     method = make_homing(cfg, ctx, db.geometry)
-    snapshots = None if exp.get("snapshots") is None else list(exp.snapshots)
+    snapshots = None if exp.snapshots is None else list(exp.snapshots)
+    if snapshots is not None and max(snapshots) >= len(db):
+        from bionav.errors import UserError
+
+        raise UserError(
+            f"bad value experiment.snapshots={snapshots}: database {db.name!r} has {len(db)} images, so the "
+            f"snapshot indices must be 0..{len(db) - 1}; drop the larger ones (null = every image)."
+        )
     hv = home_vector_matrix(
         method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
         cache=prepared_cache(cfg),
@@ -103,6 +111,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "n_pairs": hv.n_pairs,
         "ms_per_home_vector": hv.ms_per_home_vector,
     }
+    metrics.update({f"{k}_per_image": v for k, v in hv.prepared_stats.items()})
     if hv.compass_error is not None:
         metrics["compass_aae"] = float(np.nanmean(np.abs(hv.compass_error)))
     return metrics

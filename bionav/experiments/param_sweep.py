@@ -42,6 +42,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.evaluation.pairs import home_vector_matrix
+from bionav.experiments.configs import experiment_config
 from bionav.report.figures import pyplot, save_figure
 
 ROWS_FILE = "param_sweep.jsonl"
@@ -136,7 +137,7 @@ def _finite(x: float) -> float | None:
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.common import load_configured_database
 
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "param_sweep")
     homing_cls, homing_cfg, sig_name, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
     db = load_configured_database(cfg)
     levels = sweep_levels(sig_cls, rings=list(exp.rings), n_coeffs=list(exp.n_coeffs))

@@ -41,6 +41,7 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
+from bionav.experiments.configs import experiment_config
 from bionav.experiments.pol_compass_session import (
     SESSION_SCHEMA,
     SESSION_TOPIC,
@@ -81,7 +82,7 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir):
     elif how == "rotation":
         cal = calibrate_from_rotation(volts, pans, nominal=nominal)
     elif how == "file":
-        if not exp.get("calibration_path"):
+        if not exp.calibration_path:
             raise UserError("experiment.calibration=file needs experiment.calibration_path=<calibration.json of a rotation run>.")
         cal = UnitCalibration.load(exp.calibration_path)
     else:
@@ -93,7 +94,7 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir):
 
 def _pan_grid(session: Session, exp, step_deg: float):
     lo, hi, tlo, thi = session.pantilt.limits()
-    rng = exp.get("pan_range_deg")
+    rng = exp.pan_range_deg
     if rng is not None:
         lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
     step = np.deg2rad(step_deg)
@@ -179,7 +180,7 @@ def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) 
     from bionav.polcompass import counts_to_volts, heading_errors, zenith_heading
 
     lo, hi, tlo, thi = session.pantilt.limits()
-    rng = exp.get("pan_range_deg")
+    rng = exp.pan_range_deg
     if rng is not None:
         lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
     positions = np.linspace(lo, hi, int(exp.vs_em.positions))
@@ -374,6 +375,8 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
         Where figures and tables go (``None``: none written).
     progress : callable, optional
     """
+    if not (isinstance(exp, DictConfig) and OmegaConf.get_type(exp) is not dict):  # defaults and ranges
+        exp = experiment_config(OmegaConf.create({"experiment": exp}), "pol_compass")
     mode = str(exp.mode)
     if mode not in MODES:
         raise UserError(f"mode {mode!r} is unknown; choose one of {', '.join(MODES)} (mode=<name>).")
@@ -410,6 +413,13 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
         schema=SESSION_SCHEMA,
     )
     session.record_pantilt_info()
+    if devices.get("decoder") is not None:  # recorded POL-OP array counts (sensor=recording, or its replay)
+        from bionav.experiments.pol_compass_recorded import recorded_rotation_mode
+
+        if mode != "rotation":
+            raise UserError(f"recorded array counts support mode=rotation only, not mode={mode}.")
+        return recorded_rotation_mode(session, exp, sensor_config=devices["array_config"], decoder=devices["decoder"],
+                                      plots=plots)
     unit_angles = np.deg2rad(np.asarray(list(exp.unit_angles_deg), float))
     if scene is not None and mode != "partial_sky":
         from bionav.light import PolarizerLamp
@@ -434,11 +444,27 @@ def _node_dict(node) -> dict | None:
     return OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
 
 
+def _recorded_array(node: dict) -> bool:
+    """Whether the sensor plays recorded POL-OP array counts (``sensor=recording`` or a replay of such a run)."""
+    if node.get("name") == "recording":
+        return True
+    if node.get("name") == "replay":
+        from bionav.experiments.pol_compass_recorded import is_array_reading
+        from bionav.plugins.sensors.replay import read_topics
+
+        try:
+            first = read_topics(node.get("path", "run.mcap")).get(node.get("topic") or "/sensor/raw", [None])[0]
+        except UserError:
+            return False  # the replay plugin reports the missing log itself
+        return is_array_reading(first)
+    return False
+
+
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     """Entry point called by :func:`bionav.experiments.runner.run_experiment`."""
     from bionav.polcompass import CompassScene
 
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "pol_compass")
     if cfg.get("sensor") is None or not cfg.sensor.get("name"):
         raise UserError("experiment=pol_compass needs a compass: sensor=polcompass_sim, polcompass_serial or replay.")
     nodes = {
@@ -449,9 +475,13 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     rng_scene, rng_sensor, rng_reference, rng_fakes = ctx.rng.spawn(4)
     from bionav import registry
 
+    recorded_array = _recorded_array(nodes["sensor"])
+    if recorded_array:
+        nodes["pantilt"] = None  # the recorded robot turned itself; its yaw is the reference
+
     classes = {role: registry.load_plugin("sensor", node["name"]) for role, node in nodes.items() if node is not None}
     simulated = any(getattr(c, "simulated", False) for c in classes.values())
-    fake_devices = bool(exp.get("fake_devices", False))
+    fake_devices = bool(exp.fake_devices)
     needs_scene = simulated or fake_devices or str(exp.mode) == "partial_sky"
     scene = None
     if needs_scene:
@@ -479,6 +509,12 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             plugin.open()
             stack.callback(plugin.close)
             devices[role] = plugin
+        if recorded_array:
+            from bionav.plugins.sensors.recording import RecordingConfig
+
+            cfg_dec = cfg.get("decoder")
+            devices["decoder"] = ctx.plugin("decoder", cfg_dec if cfg_dec is not None and cfg_dec.get("name") else {"name": "sky_fit"})
+            devices["array_config"] = devices["sensor"].config if nodes["sensor"]["name"] == "recording" else RecordingConfig()
         metrics = run_session(
             exp,
             devices,

@@ -47,12 +47,39 @@ def plot_rotation(path: Path, pans, heading, errors, *, axial: bool) -> None:
     save_figure(fig, path, dpi=120)
 
 
+def displayed_heading_deg(pol, tcm2, *, nearest: bool) -> np.ndarray:
+    """Polarized-light compass headings as figs. 4.4/4.5 show them, degrees.
+
+    Parameters
+    ----------
+    pol : ndarray
+        Compass headings, radians: the first candidate of eq. 4.6 (the other is
+        this plus pi).
+    tcm2 : ndarray
+        Electromagnetic compass headings, radians.
+    nearest : bool
+        True: show the candidate nearest the TCM2 (an axial comparison);
+        False: the raw first candidate wrapped to [-180, 180), which jumps by
+        180 degrees against the TCM2 as the thesis' fig. 4.5 does (the compass
+        cannot tell 0 from 180 degrees).
+    """
+    pol_deg = np.degrees(np.asarray(pol, float))
+    if not nearest:
+        return (pol_deg + 180.0) % 360.0 - 180.0
+    tcm2_deg = np.degrees(np.asarray(tcm2, float))
+    return (pol_deg - tcm2_deg + 90.0) % 180.0 - 90.0 + tcm2_deg
+
+
 def plot_vs_em(path: Path, pol, tcm2, *, averaged: bool) -> None:
-    """Polarized-light compass (blue) against the TCM2 (red), figs. 4.4 / 4.5 (axial display)."""
+    """Polarized-light compass (blue) against the TCM2 (red), figs. 4.4 / 4.5.
+
+    Fig. 4.4 (averaged) shows the candidate nearest the TCM2; fig. 4.5 (raw
+    samples) the raw first candidate of eq. 4.6, so its 0/180 degree ambiguity shows.
+    """
     plt, fig, ax = _figure(figsize=(7, 4))
     x = np.arange(len(pol))
-    tcm2_deg = np.degrees(tcm2)
-    pol_deg = (np.degrees(pol) - tcm2_deg + 90.0) % 180.0 - 90.0 + tcm2_deg  # show the candidate nearest the TCM2
+    tcm2_deg = np.degrees(tcm2) if averaged else (np.degrees(tcm2) + 180.0) % 360.0 - 180.0
+    pol_deg = displayed_heading_deg(pol, tcm2, nearest=averaged)
     style = ".-" if averaged else "."
     ax.plot(
         x, pol_deg, style, color="tab:blue", ms=4, label="polarized-light compass" + (" (mean of samples)" if averaged else "")

@@ -44,7 +44,7 @@ def plugin_versions(cfg: DictConfig) -> dict[str, str]:
     from bionav import registry
 
     out = {"bionav": __version__}
-    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller"}
+    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller", "decoder": "decoder"}
     for group, kind in kinds.items():
         node = cfg.get(group)
         if not node or not node.get("name"):
@@ -53,6 +53,56 @@ def plugin_versions(cfg: DictConfig) -> dict[str, str]:
         if entry is not None:
             out[f"{group}"] = f"{entry.name} ({entry.distribution} {entry.version})"
     return out
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` with every non-finite float (NaN, inf) replaced by ``None`` (JSON ``null``).
+
+    metrics.json must be strict JSON; a measure that is undefined (e.g. a
+    compass error when no pair had one) is written as ``null``.
+    """
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_safe(value.tolist())
+    if isinstance(value, (float, np.floating)):
+        return float(value) if np.isfinite(value) else None
+    return value
+
+
+#: config groups that select plugins, and the plugin kind each selects
+PLUGIN_NODES = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor",
+                "controller": "controller"}
+
+
+def validate_run_config(cfg: DictConfig) -> None:
+    """Check every value of a run's config against its declared type and range.
+
+    The selected plugins' nodes (``homing``, ``signature``, ``sensor``,
+    ``pantilt``, ``controller``), the ``db`` node and the experiment node are
+    each checked against their ``Config`` dataclass
+    (:func:`bionav.validation.check_config`).
+
+    Raises
+    ------
+    UserError
+        Naming the first bad key, its value and the allowed range.
+    """
+    from bionav.config import plugin_config
+    from bionav.db.loading import as_database_config
+    from bionav.experiments.configs import check_run_settings, experiment_config
+
+    check_run_settings(cfg)
+    for group, kind in PLUGIN_NODES.items():
+        node = cfg.get(group)
+        if node and node.get("name"):
+            plugin_config(kind, node, key=group)  # a broken or conflicting plugin raises its message
+    if cfg.get("db") is not None:
+        as_database_config(cfg.db)
+    if cfg.get("experiment") is not None:
+        experiment_config(cfg)
 
 
 def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True) -> dict[str, Any]:
@@ -80,6 +130,7 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
     try:
         mcap.attach("config.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode(), media_type="application/yaml")
         mcap.metadata("plugins", plugin_versions(cfg))
+        validate_run_config(cfg)
         try:
             module = importlib.import_module(f"bionav.experiments.{name}")
         except ModuleNotFoundError as exc:
@@ -107,5 +158,5 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
         try:
             mcap.close()
         finally:
-            write_json_atomic(run_dir / METRICS_FILE, metrics)
+            write_json_atomic(run_dir / METRICS_FILE, json_safe(metrics))
     return metrics

@@ -25,6 +25,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.experiments.common import _get, load_samples
+from bionav.experiments.configs import experiment_config
 from bionav.light.sun import parse_time
 from bionav.report.figures import pyplot, save_figure
 
@@ -33,7 +34,7 @@ CELL_TOPIC = "/skyline_homing/cell"
 
 def _conditions(exp):
     out = []
-    for k, c in enumerate(_get(exp, "conditions", [])):
+    for k, c in enumerate(exp.conditions):
         name = str(_get(c, "name", f"c{k}"))
         t = parse_time(str(_get(c, "time", "")), what=f"experiment.conditions[{k}].time", naive_utc=False)
         out.append((name, t, float(_get(c, "cloud_cover", 0.0)), float(_get(c, "cloud_optical_depth", 20.0))))
@@ -122,46 +123,45 @@ def run(cfg, ctx) -> dict:
     from bionav.spectral.scene import garden_scene
     from bionav.spectral.sensor_model import LogSensorModel
 
-    exp = cfg.experiment
+    exp = experiment_config(cfg, "skyline_homing")
     conditions = _conditions(exp)
-    reps = [str(r) for r in _get(exp, "representations", [])]
+    reps = [str(r) for r in exp.representations]
     for r in reps:
         try:
             check_representation(r)
         except ValueError as exc:
             raise UserError(f"experiment.representations: {exc}.") from None
-    world_name = str(_get(exp, "world", "garden"))
+    world_name = str(exp.world)
     if world_name not in ("garden", "campus"):
         raise UserError(f"experiment.world={world_name!r} is unknown; choose garden or campus.")
-    nx, ny = (int(v) for v in _get(exp, "grid", [9, 9]))
-    spacing = float(_get(exp, "spacing_m", 0.5))
+    nx, ny = (int(v) for v in exp.grid)
+    spacing = float(exp.spacing_m)
     if world_name == "campus":
         from bionav.world.worlds.outdoor import GRID_SHAPE, SPACING
 
         (nx, ny), spacing = GRID_SHAPE, SPACING
-    width, height = int(_get(exp, "image_width", 120)), int(_get(exp, "image_height", 20))
-    top = np.deg2rad(float(_get(exp, "elevation_top_deg", 45.0)))
+    width, height = int(exp.image_width), int(exp.image_height)
+    top = np.deg2rad(float(exp.elevation_top_deg))
     rad_per_row = 2 * np.pi / width
     geometry = PanoramaGeometry(width, height, top / rad_per_row, rad_per_row)
-    seed = int(_get(exp, "world_seed", 0))
+    seed = int(exp.world_seed)
     extent = max(nx - 1, ny - 1) * spacing
-    sensor_model = LogSensorModel(noise_counts=float(_get(exp, "noise_counts", 4.0)))
-    learn = _get(exp, "learn", None) or {"name": "sim_natural", "seed": int(_get(cfg, "seed", 0))}
-    disc = learn_discriminants(load_samples(learn), sigma=float(_get(exp, "sigma", 30.0)))
+    sensor_model = LogSensorModel(noise_counts=float(exp.noise_counts))
+    disc = learn_discriminants(load_samples(exp.learn), sigma=float(exp.sigma))
 
     gx, gy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     positions = np.c_[gx.ravel(), gy.ravel()]
     world_pos = positions * spacing
-    side = float(_get(exp, "square_side_m", 2.0))
+    side = float(exp.square_side_m)
     square_cells = np.array([[0, 0], [1, 0], [0, 1], [1, 1]])
     centre = np.array([nx - 1, ny - 1]) * spacing / 2
     square_pos = centre - side / 2 + square_cells * side
-    do_square = bool(_get(exp, "square_test", True))
+    do_square = bool(exp.square_test)
 
     counts, squares, truths = [], [], []
     for k, (name, t, cover, tau) in enumerate(conditions):
         sky = SkyState.from_time(t, clouds=CloudLayer(cover=cover, optical_depth=tau, seed=seed + 1),
-                                 turbidity=float(_get(exp, "turbidity", 0.1)))
+                                 turbidity=float(exp.turbidity))
         if world_name == "campus":
             world = campus_world(sky, seed=seed)
             c, truth = render_campus_counts(world, geometry, positions, sensor_model=sensor_model, rng=ctx.rng,
@@ -182,9 +182,9 @@ def run(cfg, ctx) -> dict:
                         positions=positions, conditions=np.array([c[0] for c in conditions]))
 
     method = make_homing(cfg, ctx, geometry)
-    stride = max(1, int(_get(exp, "snapshot_stride", 2)))
+    stride = max(1, int(exp.snapshot_stride))
     snap_idx = np.flatnonzero((positions[:, 0] % stride == 0) & (positions[:, 1] % stride == 0))
-    step, radius = float(_get(exp, "step_length", 0.5)), float(_get(exp, "success_radius", 1.0))
+    step, radius = float(exp.step_length), float(exp.success_radius)
     names = [c[0] for c in conditions]
     n = len(conditions)
     rows, square_rows, ms = [], [], []
@@ -252,7 +252,7 @@ def run(cfg, ctx) -> dict:
         metrics["square_aae"] = {r: mean(square[r], diag) for r in reps}
         if n > 1:
             metrics["square_aae_changed"] = {r: mean(square[r], off) for r in reps}
-    if bool(_get(exp, "plots", True)):
+    if bool(exp.plots):
         _plots(ctx.plots, counts, disc, reps, names, metrics, results, geometry)
     return metrics
 

@@ -65,7 +65,9 @@ class HomingMethod:
     uses_test_steps: ClassVar[bool] = False
 
     def __init__(self, config: Any, *, geometry: PanoramaGeometry) -> None:
-        self.config = config
+        from bionav.validation import check_config
+
+        self.config = check_config(config, prefix="homing")
         self.geometry = geometry
 
     def prepare(self, image: np.ndarray) -> Any:
@@ -83,6 +85,14 @@ class HomingMethod:
             ndarrays, so it can be cached on disk. The default returns the image.
         """
         return image
+
+    def describe_prepared(self, prepared: Any) -> Mapping[str, float]:
+        """Numbers describing one prepared image (e.g. ``{"keypoints": 413.0}``).
+
+        Experiments average them over a database's images and report them as
+        ``<name>_per_image`` metrics. The default describes nothing.
+        """
+        return {}
 
     def home_vector(
         self,

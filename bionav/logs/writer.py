@@ -1,8 +1,21 @@
-"""Writing ``run.mcap``: JSON messages with JSON-schema schemas, flushed as it goes."""
+"""Writing ``run.mcap``: JSON messages with JSON-schema schemas, flushed as it goes.
+
+Conventions readers (the Foxglove app, ``@mcap/core``, Python's ``json``) rely on:
+
+* a channel whose schema name is Foxglove's (``foxglove.PoseInFrame``,
+  ``foxglove.RawImage``, ...) carries Foxglove's own JSON schema
+  (:func:`bionav.logs.foxglove.foxglove_schema`, required fields included);
+* messages are strict JSON: NaN and infinities become ``null`` on ``bionav.*``
+  channels and are refused (``ValueError``) on Foxglove channels, whose fields
+  are required numbers;
+* log times are nanoseconds since the Unix epoch; simulated sessions add their
+  simulated time to :attr:`McapLog.start_ns`, the wall-clock time the log was opened.
+"""
 
 from __future__ import annotations
 
 import json
+import math
 import time
 from pathlib import Path
 from typing import Any, Mapping
@@ -24,9 +37,34 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not JSON serialisable")
 
 
-def to_json_bytes(message: Mapping[str, Any]) -> bytes:
-    """Serialise a message to compact UTF-8 JSON (numpy arrays become lists)."""
-    return json.dumps(message, default=_json_default, separators=(",", ":"), allow_nan=True).encode()
+def _finite_or_none(value: Any) -> Any:
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, Mapping):
+        return {k: _finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite_or_none(v) for v in value]
+    if isinstance(value, (np.ndarray, np.generic)):
+        return _finite_or_none(_json_default(value))
+    return value
+
+
+def to_json_bytes(message: Mapping[str, Any], *, non_finite: str = "null") -> bytes:
+    """Serialise a message to compact, strict UTF-8 JSON (numpy arrays become lists).
+
+    Parameters
+    ----------
+    message : mapping
+        The message.
+    non_finite : {"null", "refuse"}
+        What NaN and infinities become: JSON ``null``, or a ``ValueError``.
+    """
+    try:
+        return json.dumps(message, default=_json_default, separators=(",", ":"), allow_nan=False).encode()
+    except ValueError:
+        if non_finite == "refuse":
+            raise
+    return json.dumps(_finite_or_none(message), default=_json_default, separators=(",", ":"), allow_nan=False).encode()
 
 
 class McapLog:
@@ -58,11 +96,20 @@ class McapLog:
         self._flush_interval = float(flush_interval_s)
         self._last_flush = time.monotonic()
         self._closed = False
+        #: wall-clock time the log was opened (ns since the Unix epoch): simulated time starts here
+        self.start_ns = time.time_ns()
 
     # -- channels -------------------------------------------------------------
     def _channel(self, topic: str, schema_name: str, schema: Mapping[str, Any] | None) -> int:
         if topic in self._channels:
             return self._channels[topic]
+        if schema_name.startswith("foxglove."):
+            from bionav.logs.foxglove import foxglove_schema
+
+            try:
+                schema = foxglove_schema(schema_name)  # Foxglove's own, whatever the caller passed
+            except KeyError as exc:
+                raise ValueError(f"topic {topic}: {exc.args[0]}") from None
         schema_json = json.dumps(dict(schema or ANY_OBJECT_SCHEMA), sort_keys=True)
         key = (schema_name, schema_json)
         if key not in self._schemas:
@@ -99,9 +146,10 @@ class McapLog:
             (``foxglove.PoseInFrame``, ``foxglove.RawImage``...), else ``bionav.<Thing>``.
         schema : mapping, optional
             JSON schema of the message; a permissive object schema if omitted.
+            Ignored for Foxglove names: Foxglove's own schema is written.
         log_time_ns : int, optional
             Log time in nanoseconds since the Unix epoch; now if omitted. Replayed
-            and simulated sessions pass their own clock.
+            and simulated sessions pass their own clock (``start_ns`` plus simulated time).
         """
         if self._closed:
             raise RuntimeError(f"the log {self.path} is already closed")
@@ -112,12 +160,24 @@ class McapLog:
             channel_id=channel,
             log_time=t,
             publish_time=t,
-            data=to_json_bytes(message),
+            data=self._encode(topic, schema_name, message),
             sequence=self._sequence[topic],
         )
         self._sequence[topic] += 1
         if time.monotonic() - self._last_flush >= self._flush_interval:
             self.flush()
+
+    @staticmethod
+    def _encode(topic: str, schema_name: str, message: Mapping[str, Any]) -> bytes:
+        if not schema_name.startswith("foxglove."):
+            return to_json_bytes(message)
+        try:
+            return to_json_bytes(message, non_finite="refuse")
+        except ValueError:
+            raise ValueError(
+                f"topic {topic}: a {schema_name} message holds NaN or infinity, which Foxglove's schema does not "
+                f"allow; log such values on a bionav.* channel (they become null there)."
+            ) from None
 
     def attach(self, name: str, data: bytes, *, media_type: str) -> None:
         """Attach a file (e.g. the resolved config as YAML)."""

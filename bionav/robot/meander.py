@@ -37,6 +37,7 @@ import numpy as np
 from bionav.geometry import wrap_angle
 from bionav.robot.controller import Command, Controller, LanePlan, Observation
 from bionav.robot.kinematics import Pose, wheel_speeds
+from bionav.validation import bounded
 
 
 @dataclass
@@ -78,18 +79,18 @@ class MeanderConfig:
         bias-corrected odometry frame).
     """
 
-    speed: float = 0.10
-    turn_rate: float = 0.5
-    track_width: float = 0.30
-    lookahead: float = 0.60
-    heading_gain: float = 1.5
-    max_steer_rate: float = 0.5
+    speed: float = bounded(0.10, gt=0.0, le=5.0)
+    turn_rate: float = bounded(0.5, gt=0.0, le=20.0)
+    track_width: float = bounded(0.30, gt=0.0, le=5.0)
+    lookahead: float = bounded(0.60, gt=0.0, le=100.0)
+    heading_gain: float = bounded(1.5, ge=0.0, le=100.0)
+    max_steer_rate: float = bounded(0.5, gt=0.0, le=20.0)
     bias_learning: bool = False
-    bias_gain: float = 0.5
-    bias_window: float = 0.2
-    wall_gate_deg: float = 20.0
-    turn_tolerance_deg: float = 0.5
-    turn_reference: str = "lane_mean"
+    bias_gain: float = bounded(0.5, ge=0.0, le=1.0)
+    bias_window: float = bounded(0.2, gt=0.0, le=100.0)
+    wall_gate_deg: float = bounded(20.0, ge=0.0, le=180.0)
+    turn_tolerance_deg: float = bounded(0.5, gt=0.0, le=45.0)
+    turn_reference: str = bounded("lane_mean", choices=("local", "lane_mean"))
 
 
 class MeanderController(Controller):

@@ -9,11 +9,17 @@ What a replay needs (and what :class:`EpisodeRecorder` therefore logs):
   pose, wall reading, bumper -- and its output (wheel commands, done), plus
   the digest (:func:`bionav.robot.simulator.image_digest`) and true pose of
   every image the controller grabbed during the tick;
-* the images themselves (``/cleaning/image``, ``foxglove.RawImage`` with
-  ``32FC1`` or ``64FC1`` data) when ``log_images`` is on. Without them a
-  replay re-creates each image with the run's camera (the renderer is
-  deterministic, the camera noise is seeded per run and capture) at the logged
-  true pose and checks it against the logged digest.
+* the images themselves when ``log_images`` is on: ``/cleaning/capture``
+  (``bionav.Capture``: run, tick, capture index and the exact array, any dtype
+  and shape, for replay) and, for 2-D images, ``/cleaning/image``
+  (``foxglove.RawImage``, ``32FC1`` brightness 0..1 or ``mono8``/``mono16``,
+  for viewing in Foxglove). Without them a replay re-creates each image with
+  the run's camera (the renderer is deterministic, the camera noise is seeded
+  per run and capture) at the logged true pose and checks it against the
+  logged digest.
+
+Log times are the run's wall-clock start (:attr:`bionav.logs.writer.McapLog.start_ns`)
+plus simulated time, runs laid end to end.
 
 :func:`replay_episode` feeds the logged observations to a freshly reset
 controller and compares every command it emits with the logged one, exactly
@@ -36,6 +42,7 @@ from bionav.robot.simulator import image_digest
 STEP_TOPIC = "/cleaning/step"
 RUN_TOPIC = "/cleaning/run"
 IMAGE_TOPIC = "/cleaning/image"
+CAPTURE_TOPIC = "/cleaning/capture"
 POSE_TOPIC = "/cleaning/true_pose"
 CONTROLLER_TOPIC = "/cleaning/controller"
 RESULT_TOPIC = "/cleaning/result"
@@ -83,28 +90,19 @@ CONTROLLER_SCHEMA = {
     "description": "Controller internals: snapshots stored, triangulation fixes (h, e, chosen snapshots), lane events.",
 }
 
-POSE_SCHEMA = {
+CAPTURE_SCHEMA = {
     "type": "object",
-    "title": "foxglove.PoseInFrame",
+    "title": "bionav.Capture",
+    "description": "One grabbed image exactly as the controller saw it (little-endian bytes), for replay.",
     "properties": {
-        "timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
-        "frame_id": {"type": "string"},
-        "pose": {"type": "object"},
-    },
-}
-
-IMAGE_SCHEMA = {
-    "type": "object",
-    "title": "foxglove.RawImage",
-    "properties": {
-        "timestamp": {"type": "object"},
-        "frame_id": {"type": "string"},
-        "width": {"type": "integer"},
-        "height": {"type": "integer"},
-        "encoding": {"type": "string"},
-        "step": {"type": "integer"},
+        "run": {"type": "integer"},
+        "tick": {"type": "integer"},
+        "index": {"type": "integer", "description": "capture index within the run"},
+        "dtype": {"type": "string", "description": "numpy dtype, e.g. float32"},
+        "shape": {"type": "array", "items": {"type": "integer"}},
         "data": {"type": "string", "contentEncoding": "base64"},
     },
+    "required": ["run", "tick", "index", "dtype", "shape", "data"],
 }
 
 
@@ -112,26 +110,62 @@ def _stamp(ns: int) -> dict:
     return {"sec": int(ns // 1_000_000_000), "nsec": int(ns % 1_000_000_000)}
 
 
-def encode_image(image: np.ndarray) -> tuple[str, int, int, int, str]:
-    """``(encoding, width, height, step, base64 data)`` of a float image, little-endian, lossless."""
+def raw_image_from_array(image: np.ndarray, *, timestamp_ns: int, frame_id: str) -> dict:
+    """A ``foxglove.RawImage`` message of a single-channel image, in an encoding Foxglove displays.
+
+    Parameters
+    ----------
+    image : ndarray, shape (H, W)
+        Brightness: float (0 = black, 1 = white; float64 is converted to
+        float32, Foxglove has no 64-bit encoding), uint8 or uint16.
+    timestamp_ns : int
+        Nanoseconds since the Unix epoch.
+    frame_id : str
+        Frame of the camera.
+
+    Returns
+    -------
+    dict
+        Exactly the fields of Foxglove's schema: ``timestamp``, ``frame_id``,
+        ``width``, ``height``, ``encoding`` (``32FC1``, ``mono8`` or ``mono16``),
+        ``step`` and base64 little-endian ``data``.
+
+    Raises
+    ------
+    ValueError
+        For arrays that are not 2-D, or of another dtype.
+    """
     a = np.asarray(image)
-    if a.dtype == np.float32:
-        enc, item = "32FC1", 4
-    elif a.dtype == np.float64:
-        enc, item = "64FC1", 8
+    if a.ndim != 2:
+        raise ValueError(f"a foxglove.RawImage needs a single-channel image (H, W), not shape {a.shape}")
+    if a.dtype.kind == "f":
+        enc, dtype = "32FC1", np.dtype("<f4")
+    elif a.dtype == np.uint8:
+        enc, dtype = "mono8", np.dtype("u1")
+    elif a.dtype == np.uint16:
+        enc, dtype = "mono16", np.dtype("<u2")
     else:
-        raise ValueError(f"cannot log images of dtype {a.dtype}")
-    a2 = a.reshape(1, -1) if a.ndim == 1 else a
-    if a2.ndim != 2:
-        raise ValueError("only single-channel images (H, W) or vectors can be logged")
-    h, w = a2.shape
-    data = np.ascontiguousarray(a2, dtype=a.dtype.newbyteorder("<")).tobytes()
-    return enc, w, h, w * item, base64.b64encode(data).decode()
+        raise ValueError(f"cannot log images of dtype {a.dtype} as foxglove.RawImage (float, uint8 or uint16)")
+    h, w = a.shape
+    data = np.ascontiguousarray(a, dtype=dtype).tobytes()
+    return {"timestamp": _stamp(timestamp_ns), "frame_id": frame_id, "width": int(w), "height": int(h),
+            "encoding": enc, "step": int(w * dtype.itemsize), "data": base64.b64encode(data).decode()}
 
 
-def decode_image(message: dict) -> np.ndarray:
-    """Inverse of :func:`encode_image` for a logged ``foxglove.RawImage`` message."""
-    dtype = {"32FC1": "<f4", "64FC1": "<f8"}[message["encoding"]]
+def encode_capture(image: np.ndarray) -> dict:
+    """``{dtype, shape, data}`` of an array, little-endian and lossless (any dtype, any shape)."""
+    a = np.asarray(image)
+    data = np.ascontiguousarray(a, dtype=a.dtype.newbyteorder("<")).tobytes()
+    return {"dtype": str(a.dtype), "shape": [int(n) for n in a.shape], "data": base64.b64encode(data).decode()}
+
+
+def decode_capture(message: dict) -> np.ndarray:
+    """Inverse of :func:`encode_capture` (also reads the old ``/cleaning/image`` messages with an index)."""
+    if "dtype" in message:
+        dtype = np.dtype(message["dtype"])
+        raw = np.frombuffer(base64.b64decode(message["data"]), dtype=dtype.newbyteorder("<"))
+        return raw.astype(dtype).reshape(message["shape"])
+    dtype = {"32FC1": "<f4", "64FC1": "<f8"}[message["encoding"]]  # logs written before issue 20
     a = np.frombuffer(base64.b64decode(message["data"]), dtype=dtype).reshape(message["height"], message["width"])
     a = a.astype(np.float32 if message["encoding"] == "32FC1" else np.float64)
     return a[0] if message.get("vector") else a
@@ -162,6 +196,9 @@ class EpisodeRecorder:
     pose_every: int = 10
     last_time_ns: int = field(default=0, init=False)
 
+    def __post_init__(self) -> None:
+        self.last_time_ns = int(self.time_offset_ns)
+
     def start(self, meta: dict) -> None:
         """Write the run's ``/cleaning/run`` message."""
         self.log.write(RUN_TOPIC, {"run": self.run, **meta}, schema_name="bionav.CleaningRun", schema=RUN_SCHEMA,
@@ -175,12 +212,11 @@ class EpisodeRecorder:
         for img, pose, index in robot.captures:
             captures.append({"index": index, "digest": image_digest(img), "true_pose": list(pose.as_tuple())})
             if self.log_images:
-                enc, w, h, step, data = encode_image(img)
-                self.log.write(IMAGE_TOPIC, {"timestamp": _stamp(ns), "frame_id": f"robot_run{self.run}",
-                                             "width": w, "height": h, "encoding": enc, "step": step, "data": data,
-                                             "vector": bool(np.ndim(img) == 1), "run": self.run, "tick": tick,
-                                             "index": index},
-                               schema_name="foxglove.RawImage", schema=IMAGE_SCHEMA, log_time_ns=ns)
+                self.log.write(CAPTURE_TOPIC, {"run": self.run, "tick": tick, "index": index, **encode_capture(img)},
+                               schema_name="bionav.Capture", schema=CAPTURE_SCHEMA, log_time_ns=ns)
+                if np.ndim(img) == 2:  # panoramas (not the oracle's pose vectors) also for Foxglove's Image panel
+                    self.log.write(IMAGE_TOPIC, raw_image_from_array(img, timestamp_ns=ns, frame_id="camera"),
+                                   schema_name="foxglove.RawImage", log_time_ns=ns)
         wall = None if obs.wall is None else [obs.wall.distance, obs.wall.angle]
         self.log.write(STEP_TOPIC, {
             "run": self.run, "tick": tick, "time": obs.time, "odometry": list(obs.odometry.as_tuple()),
@@ -196,7 +232,7 @@ class EpisodeRecorder:
                 "timestamp": _stamp(ns), "frame_id": "world",
                 "pose": {"position": {"x": x, "y": y, "z": 0.0},
                          "orientation": {"x": 0.0, "y": 0.0, "z": float(np.sin(th / 2)), "w": float(np.cos(th / 2))}},
-            }, schema_name="foxglove.PoseInFrame", schema=POSE_SCHEMA, log_time_ns=ns)
+            }, schema_name="foxglove.PoseInFrame", log_time_ns=ns)
 
 
 @dataclass
@@ -212,7 +248,9 @@ def load_logged_runs(messages: Iterable[tuple[str, int, dict]]) -> dict[int, Log
     """Group ``(topic, log_time_ns, message)`` tuples (:func:`bionav.logs.read_messages`) by run."""
     runs: dict[int, LoggedRun] = {}
     for topic, _t, msg in messages:
-        if topic not in (RUN_TOPIC, STEP_TOPIC, IMAGE_TOPIC):
+        if topic not in (RUN_TOPIC, STEP_TOPIC, IMAGE_TOPIC, CAPTURE_TOPIC):
+            continue
+        if topic == IMAGE_TOPIC and "index" not in msg:  # a view for Foxglove; the exact copy is the capture
             continue
         r = runs.setdefault(int(msg["run"]), LoggedRun({}, [], {}))
         if topic == RUN_TOPIC:
@@ -220,7 +258,7 @@ def load_logged_runs(messages: Iterable[tuple[str, int, dict]]) -> dict[int, Log
         elif topic == STEP_TOPIC:
             r.steps.append(msg)
         else:
-            r.images[int(msg["index"])] = decode_image(msg)
+            r.images[int(msg["index"])] = decode_capture(msg)
     for r in runs.values():
         r.steps.sort(key=lambda m: m["tick"])
     return runs

@@ -9,14 +9,19 @@ which lies in ``[0, 1]`` (0 for identical columns; defined as 0 when both
 columns are zero). Möller, Horst & Fleer (2014, "Illumination tolerance for
 visual navigation with the holistic min-warping method", Robotics 3) found it
 the best measure for min-warping on edge-filtered images.
+
+The fast path (``quantised=True``) computes it as the SIMD reference
+implementation of min-warping does (Möller, Horst & Fleer 2014; WarpingSIMD):
+both stacks are quantised to 16-bit integers with one common scale (NSAD does
+not change when both columns are scaled alike), the absolute differences are
+summed in 16 bits, and the distance is stored as a byte,
+``round(NSAD * q)`` with the quantum ``q`` of :func:`distance_quantum`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
-
-from bionav.homing.warping.kernels import PARALLEL_LOCK
+from numba import njit
 
 
 def column_distance_matrix(snapshot, current):
@@ -44,7 +49,147 @@ def column_distance_matrix(snapshot, current):
     return out
 
 
-@njit(parallel=True, fastmath=True, cache=True)
+def distance_quantum(width: int):
+    """Quantum of the 8-bit distances and the dtype of their sums over ``width`` columns.
+
+    Returns
+    -------
+    q : int
+        Quantised distances are ``round(NSAD * q)`` in ``0 .. q``;
+        ``q = min(255, 65535 // width)`` so that a match value (a sum over
+        ``width`` columns) fits 16 bits (227 at 288 columns, 189 at 346).
+    dtype : numpy dtype
+        ``uint16``, or ``uint32`` with ``q = 255`` for panoramas wider than
+        1023 columns.
+    """
+    q = min(255, 65535 // int(width))
+    if q >= 64:
+        return q, np.dtype(np.uint16)
+    return 255, np.dtype(np.uint32)
+
+
+def _image_quantum(n_rows: int) -> int:
+    """Largest |value| of the 16-bit edge images: ``2 * n_rows * q`` must fit 16 bits."""
+    return max(1, min(2047, 65535 // (2 * int(n_rows))))
+
+
+@njit(nogil=True, fastmath=True, cache=True)
+def _quantise(planes, scale, out, norms):
+    """``out[k, r, j] = round(scale * planes[k, r, j % W])`` (``j < out.shape[2]``); ``norms`` = sum_r |out|."""
+    n_planes, n_rows, width = planes.shape
+    n_out = out.shape[2]
+    for k in range(n_planes):
+        nk = norms[k]
+        for j in range(n_out):
+            nk[j] = 0
+        for r in range(n_rows):
+            src = planes[k, r]
+            o = out[k, r]
+            for j in range(width):
+                o[j] = np.int16(np.rint(src[j] * scale))
+            for j in range(width, n_out):
+                o[j] = o[j - width]
+            for j in range(n_out):
+                nk[j] += abs(np.int32(o[j]))
+
+
+@njit(nogil=True, fastmath=True, cache=True)
+def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
+    """8-bit NSAD in diagonal layout from 16-bit stacks.
+
+    ``sq`` (K, R, W) and ``sn`` (K, W): quantised snapshot planes and column
+    norms; ``cq2`` (K, R, 2 W) and ``cn2`` (K, 2 W): the current view's, twice
+    side by side, so that the columns ``i + d`` of all snapshot columns ``i``
+    are one contiguous run. The sums of a plane are kept for all diagonals
+    (``W x W`` 16-bit, in L2 cache) and built eight rows at a time, so that
+    those rows stay in L1 cache while every diagonal visits them; the inner
+    loops run over all ``W`` columns (32 16-bit lanes). The bytes are then
+    de-interleaved into ``out[k, d, i % step, i // step]``.
+    """
+    n_planes, n_rows, width = sq.shape
+    n = width // step
+    acc = np.empty((width, width), np.uint16)
+    t = np.zeros(width, np.uint8)
+    qf = np.float32(quantum)
+    for k in range(n_planes):
+        acc[:] = 0
+        # |a - b| as max - min keeps the loops in 16-bit lanes
+        r = 0
+        while r + 8 <= n_rows:
+            a0 = sq[k, r]
+            a1 = sq[k, r + 1]
+            a2 = sq[k, r + 2]
+            a3 = sq[k, r + 3]
+            a4 = sq[k, r + 4]
+            a5 = sq[k, r + 5]
+            a6 = sq[k, r + 6]
+            a7 = sq[k, r + 7]
+            for d in range(width):
+                b0 = cq2[k, r, d:d + width]
+                b1 = cq2[k, r + 1, d:d + width]
+                b2 = cq2[k, r + 2, d:d + width]
+                b3 = cq2[k, r + 3, d:d + width]
+                b4 = cq2[k, r + 4, d:d + width]
+                b5 = cq2[k, r + 5, d:d + width]
+                b6 = cq2[k, r + 6, d:d + width]
+                b7 = cq2[k, r + 7, d:d + width]
+                ac = acc[d]
+                for i in range(width):
+                    ac[i] += np.uint16(
+                        max(a0[i], b0[i]) - min(a0[i], b0[i]) + max(a1[i], b1[i]) - min(a1[i], b1[i])
+                        + max(a2[i], b2[i]) - min(a2[i], b2[i]) + max(a3[i], b3[i]) - min(a3[i], b3[i])
+                        + max(a4[i], b4[i]) - min(a4[i], b4[i]) + max(a5[i], b5[i]) - min(a5[i], b5[i])
+                        + max(a6[i], b6[i]) - min(a6[i], b6[i]) + max(a7[i], b7[i]) - min(a7[i], b7[i])
+                    )
+            r += 8
+        while r < n_rows:
+            a0 = sq[k, r]
+            for d in range(width):
+                b0 = cq2[k, r, d:d + width]
+                ac = acc[d]
+                for i in range(width):
+                    ac[i] += np.uint16(max(a0[i], b0[i]) - min(a0[i], b0[i]))
+            r += 1
+        na = sn[k]
+        for d in range(width):
+            nb = cn2[k, d:d + width]
+            ac = acc[d]
+            for i in range(width):
+                den = np.float32(na[i] + nb[i])
+                val = np.float32(0.5)
+                if den > 0:
+                    val = np.float32(ac[i]) * qf / den + np.float32(0.5)
+                t[i] = np.uint8(val)
+            o = out[k, d]
+            if step == 1:
+                o0 = o[0]
+                for m in range(n):
+                    o0[m] = t[m]
+                    o0[m + n] = t[m]
+            elif step == 3:  # constant stride: compiles to byte shuffles
+                o0 = o[0]
+                o1 = o[1]
+                o2 = o[2]
+                for m in range(n):
+                    x0 = t[3 * m]
+                    x1 = t[3 * m + 1]
+                    x2 = t[3 * m + 2]
+                    o0[m] = x0
+                    o1[m] = x1
+                    o2[m] = x2
+                    o0[m + n] = x0
+                    o1[m + n] = x1
+                    o2[m + n] = x2
+            else:
+                for rr in range(step):
+                    orr = o[rr]
+                    for m in range(n):
+                        x = t[m * step + rr]
+                        orr[m] = x
+                        orr[m + n] = x
+
+
+@njit(nogil=True, fastmath=True, cache=True)
 def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
     """Fill ``out[k, d, i % step, i // step (+ n)] = NSAD(snap[k, :, i], cur[k, :, (i + d) % W])``.
 
@@ -57,31 +202,37 @@ def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
     """
     n_planes, n_rows, width = snap.shape
     n = width // step
-    for t in prange(n_planes * width):
-        k = t // width
-        d = t - k * width
-        acc = np.zeros(width, dtype=np.float32)
-        for r in range(n_rows):
-            a = snap[k, r]
-            b = cur2[k, r, d:d + width]
-            for i in range(width):
-                acc[i] += abs(a[i] - b[i])
-        na = snap_norm[k]
-        nb = cur_norm2[k, d:d + width]
-        # loop over (i % step, i // step) rather than dividing: an integer
-        # division by a run-time step costs more than the whole row sum
-        for rr in range(step):
-            for m in range(n):
-                i = m * step + rr
-                den = na[i] + nb[i]
-                val = np.float32(0.0)
-                if den > 0:
-                    val = acc[i] / den
-                out[k, d, rr, m] = val
-                out[k, d, rr, m + n] = val
+    acc = np.zeros(width, dtype=np.float32)
+    for k in range(n_planes):
+        for d in range(width):
+            acc[:] = 0.0
+            for r in range(n_rows):
+                a = snap[k, r]
+                b = cur2[k, r, d:d + width]
+                for i in range(width):
+                    acc[i] += abs(a[i] - b[i])
+            na = snap_norm[k]
+            nb = cur_norm2[k, d:d + width]
+            # loop over (i % step, i // step) rather than dividing: an integer
+            # division by a run-time step costs more than the whole row sum
+            for rr in range(step):
+                for m in range(n):
+                    i = m * step + rr
+                    den = na[i] + nb[i]
+                    val = np.float32(0.0)
+                    if den > 0:
+                        val = acc[i] / den
+                    out[k, d, rr, m] = val
+                    out[k, d, rr, m + n] = val
 
 
-def diagonal_distances(snapshot, current, *, step: int = 1, out=None):
+def _absmax(stack, key):
+    if f"{key}_absmax" in stack:
+        return float(stack[f"{key}_absmax"])
+    return float(np.abs(np.asarray(stack[key])).max(initial=0.0))
+
+
+def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised: bool = False):
     """Fast column distances in the layout the search kernels read.
 
     Parameters
@@ -90,15 +241,20 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None):
         Scale-plane stacks (see :func:`column_distance_matrix`).
     step : int
         Alpha step in columns (``W`` must be a multiple of it).
-    out : ndarray, shape (K, W, step, 2 * W // step), float32, optional
-        Array to fill (C-contiguous), e.g. the first level of the search's
-        window minima; a new one by default.
+    out : ndarray, shape (K, W, step, 2 * W // step), optional
+        Array to fill (C-contiguous, float32 or uint8 for ``quantised``), e.g.
+        the first level of the search's window minima; a new one by default.
+    quantised : bool
+        Quantise as the SIMD reference does (16-bit images, 16-bit sums, 8-bit
+        distances ``round(NSAD * q)``, ``q`` of :func:`distance_quantum`);
+        float32 NSAD otherwise.
 
     Returns
     -------
-    ndarray, shape (K, W, step, 2 * W // step), float32
+    ndarray, shape (K, W, step, 2 * W // step), float32 or uint8
         ``E[k, d, i % step, i // step]`` (and again at ``i // step + W // step``)
-        equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``.
+        equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``
+        (times ``q`` and rounded when quantised).
     """
     snap = np.ascontiguousarray(snapshot["snap"], dtype=np.float32)
     cur = np.ascontiguousarray(current["cur"], dtype=np.float32)
@@ -106,22 +262,34 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None):
         raise ValueError(
             f"snapshot and current view stacks differ in shape: {snap.shape} vs {cur.shape}"
         )
-    n_planes, _, width = snap.shape
+    n_planes, n_rows, width = snap.shape
     if width % step:
         raise ValueError(f"width {width} is not a multiple of the alpha step {step}")
-    shape = (n_planes, width, step, 2 * (width // step))
+    n = width // step
+    shape = (n_planes, width, step, 2 * n)
+    dtype = np.uint8 if quantised else np.float32
     if out is None:
-        out = np.empty(shape, dtype=np.float32)
-    elif out.shape != shape or out.dtype != np.float32 or not out.flags.c_contiguous:
-        raise ValueError(f"out must be a C-contiguous float32 array of shape {shape}")
+        out = np.empty(shape, dtype=dtype)
+    elif out.shape != shape or out.dtype != dtype or not out.flags.c_contiguous:
+        raise ValueError(f"out must be a C-contiguous {np.dtype(dtype).name} array of shape {shape}")
+    if quantised:
+        top = max(_absmax(snapshot, "snap"), _absmax(current, "cur"))
+        scale = np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
+        sq = np.empty((n_planes, n_rows, width), np.int16)
+        sn = np.empty((n_planes, width), np.int32)
+        cq2 = np.empty((n_planes, n_rows, 2 * width), np.int16)
+        cn2 = np.empty((n_planes, 2 * width), np.int32)
+        _quantise(snap, scale, sq, sn)
+        _quantise(cur, scale, cq2, cn2)
+        _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
+        return out
     cur_norm = np.asarray(current["cur_norm"], dtype=np.float32)
-    with PARALLEL_LOCK:
-        _diagonal_distances(
-            snap,
-            np.concatenate([cur, cur], axis=2),
-            np.ascontiguousarray(snapshot["snap_norm"], dtype=np.float32),
-            np.concatenate([cur_norm, cur_norm], axis=1),
-            int(step),
-            out,
-        )
+    _diagonal_distances(
+        snap,
+        np.concatenate([cur, cur], axis=2),
+        np.ascontiguousarray(snapshot["snap_norm"], dtype=np.float32),
+        np.concatenate([cur_norm, cur_norm], axis=1),
+        int(step),
+        out,
+    )
     return out

@@ -1,4 +1,4 @@
-"""Numba search kernels of min-warping and 2D-warping.
+"""Numba search kernels of min-warping and 2D-warping (single-threaded, GIL released).
 
 They read the column distances in the layout of
 :func:`~bionav.homing.warping.distance.diagonal_distances`,
@@ -10,26 +10,27 @@ steps (``a * step`` columns) and rotation ``p`` columns,
     i = u + a * step,    j = v - p + a * step,    d = v - u - p,
 
 so ``d`` does not depend on ``a`` and the distances of all alpha steps of one
-template entry are ``n_alpha`` consecutive floats: the kernels vectorise over
+template entry are ``n_alpha`` consecutive values: the kernels vectorise over
 alpha. Consecutive ``v`` are consecutive ``d`` as well, so min-warping reads
 the minimum over a run of allowed current columns from sliding minima over
 ``d`` (:func:`fill_window_minima`). The plain, loop-by-loop equivalents are in
 :mod:`~bionav.homing.warping.reference`.
+
+Every kernel works on float32 distances (NSAD) and on the quantised 8-bit
+distances of :func:`~bionav.homing.warping.distance.diagonal_distances`
+(``quantised=True``), whose minima are taken on bytes and summed in 16 bits
+(``numba.njit`` compiles one specialisation per dtype; the inner min/add loops
+compile to packed byte/word instructions, see ``docs/performance.md``).
+
+All kernels run on the calling thread and release the GIL (``nogil=True``):
+callers parallelise over pairs or snapshots (the grid runner's worker threads),
+which never oversubscribes the cores and never spin-waits.
 """
 
 from __future__ import annotations
 
-import threading
-
 import numpy as np
-from numba import njit, prange
-
-#: Serialises launches of the parallel kernels. Callers on several Python
-#: threads (the grid runner's workers) would otherwise start one team of
-#: numba threads each, which oversubscribes the cores and aborts with numba's
-#: ``workqueue`` threading layer (the only one available where neither OpenMP
-#: nor TBB is installed). The kernels themselves use every core.
-PARALLEL_LOCK = threading.Lock()
+from numba import njit
 
 
 @njit(inline="always")
@@ -46,7 +47,7 @@ def _wrap(d, width):
     return d
 
 
-@njit(parallel=True, fastmath=True, cache=True)
+@njit(nogil=True, fastmath=True, cache=True)
 def fill_window_minima(levels):
     """Sliding minima over ``d`` of the column distances, in place.
 
@@ -59,31 +60,32 @@ def fill_window_minima(levels):
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32
+    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
         ``levels[0]`` filled; levels ``1 .. J`` are overwritten.
     """
     n_levels, n_planes, width, step, m2 = levels.shape
+    row = step * m2
     for j in range(1, n_levels):
         h = 1 << (j - 1)
-        for t in prange(n_planes * width):
-            k = t // width
-            d = t - k * width
-            d2 = _wrap(d + h, width)
-            for rr in range(step):
-                a = levels[j - 1, k, d, rr]
-                b = levels[j - 1, k, d2, rr]
-                o = levels[j, k, d, rr]
-                for m in range(m2):
+        for k in range(n_planes):
+            src = levels[j - 1, k].reshape((width, row))
+            dst = levels[j, k].reshape((width, row))
+            for d in range(width):
+                d2 = _wrap(d + h, width)
+                a = src[d]
+                b = src[d2]
+                o = dst[d]
+                for m in range(row):
                     o[m] = min(a[m], b[m])
 
 
-@njit(parallel=True, fastmath=True, cache=True)
-def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, n_chunks):
+@njit(nogil=True, fastmath=True, cache=True)
+def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, out):
     """Min-warping match values for every alpha step and the given rotations.
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32
+    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
         Column distances (diagonal layout) and their sliding minima
         (:func:`fill_window_minima`).
     n_alpha : int
@@ -94,56 +96,80 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, n_chun
         Min-warping windows (:func:`~bionav.homing.warping.templates.minwarp_windows`):
         the entries ``start[u] .. start[u + 1] - 1`` of snapshot column ``u``
         each cover ``2**w_level`` current columns from ``w_v`` in plane ``w_plane``.
-    n_chunks : int
-        Number of independent partial sums (one per thread).
+    big : scalar of the dtype of ``levels``
+        Its largest value (``inf`` or 255); the minimum of a column without
+        allowed entries.
+    out : ndarray, shape (P, n_alpha)
+        Zero-filled accumulator: float32 for float distances, uint16 (or
+        uint32) for quantised ones, wide enough for ``W`` times the largest
+        distance (:func:`~bionav.homing.warping.distance.distance_quantum`).
 
     Returns
     -------
-    ndarray, shape (P, n_alpha), float32
-        ``sum_u min_{v, k allowed} dist`` for each (psi, alpha); lower is better.
+    ndarray, shape (P, n_alpha)
+        ``out``: ``sum_u min_{v, k allowed} dist`` for each (psi, alpha); lower is better.
     """
-    _, n_planes, width, step, _ = levels.shape
+    _, n_planes, width, step, m2 = levels.shape
     n_p = p_cols.shape[0]
-    partial = np.zeros((n_chunks, n_p, n_alpha), dtype=np.float32)
-    for c in prange(n_chunks):
-        best = np.empty(n_alpha, dtype=np.float32)
-        for u in range(c, width, n_chunks):
-            m0 = u // step
-            rr = u - m0 * step
+    best = np.empty((n_p, n_alpha), dtype=levels.dtype)
+    row_stride = step * m2
+    # snapshot columns in phase order (u = rr, rr + step, ...): one phase reads
+    # a third of the table (step 3), which keeps the reads in cache; per window
+    # all rotations at once (the window's plane and level stay fixed); the
+    # first window of a column is copied, the others compared and selected
+    # (packed byte compares)
+    for rr in range(step):
+        for u in range(rr, width, step):
+            e0 = start[u]
+            e1 = start[u + 1]
+            off = rr * m2 + u // step
+            for e in range(e0, e1):
+                flat = levels[w_level[e], w_plane[e]].reshape(-1)
+                v0 = w_v[e] - u
+                first = e == e0
+                for ip in range(n_p):
+                    base = _wrap(v0 - p_cols[ip], width) * row_stride + off
+                    row = flat[base:base + n_alpha]
+                    b = best[ip]
+                    if first:
+                        for a in range(n_alpha):
+                            b[a] = row[a]
+                    else:
+                        for a in range(n_alpha):
+                            x = row[a]
+                            if x < b[a]:
+                                b[a] = x
+            if e1 == e0:
+                best[:] = big
             for ip in range(n_p):
+                acc = out[ip]
+                b = best[ip]
                 for a in range(n_alpha):
-                    best[a] = np.inf
-                pc = p_cols[ip]
-                for e in range(start[u], start[u + 1]):
-                    d = _wrap(w_v[e] - u - pc, width)
-                    row = levels[w_level[e], w_plane[e], d, rr, m0:m0 + n_alpha]
-                    for a in range(n_alpha):
-                        best[a] = min(best[a], row[a])
-                for a in range(n_alpha):
-                    partial[c, ip, a] += best[a]
-    out = np.zeros((n_p, n_alpha), dtype=np.float32)
-    for c in range(n_chunks):
-        out += partial[c]
+                    acc[a] += b[a]
     return out
 
 
-@njit(fastmath=True, cache=True)
-def minwarp_scores_at(dist, a_cols, p_cols, vlo, vhi, klo, khi):
+@njit(nogil=True, fastmath=True, cache=True)
+def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
     """Min-warping match values at single (alpha, psi) pairs given in columns.
+
+    Reads the same windows as :func:`minwarp_scores` (used by the fine search,
+    which visits hypotheses between the grid's alpha steps).
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step), float32
+    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
     a_cols, p_cols : ndarray, shape (N,), int64
         Movement direction and rotation of each pair, in columns.
-    vlo, vhi, klo, khi : ndarray
-        Min-warping template.
+    start, w_plane, w_level, w_v : ndarray
+        Min-warping windows.
 
     Returns
     -------
     ndarray, shape (N,), float64
+        In the units of ``levels``.
     """
-    n_planes, width, step, _ = dist.shape
+    _, n_planes, width, step, _ = levels.shape
     out = np.zeros(a_cols.shape[0])
     for t in range(a_cols.shape[0]):
         ac = a_cols[t] % width
@@ -156,18 +182,17 @@ def minwarp_scores_at(dist, a_cols, p_cols, vlo, vhi, klo, khi):
             m = i // step
             rr = i - m * step
             best = np.inf
-            for v in range(vlo[u], vhi[u] + 1):
-                d = _wrap(v - u - pc, width)
-                for k in range(klo[u, v], khi[u, v] + 1):
-                    x = dist[k, d, rr, m]
-                    if x < best:
-                        best = x
+            for e in range(start[u], start[u + 1]):
+                d = _wrap(w_v[e] - u - pc, width)
+                x = np.float64(levels[w_level[e], w_plane[e], d, rr, m])
+                if x < best:
+                    best = x
             total += best
         out[t] = total
     return out
 
 
-@njit(parallel=True, fastmath=True, cache=True)
+@njit(nogil=True, fastmath=True, cache=True)
 def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
     """2D-warping match values for every (rho, psi, alpha step).
 
@@ -189,25 +214,21 @@ def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
     n_rho = v_tab.shape[0]
     n_p = p_cols.shape[0]
     out = np.zeros((n_rho, n_p, n_alpha), dtype=np.float32)
-    col_m = np.arange(width) // step
-    col_r = np.arange(width) - col_m * step
-    for t in prange(n_rho * n_p):
-        ir = t // n_p
-        ip = t - ir * n_p
-        pc = p_cols[ip]
-        acc = np.zeros(n_alpha, dtype=np.float32)
-        for u in range(width):
-            m0 = col_m[u]
-            rr = col_r[u]
-            d = _wrap(v_tab[ir, u] - u - pc, width)
-            row = dist[k_tab[ir, u], d, rr, m0:m0 + n_alpha]
-            for a in range(n_alpha):
-                acc[a] += row[a]
-        out[ir, ip] = acc
+    for ir in range(n_rho):
+        for ip in range(n_p):
+            pc = p_cols[ip]
+            acc = out[ir, ip]
+            for u in range(width):
+                m0 = u // step
+                rr = u - m0 * step
+                d = _wrap(v_tab[ir, u] - u - pc, width)
+                row = dist[k_tab[ir, u], d, rr]
+                for a in range(n_alpha):
+                    acc[a] += row[m0 + a]
     return out
 
 
-@njit(fastmath=True, cache=True)
+@njit(nogil=True, fastmath=True, cache=True)
 def warp2d_scores_at(dist, a_cols, p_cols, rho_idx, v_tab, k_tab):
     """2D-warping match values at single (alpha, psi, rho) triples (columns, columns, index)."""
     n_planes, width, step, _ = dist.shape
@@ -229,7 +250,7 @@ def warp2d_scores_at(dist, a_cols, p_cols, rho_idx, v_tab, k_tab):
     return out
 
 
-@njit(fastmath=True, cache=True)
+@njit(nogil=True, fastmath=True, cache=True)
 def compass_measure(dist, p_cols):
     """Visual-compass distance of each rotation: ``sum_i min_k dist[k, i, i - p]``.
 
@@ -237,6 +258,10 @@ def compass_measure(dist, p_cols):
     ``p`` columns, column by column, taking for each column the best scale
     plane (so that landmarks that came closer or receded still match); small
     values mark plausible rotations.
+
+    Parameters
+    ----------
+    dist : ndarray, shape (K, W, step, 2 * W // step), float32 or uint8
 
     Returns
     -------
@@ -258,3 +283,41 @@ def compass_measure(dist, p_cols):
                 total += best
         out[ip] = total
     return out
+
+
+@njit(nogil=True, cache=True)
+def swap_roles(dist, out):
+    """Column distances of the swapped pair from those of the pair (the transposed stack).
+
+    With inversion-symmetric scale factors (``sigma_{K-1-k} = 1 / sigma_k``)
+    plane ``k`` of the swapped pair (current view as snapshot) compares the
+    same two images as plane ``K-1-k`` of the pair, with the roles of the
+    columns exchanged: ``D'[k, j, i] = D[K-1-k, i, j]``. In diagonal layout
+    ``E'[k, d, j] = E[K-1-k, -d, j + d]`` (indices modulo ``W``).
+
+    Parameters
+    ----------
+    dist : ndarray, shape (K, W, step, 2 * W // step)
+        Diagonal-layout distances of the pair.
+    out : ndarray, same shape and dtype
+        Filled with those of the swapped pair (both halves of the last axis).
+    """
+    n_planes, width, step, m2 = dist.shape
+    n = width // step
+    for k in range(n_planes):
+        src = dist[n_planes - 1 - k]
+        for d in range(width):
+            s = src[width - d if d > 0 else 0]
+            o = out[k, d]
+            for rj in range(step):
+                # columns j = rj + step * mj map to i = j + d = ph + step * (off + mj)
+                c = rj + d
+                off = c // step
+                ph = c - off * step
+                if off >= n:
+                    off -= n
+                row = s[ph, off:off + n]
+                dst = o[rj]
+                for m in range(n):
+                    dst[m] = row[m]
+                    dst[m + n] = row[m]

@@ -64,6 +64,38 @@ def default_thresholds(scales) -> np.ndarray:
     return tau
 
 
+def reference_thresholds(scales, *, max_ratio: float = 2.5) -> np.ndarray:
+    """Thresholds of the SIMD reference implementation (WarpingSIMD).
+
+    The arithmetic means of neighbouring scale factors, and a finite last
+    threshold: scale ratios above ``max_ratio`` are not allowed (the reference
+    default 2.5 with scale factors up to 2).
+
+    Parameters
+    ----------
+    scales : array_like, shape (K,)
+        Increasing scale factors.
+    max_ratio : float
+        Largest allowed scale ratio (``> scales[-1]``).
+
+    Returns
+    -------
+    ndarray, shape (K,)
+    """
+    s = np.asarray(scales, dtype=np.float64)
+    if not max_ratio > s[-1]:
+        raise ValueError(f"the largest scale ratio {max_ratio} must exceed the largest scale factor {s[-1]}")
+    tau = np.empty_like(s)
+    tau[:-1] = 0.5 * (s[:-1] + s[1:])
+    tau[-1] = float(max_ratio)
+    return tau
+
+
+#: Rules for the thresholds when none are given: ``geometric`` (geometric means,
+#: no largest ratio) and ``reference`` (arithmetic means, largest ratio 2.5).
+THRESHOLD_RULES = ("geometric", "reference")
+
+
 def check_scales(scales, thresholds=None):
     """Validate scale factors and thresholds; return both as float64 arrays.
 
@@ -145,7 +177,10 @@ def scale_plane_stack(image, *, geometry: PanoramaGeometry, scales=None):
         planes in the snapshot role; ``cur`` (K, H-1, W) float32: its planes in
         the current-view role; ``snap_norm`` and ``cur_norm`` (K, W) float32:
         the sum of absolute values of every column of those planes (the
-        denominators of the normalised sum of absolute differences).
+        denominators of the normalised sum of absolute differences);
+        ``snap_absmax`` and ``cur_absmax`` () float32: the largest absolute
+        value of each role's planes (the quantised distances scale both
+        images of a pair by the larger of the two).
     """
     s = default_scales() if scales is None else np.asarray(scales, dtype=np.float64)
     s, _ = check_scales(s)
@@ -172,4 +207,6 @@ def scale_plane_stack(image, *, geometry: PanoramaGeometry, scales=None):
         "cur": np.ascontiguousarray(cur, dtype=np.float32),
         "snap_norm": np.abs(snap).sum(axis=1).astype(np.float32),
         "cur_norm": np.abs(cur).sum(axis=1).astype(np.float32),
+        "snap_absmax": np.array(np.abs(snap).max(initial=0.0), dtype=np.float32),
+        "cur_absmax": np.array(np.abs(cur).max(initial=0.0), dtype=np.float32),
     }

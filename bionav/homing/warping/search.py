@@ -21,19 +21,19 @@ entry as one vector; otherwise they search every column and keep the grid.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import get_num_threads
 
 from bionav.geometry import wrap_angle
-from bionav.homing.warping.distance import diagonal_distances
+from bionav.homing.warping.distance import diagonal_distances, distance_quantum
 from bionav.homing.warping.kernels import (
-    PARALLEL_LOCK,
     compass_measure,
     fill_window_minima,
     minwarp_scores,
     minwarp_scores_at,
+    swap_roles,
     warp2d_scores,
     warp2d_scores_at,
 )
@@ -97,16 +97,51 @@ def _layout_step(width: int, n_alpha: int, p_cols, double_search: bool) -> int:
 WINDOW_LEVEL = 4
 
 
-def _window_minima(snapshot, current, step, windows):
-    """Column distances (level 0) and the sliding minima the windows read."""
+_WORKSPACE = threading.local()
+
+
+def _buffer(name, shape, dtype):
+    """A per-thread array reused between calls (saves allocating and faulting in
+    several MB per home vector); valid until the next call on the same thread."""
+    cache = _WORKSPACE.__dict__.setdefault("arrays", {})
+    arr = cache.get(name)
+    if arr is None or arr.shape != shape or arr.dtype != dtype:
+        arr = np.empty(shape, dtype=dtype)
+        cache[name] = arr
+    return arr
+
+
+def _window_minima(snapshot, current, step, windows, quantised, name="levels"):
+    """Column distances (level 0) and the sliding minima the windows read.
+
+    The result is a per-thread buffer ``name``.
+    """
     n_levels = int(windows[2].max(initial=0)) + 1
     n_planes, _, width = np.shape(snapshot["snap"])
-    levels = np.empty((n_levels, n_planes, width, step, 2 * (width // step)), dtype=np.float32)
-    diagonal_distances(snapshot, current, step=step, out=levels[0])
+    dtype = np.dtype(np.uint8 if quantised else np.float32)
+    levels = _buffer(name, (n_levels, n_planes, width, step, 2 * (width // step)), dtype)
+    diagonal_distances(snapshot, current, step=step, out=levels[0], quantised=quantised)
     if n_levels > 1:
-        with PARALLEL_LOCK:
-            fill_window_minima(levels)
+        fill_window_minima(levels)
     return levels
+
+
+def _search(levels, n_a_eff, p_cols, windows, quantised):
+    """Match values of every (psi, alpha step) in distance units (float64)."""
+    width = levels.shape[2]
+    if quantised:
+        q, acc_dtype = distance_quantum(width)
+        out = np.zeros((p_cols.size, n_a_eff), acc_dtype)
+        minwarp_scores(levels, n_a_eff, p_cols, *windows, np.uint8(255), out)
+    else:
+        out = np.zeros((p_cols.size, n_a_eff), np.float32)
+        minwarp_scores(levels, n_a_eff, p_cols, *windows, np.float32(np.inf), out)
+    return out.astype(np.float64)
+
+
+def _symmetric_scales(scales) -> bool:
+    s = np.asarray(scales, dtype=np.float64)
+    return bool(np.allclose(s * s[::-1], 1.0, rtol=1e-9, atol=0.0))
 
 
 def _select_psi(dist, p_cols, compass_fraction):
@@ -134,7 +169,15 @@ def _check_pair(snapshot, current):
 
 
 def minwarping_scores(
-    snapshot, current, *, n_alpha=96, n_psi=96, thresholds=None, psi_cols=None, window_level=WINDOW_LEVEL
+    snapshot,
+    current,
+    *,
+    n_alpha=96,
+    n_psi=96,
+    thresholds=None,
+    psi_cols=None,
+    window_level=WINDOW_LEVEL,
+    quantised=False,
 ):
     """Min-warping match values on the full (psi, alpha) grid (fast kernels).
 
@@ -152,6 +195,9 @@ def minwarping_scores(
         Largest window level of the sliding minima
         (:func:`~bionav.homing.warping.templates.minwarp_windows`); changes the
         speed, not the result.
+    quantised : bool
+        8-bit distances summed in 16 bits (the fast default of
+        :func:`minwarping`); float32 NSAD otherwise.
 
     Returns
     -------
@@ -159,9 +205,10 @@ def minwarping_scores(
         Movement directions in columns.
     p_cols : ndarray, shape (P,), int64
         Rotations in columns.
-    scores : ndarray, shape (P, n_alpha), float32
+    scores : ndarray, shape (P, n_alpha), float64
         ``scores[p, a] = sum over snapshot columns of the minimum NSAD over the
-        reachable current columns and allowed planes``.
+        reachable current columns and allowed planes`` (quantised: in units
+        of ``1 / q``, :func:`~bionav.homing.warping.distance.distance_quantum`).
     """
     scales = _check_pair(snapshot, current)
     scales, tau = check_scales(scales, thresholds)
@@ -170,9 +217,10 @@ def minwarping_scores(
     p_cols = _column_grid(n_psi, width) if psi_cols is None else np.asarray(psi_cols, np.int64) % width
     step = _layout_step(width, n_alpha, p_cols, False)
     windows = minwarp_windows(minwarp_template(width, scales, tau), max_level=window_level)
-    levels = _window_minima(snapshot, current, step, windows)
-    with PARALLEL_LOCK:
-        scores = minwarp_scores(levels, width // step, p_cols, *windows, get_num_threads())
+    levels = _window_minima(snapshot, current, step, windows, quantised)
+    scores = _search(levels, width // step, p_cols, windows, quantised)
+    if quantised:
+        scores /= distance_quantum(width)[0]
     return a_cols, p_cols, scores[:, a_cols // step]
 
 
@@ -188,6 +236,7 @@ def minwarping(
     double_search: bool = False,
     template=None,
     windows=None,
+    quantised: bool = True,
 ) -> WarpingResult:
     """Min-warping home direction and visual compass of one image pair.
 
@@ -234,10 +283,26 @@ def minwarping(
     windows : tuple, optional
         Precomputed ``minwarp_windows(template)`` (the search reads the
         minimum over runs of allowed current columns from sliding minima).
+    quantised : bool
+        8-bit column distances with 16-bit sums, as in the SIMD reference
+        implementation (default; about as fast as it). ``False`` runs the
+        same search on float32 distances (the tests check that both agree
+        within one search step).
 
     Returns
     -------
     WarpingResult
+        ``score`` in NSAD units (summed over the snapshot columns, and over
+        both searches with ``double_search``).
+
+    Notes
+    -----
+    Runs on the calling thread and releases the GIL: parallelise over pairs.
+    With ``double_search`` and inversion-symmetric scale factors
+    (``sigma_{K-1-k} = 1 / sigma_k``, as the default ones) the distances of the
+    swapped pair are the pair's, transposed
+    (:func:`~bionav.homing.warping.kernels.swap_roles`); otherwise they are
+    computed anew.
     """
     scales = _check_pair(snapshot, current)
     scales, tau = check_scales(scales, thresholds)
@@ -248,19 +313,22 @@ def minwarping(
     p_all = _column_grid(n_psi, width)
     step = _layout_step(width, n_alpha, p_all, double_search)
     n_a_eff = width // step
-    tmpl = minwarp_template(width, scales, tau) if template is None else template
-    windows = minwarp_windows(tmpl, max_level=WINDOW_LEVEL) if windows is None else windows
-    levels = _window_minima(snapshot, current, step, windows)
-    dist = levels[0]
-    p_cols = _select_psi(dist, p_all, compass_fraction)
-    with PARALLEL_LOCK:
-        scores = minwarp_scores(levels, n_a_eff, p_cols, *windows, get_num_threads()).astype(np.float64)
-    dist2 = None
+    if windows is None:
+        tmpl = minwarp_template(width, scales, tau) if template is None else template
+        windows = minwarp_windows(tmpl, max_level=WINDOW_LEVEL)
+    levels = _window_minima(snapshot, current, step, windows, quantised)
+    p_cols = _select_psi(levels[0], p_all, compass_fraction)
+    scores = _search(levels, n_a_eff, p_cols, windows, quantised)
+    levels2 = None
     if double_search:
-        levels2 = _window_minima(current, snapshot, step, windows)
-        dist2 = levels2[0]
-        with PARALLEL_LOCK:
-            scores2 = minwarp_scores(levels2, n_a_eff, (-p_cols) % width, *windows, get_num_threads())
+        levels2 = _buffer("levels2", levels.shape, levels.dtype)
+        if _symmetric_scales(scales):
+            swap_roles(levels[0], levels2[0])
+            if levels2.shape[0] > 1:
+                fill_window_minima(levels2)
+        else:
+            _window_minima(current, snapshot, step, windows, quantised, name="levels2")
+        scores2 = _search(levels2, n_a_eff, (-p_cols) % width, windows, quantised)
         # hypothesis (a, p) of the pair corresponds to (a + W/2 - p, -p) of the swapped pair
         a_eff = np.arange(n_a_eff) * step
         idx = ((a_eff[None, :] + width // 2 - p_cols[:, None]) % width) // step
@@ -270,16 +338,20 @@ def minwarping(
     best_a, best_p, best = int(a_cols[ia]), int(p_cols[ip]), float(scores[ip, ia])
     if fine_search:
         best_a, best_p, best = _fine(
-            lambda ac, pc: _minwarp_at(dist, dist2, ac, pc, tmpl, width),
+            lambda ac, pc: _minwarp_at(levels, levels2, ac, pc, windows, width),
             best_a, best_p, best, width, n_alpha, n_psi,
         )
+    if quantised:
+        best /= distance_quantum(width)[0]
     return _result(best_a, best_p, np.nan, best, width, n_psi_searched=int(p_cols.size))
 
 
-def _minwarp_at(dist, dist2, a_cols, p_cols, tmpl, width):
-    out = minwarp_scores_at(dist, a_cols, p_cols, *tmpl)
-    if dist2 is not None:
-        out = out + minwarp_scores_at(dist2, (a_cols + width // 2 - p_cols) % width, (-p_cols) % width, *tmpl)
+def _minwarp_at(levels, levels2, a_cols, p_cols, windows, width):
+    out = minwarp_scores_at(levels, a_cols, p_cols, *windows)
+    if levels2 is not None:
+        out = out + minwarp_scores_at(
+            levels2, (a_cols + width // 2 - p_cols) % width, (-p_cols) % width, *windows
+        )
     return out
 
 
@@ -335,8 +407,7 @@ def warping2d_scores(
     rhos = rho_grid(n_rho, rho_max)
     v_tab, k_tab = warp2d_template(width, rhos, tau)
     dist = diagonal_distances(snapshot, current, step=step)
-    with PARALLEL_LOCK:
-        scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)
+    scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)
     return a_cols, p_cols, rhos, scores[:, :, a_cols // step]
 
 
@@ -397,8 +468,7 @@ def warping2d(
     v_tab, k_tab = warp2d_template(width, rhos, tau) if template is None else template
     dist = diagonal_distances(snapshot, current, step=step)
     p_cols = _select_psi(dist, p_all, compass_fraction)
-    with PARALLEL_LOCK:
-        scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)[:, :, a_cols // step]
+    scores = warp2d_scores(dist, width // step, p_cols, v_tab, k_tab)[:, :, a_cols // step]
     il, ip, ia = np.unravel_index(int(np.argmin(scores)), scores.shape)
     best_a, best_p, best = int(a_cols[ia]), int(p_cols[ip]), float(scores[il, ip, ia])
     if fine_search:

@@ -16,21 +16,20 @@ differences wins. Conventions of ``alpha``, ``psi`` and the home direction as in
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from bionav.geometry import wrap_angle
-from bionav.homing.warping.kernels import PARALLEL_LOCK
 from bionav.homing.warping.search import WarpingResult, rho_grid
 
 
-@njit(parallel=True, fastmath=True, cache=True)
+@njit(nogil=True, fastmath=True, cache=True)
 def _warp1d_scores(snap, cur4, alphas, psis, rhos):
     """``cur4`` is the current strip tiled four times plus one sample (no wrap needed)."""
     width = snap.shape[0]
     n_a, n_r, n_p = alphas.shape[0], rhos.shape[0], psis.shape[0]
     out = np.empty((n_a, n_r, n_p))
     scale = width / (2.0 * np.pi)
-    for t in prange(n_a * n_r):
+    for t in range(n_a * n_r):
         ia = t // n_r
         il = t - ia * n_r
         alpha = alphas[ia]
@@ -73,14 +72,13 @@ def warping1d_scores(snapshot, current, *, alphas, psis, rhos):
     c = np.ascontiguousarray(current, dtype=np.float64)
     if s.ndim != 1 or s.shape != c.shape:
         raise ValueError(f"need two horizon strips of equal length, got shapes {s.shape} and {c.shape}")
-    with PARALLEL_LOCK:
-        return _warp1d_scores(
-            s,
-            np.concatenate([c, c, c, c, c[:1]]),
-            np.asarray(alphas, dtype=np.float64),
-            np.asarray(psis, dtype=np.float64),
-            np.asarray(rhos, dtype=np.float64),
-        )
+    return _warp1d_scores(
+        s,
+        np.concatenate([c, c, c, c, c[:1]]),
+        np.asarray(alphas, dtype=np.float64),
+        np.asarray(psis, dtype=np.float64),
+        np.asarray(rhos, dtype=np.float64),
+    )
 
 
 def warping1d(

@@ -17,6 +17,7 @@ import numpy as np
 from bionav.geometry import wrap_angle
 from bionav.robot.controller import Command, Controller, LanePlan, Observation
 from bionav.robot.kinematics import Pose, wheel_speeds
+from bionav.validation import bounded
 
 
 @dataclass
@@ -39,13 +40,13 @@ class RandomConfig:
         Stop after driving this multiple of the ideal meander's path length.
     """
 
-    speed: float = 0.10
-    turn_rate: float = 0.5
-    track_width: float = 0.30
-    backoff: float = 0.03
-    min_turn_deg: float = 45.0
-    max_turn_deg: float = 180.0
-    path_factor: float = 1.0
+    speed: float = bounded(0.10, gt=0.0, le=5.0)
+    turn_rate: float = bounded(0.5, gt=0.0, le=20.0)
+    track_width: float = bounded(0.30, gt=0.0, le=5.0)
+    backoff: float = bounded(0.03, ge=0.0, le=10.0)
+    min_turn_deg: float = bounded(45.0, ge=0.0, le=360.0)
+    max_turn_deg: float = bounded(180.0, ge=0.0, le=360.0)
+    path_factor: float = bounded(1.0, gt=0.0, le=1000.0)
 
 
 class RandomController(Controller):

@@ -54,6 +54,7 @@ from bionav.geometry import wrap_angle
 from bionav.robot.controller import Observation
 from bionav.robot.kinematics import Pose
 from bionav.robot.meander import MeanderConfig, MeanderController
+from bionav.validation import bounded
 
 
 @dataclass
@@ -87,15 +88,15 @@ class TriangulationConfig(MeanderConfig):
     """
 
     bias_learning: bool = True
-    snapshot_interval: float = 0.10
-    max_snapshot_distance: float = 1.0
-    min_intersection_deg: float = 30.0
-    bearing_std_deg: float = 5.0
-    compass_std_deg: float = 3.0
-    orientation: str = "compass"
-    fix_gain: float = 0.5
-    max_innovation: float = 0.15
-    max_rejections: int = 3
+    snapshot_interval: float = bounded(0.10, gt=0.0, le=100.0)
+    max_snapshot_distance: float = bounded(1.0, gt=0.0, le=1000.0)
+    min_intersection_deg: float = bounded(30.0, ge=0.0, lt=90.0)
+    bearing_std_deg: float = bounded(5.0, gt=0.0, le=180.0)
+    compass_std_deg: float = bounded(3.0, gt=0.0, le=180.0)
+    orientation: str = bounded("compass", choices=("compass", "odometry"))
+    fix_gain: float = bounded(0.5, gt=0.0, le=1.0)
+    max_innovation: float = bounded(0.15, gt=0.0, le=100.0)
+    max_rejections: int = bounded(3, ge=0, le=1000)
 
 
 @dataclass

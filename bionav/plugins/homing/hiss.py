@@ -10,6 +10,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
 from bionav.homing.imageops import check_image_size
+from bionav.validation import Range, bounded
 
 
 class HissHoming(HomingMethod):
@@ -38,14 +39,14 @@ class HissHoming(HomingMethod):
         n_features, contrast_threshold, edge_threshold, sigma: OpenCV SIFT parameters.
         """
 
-        image_size: list[int] | None = None
-        wrap_pad: float = 0.1
-        ratio: float = 0.8
-        scale_threshold: float = 0.0
-        n_features: int = 0
-        contrast_threshold: float = 0.04
-        edge_threshold: float = 10.0
-        sigma: float = 1.6
+        image_size: list[int] | None = bounded(None, length=2, item=Range(ge=8, le=8192))
+        wrap_pad: float = bounded(0.1, ge=0.0, le=0.5)
+        ratio: float = bounded(0.8, gt=0.0, le=1.0)
+        scale_threshold: float = bounded(0.0, ge=0.0, le=10.0)
+        n_features: int = bounded(0, ge=0, le=100_000)
+        contrast_threshold: float = bounded(0.04, ge=0.0, le=1.0)
+        edge_threshold: float = bounded(10.0, gt=0.0, le=1000.0)
+        sigma: float = bounded(1.6, gt=0.0, le=10.0)
 
     def __init__(self, config: Any, *, geometry) -> None:
         super().__init__(config, geometry=geometry)

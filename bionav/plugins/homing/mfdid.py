@@ -8,6 +8,7 @@ from typing import Optional
 import numpy as np
 
 from bionav.homing.base import HomeVector, HomingMethod
+from bionav.validation import Range, bounded
 
 
 @dataclass
@@ -30,9 +31,9 @@ class MfdidConfig:
         floor and ceiling close to the robot.
     """
 
-    image_size: Optional[list[int]] = None
-    lowpass_sigma: float = 0.04
-    vertical_sigma: float = 0.0
+    image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=8, le=8192))
+    lowpass_sigma: float = bounded(0.04, ge=0.0, le=1.0)
+    vertical_sigma: float = bounded(0.0, ge=0.0, le=1.0)
     vertical_flow: bool = False
 
 

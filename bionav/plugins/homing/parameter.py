@@ -18,6 +18,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.geometry import PanoramaGeometry
 from bionav.homing.base import HomeVector, HomingMethod
+from bionav.validation import bounded
 
 GRADIENTS = ("auto", "test_steps", "matched_filter")
 
@@ -44,11 +45,11 @@ class Config:
     """
 
     signature: str = "mffc_phase"
-    gradient: str = "auto"
-    rings: Optional[int] = None
-    n_coeffs: Optional[int] = None
-    bins: Optional[int] = None
-    mf_step: float = 0.05
+    gradient: str = bounded("auto", choices=("auto", "test_steps", "matched_filter"))
+    rings: Optional[int] = bounded(None, ge=1, le=1000)
+    n_coeffs: Optional[int] = bounded(None, ge=1, le=1000)
+    bins: Optional[int] = bounded(None, ge=2, le=4096)
+    mf_step: float = bounded(0.05, gt=0.0, le=1.0)
 
 
 def _to_gray(image: np.ndarray) -> np.ndarray:

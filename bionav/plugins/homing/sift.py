@@ -8,6 +8,7 @@ from typing import Optional
 import numpy as np
 
 from bionav.homing.base import HomeVector, HomingMethod
+from bionav.validation import Range, bounded
 
 
 @dataclass
@@ -30,14 +31,14 @@ class SiftConfig:
         OpenCV SIFT parameters.
     """
 
-    search_radius: float = 0.22
-    combine: str = "average"
-    window: int = 10
-    image_size: Optional[list[int]] = None
-    n_features: int = 0
-    contrast_threshold: float = 0.04
-    edge_threshold: float = 10.0
-    sigma: float = 1.6
+    search_radius: float = bounded(0.22, gt=0.0, le=0.5)
+    combine: str = bounded("average", choices=("average", "max"))
+    window: int = bounded(10, ge=1, le=360)
+    image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=8, le=8192))
+    n_features: int = bounded(0, ge=0, le=100_000)
+    contrast_threshold: float = bounded(0.04, ge=0.0, le=1.0)
+    edge_threshold: float = bounded(10.0, gt=0.0, le=1000.0)
+    sigma: float = bounded(1.6, gt=0.0, le=10.0)
 
 
 class SiftHoming(HomingMethod):
@@ -76,6 +77,11 @@ class SiftHoming(HomingMethod):
             edge_threshold=c.edge_threshold,
             sigma=c.sigma,
         )
+
+    def describe_prepared(self, prepared) -> dict[str, float]:
+        """``keypoints``: the number of SIFT keypoints of the image (thesis tables B.1-B.4, "Keys")."""
+        xy = prepared["xy"] if isinstance(prepared, dict) else prepared.xy
+        return {"keypoints": float(len(xy))}
 
     def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
         from bionav.homing.sift_homing import sift_home_vector

@@ -10,7 +10,7 @@ no aligned images. The algorithms live in :mod:`bionav.homing.warping`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -18,6 +18,8 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
 from bionav.homing.imageops import check_image_size
+from bionav.homing.warping.scaleplanes import THRESHOLD_RULES
+from bionav.validation import Range, bounded
 
 
 def _grey(image) -> np.ndarray:
@@ -70,17 +72,24 @@ class _PlaneWarping(HomingMethod):
         self._template_width = None
 
     def _scales(self):
-        from bionav.homing.warping.scaleplanes import check_scales, default_scales
+        from bionav.homing.warping.scaleplanes import check_scales, default_scales, reference_thresholds
 
         cfg = self.config
         scales = default_scales() if cfg.scales is None else [float(x) for x in cfg.scales]
         thresholds = None if cfg.thresholds is None else [float(x) for x in cfg.thresholds]
+        if thresholds is None and getattr(cfg, "threshold_rule", "geometric") == "reference":
+            thresholds = reference_thresholds(scales, max_ratio=cfg.max_scale_ratio)
         return check_scales(scales, thresholds)
 
     def _check(self) -> None:
         cfg = self.config
         name = self.name
         _check_common(name, cfg)
+        rule = getattr(cfg, "threshold_rule", "geometric")
+        if rule not in THRESHOLD_RULES:
+            raise UserError(
+                f"homing.threshold_rule={rule!r} is not one of {', '.join(THRESHOLD_RULES)}"
+            )
         try:
             self._scales()
         except ValueError as exc:
@@ -154,25 +163,35 @@ class MinWarping(_PlaneWarping):
         butterworth_order: order of that filter.
         n_alpha, n_psi: search steps over 360 degrees for movement direction and rotation.
         scales: scale factors of the planes; null = 2 ** ((k - 4) / 4), k = 0..8.
-        thresholds: upper scale thresholds per plane; null = geometric midpoints.
+        thresholds: upper scale thresholds per plane; null = by threshold_rule.
+        threshold_rule: thresholds when none are given: geometric (geometric means of
+            neighbouring scales, no largest ratio) or reference (arithmetic means, largest
+            scale ratio max_scale_ratio, as the SIMD reference implementation WarpingSIMD).
+        max_scale_ratio: largest allowed scale ratio of the reference rule.
         compass_acceleration: search only compass_fraction of the rotations, those the
             visual compass measure ranks best.
         compass_fraction: fraction of rotations searched with compass acceleration.
         fine_search: refine alpha and psi at one-column resolution.
         double_search: also search with snapshot and current view exchanged.
+        quantised: 8-bit column distances summed in 16 bits, as the SIMD reference
+            implementation (fast); false searches float32 distances (about 2x slower,
+            home directions agree within one search step).
         """
 
-        image_size: list[int] | None = field(default_factory=lambda: [288, 50])
-        butterworth_cutoff: float | None = None
-        butterworth_order: int = 3
-        n_alpha: int = 96
-        n_psi: int = 96
-        scales: list[float] | None = None
-        thresholds: list[float] | None = None
+        image_size: list[int] | None = bounded([288, 50], length=2, item=Range(ge=8, le=8192))
+        butterworth_cutoff: float | None = bounded(None, gt=0.0, le=1.0)
+        butterworth_order: int = bounded(3, ge=1, le=10)
+        n_alpha: int = bounded(96, ge=4, le=4096)
+        n_psi: int = bounded(96, ge=4, le=4096)
+        scales: list[float] | None = bounded(None, gt=0.0, le=100.0)
+        thresholds: list[float] | None = bounded(None, gt=0.0, le=100.0)
+        threshold_rule: str = bounded("geometric", choices=THRESHOLD_RULES)
+        max_scale_ratio: float = bounded(2.5, gt=1.0, le=100.0)
         compass_acceleration: bool = False
-        compass_fraction: float = 0.25
+        compass_fraction: float = bounded(0.25, gt=0.0, le=1.0)
         fine_search: bool = False
         double_search: bool = False
+        quantised: bool = True
 
     def _check(self) -> None:
         super()._check()
@@ -210,6 +229,7 @@ class MinWarping(_PlaneWarping):
             double_search=cfg.double_search,
             template=template,
             windows=windows,
+            quantised=cfg.quantised,
         )
         return self._to_home_vector(result)
 
@@ -228,17 +248,17 @@ class Warping2D(_PlaneWarping):
     class Config:
         """Parameters of 2D-warping (see :class:`MinWarping.Config`; plus ``n_rho``, ``rho_max``)."""
 
-        image_size: list[int] | None = field(default_factory=lambda: [288, 50])
-        butterworth_cutoff: float | None = None
-        butterworth_order: int = 3
-        n_alpha: int = 96
-        n_psi: int = 96
-        n_rho: int = 20
-        rho_max: float = 0.95
-        scales: list[float] | None = None
-        thresholds: list[float] | None = None
+        image_size: list[int] | None = bounded([288, 50], length=2, item=Range(ge=8, le=8192))
+        butterworth_cutoff: float | None = bounded(None, gt=0.0, le=1.0)
+        butterworth_order: int = bounded(3, ge=1, le=10)
+        n_alpha: int = bounded(96, ge=4, le=4096)
+        n_psi: int = bounded(96, ge=4, le=4096)
+        n_rho: int = bounded(20, ge=1, le=1000)
+        rho_max: float = bounded(0.95, ge=0.0, lt=1.0)
+        scales: list[float] | None = bounded(None, gt=0.0, le=100.0)
+        thresholds: list[float] | None = bounded(None, gt=0.0, le=100.0)
         compass_acceleration: bool = False
-        compass_fraction: float = 0.25
+        compass_fraction: float = bounded(0.25, gt=0.0, le=1.0)
         fine_search: bool = False
 
     def _check(self) -> None:
@@ -296,14 +316,14 @@ class Warping1D(HomingMethod):
         n_alpha, n_psi, n_rho: search steps; rho_max: largest distance ratio.
         """
 
-        image_size: list[int] | None = field(default_factory=lambda: [288, 50])
-        butterworth_cutoff: float | None = None
-        butterworth_order: int = 3
-        strip_rows: int = 5
-        n_alpha: int = 36
-        n_psi: int = 36
-        n_rho: int = 36
-        rho_max: float = 0.95
+        image_size: list[int] | None = bounded([288, 50], length=2, item=Range(ge=8, le=8192))
+        butterworth_cutoff: float | None = bounded(None, gt=0.0, le=1.0)
+        butterworth_order: int = bounded(3, ge=1, le=10)
+        strip_rows: int = bounded(5, ge=1, le=8192)
+        n_alpha: int = bounded(36, ge=4, le=4096)
+        n_psi: int = bounded(36, ge=4, le=4096)
+        n_rho: int = bounded(36, ge=1, le=1000)
+        rho_max: float = bounded(0.95, ge=0.0, lt=1.0)
 
     def __init__(self, config: Any, *, geometry) -> None:
         super().__init__(config, geometry=geometry)

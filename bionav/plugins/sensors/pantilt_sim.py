@@ -12,17 +12,18 @@ from dataclasses import dataclass
 
 from bionav.errors import UserError
 from bionav.plugins.sensors.base import PanTiltPlugin
+from bionav.validation import bounded
 
 
 @dataclass
 class PanTiltSimConfig:
     """Parameters of ``pantilt=sim`` (defaults: PTU-46-17.5)."""
 
-    resolution_arcsec: float = 185.1428
-    pan_min_pos: int = -3090
-    pan_max_pos: int = 3090
-    tilt_min_pos: int = -907
-    tilt_max_pos: int = 604
+    resolution_arcsec: float = bounded(185.1428, gt=0.0, le=36000.0)
+    pan_min_pos: int = bounded(-3090, ge=-1_000_000, le=1_000_000)
+    pan_max_pos: int = bounded(3090, ge=-1_000_000, le=1_000_000)
+    tilt_min_pos: int = bounded(-907, ge=-1_000_000, le=1_000_000)
+    tilt_max_pos: int = bounded(604, ge=-1_000_000, le=1_000_000)
 
 
 class PanTiltSim(PanTiltPlugin):

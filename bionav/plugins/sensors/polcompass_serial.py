@@ -12,10 +12,11 @@ silent board, garbage or short reply, unplugged cable) raises
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from bionav.errors import UserError
 from bionav.plugins.sensors.base import SensorPlugin, SerialDeviceMixin
+from bionav.validation import Range, bounded
 
 ANALOG_COMMANDS = b"ZXCVBNM,"
 
@@ -35,11 +36,11 @@ class PolCompassSerialConfig:
     """Parameters of ``sensor=polcompass_serial``."""
 
     port: str = "/dev/ttyUSB0"
-    baudrate: int = 115200
-    timeout_s: float = 0.5
-    lines: list[int] = field(default_factory=lambda: [1, 2, 3])
-    reconnect_attempts: int = 1
-    reconnect_delay_s: float = 0.5
+    baudrate: int = bounded(115200, ge=50, le=4_000_000)
+    timeout_s: float = bounded(0.5, gt=0.0, le=3600.0)
+    lines: list[int] = bounded([1, 2, 3], length=(1, 8), item=Range(ge=1, le=8))
+    reconnect_attempts: int = bounded(1, ge=0, le=1000)
+    reconnect_delay_s: float = bounded(0.5, ge=0.0, le=3600.0)
 
 
 class PolCompassSerial(SerialDeviceMixin, SensorPlugin):

@@ -11,29 +11,30 @@ from the generator the experiment passes in.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from bionav.errors import UserError
 from bionav.plugins.sensors.base import SensorPlugin
 from bionav.plugins.sensors.polcompass_serial import READING_SCHEMA
+from bionav.validation import Range, bounded
 
 
 @dataclass
 class PolCompassSimConfig:
     """Parameters of ``sensor=polcompass_sim`` (the simulated device)."""
 
-    noise_v: float = 0.005  # output noise per reading, volts (about one ADC step)
-    gain_sigma: float = 0.03  # relative spread of the log-ratio gains
-    offset_sigma_v: float = 0.03  # spread of the output offsets, volts
-    sensitivity_sigma: float = 0.05  # relative spread of the photodiode pairs' sensitivity ratio
-    angle_sigma_deg: float = 1.0  # polarizer mounting spread
-    device_seed: int = 7  # which simulated device (its tolerances)
-    polarizer_efficiency: float = 0.99
-    cone_half_angle_deg: float = 10.0  # Hamamatsu S5821-1 with lens
-    unit_angles_deg: list[float] = field(default_factory=lambda: [0.0, 60.0, 120.0])
-    lines: list[int] = field(default_factory=lambda: [1, 2, 3])
+    noise_v: float = bounded(0.005, ge=0.0, le=10.0)  # output noise per reading, volts (about one ADC step)
+    gain_sigma: float = bounded(0.03, ge=0.0, le=10.0)  # relative spread of the log-ratio gains
+    offset_sigma_v: float = bounded(0.03, ge=0.0, le=10.0)  # spread of the output offsets, volts
+    sensitivity_sigma: float = bounded(0.05, ge=0.0, le=10.0)  # relative spread of the photodiode pairs' sensitivity ratio
+    angle_sigma_deg: float = bounded(1.0, ge=0.0, le=90.0)  # polarizer mounting spread
+    device_seed: int = bounded(7, ge=0)  # which simulated device (its tolerances)
+    polarizer_efficiency: float = bounded(0.99, ge=0.0, le=1.0)
+    cone_half_angle_deg: float = bounded(10.0, ge=0.0, lt=90.0)  # Hamamatsu S5821-1 with lens
+    unit_angles_deg: list[float] = bounded([0.0, 60.0, 120.0], length=(2, 8), item=Range(ge=-360.0, le=360.0))
+    lines: list[int] = bounded([1, 2, 3], length=(1, 8), item=Range(ge=1, le=8))
 
 
 def build_hardware(config: PolCompassSimConfig):

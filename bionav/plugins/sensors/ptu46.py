@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass
 
 from bionav.plugins.sensors.base import PanTiltPlugin, SerialDeviceMixin
+from bionav.validation import bounded
 
 
 @dataclass
@@ -29,12 +30,12 @@ class PTU46Config:
     """Parameters of ``pantilt=ptu46``."""
 
     port: str = "/dev/ttyUSB1"
-    baudrate: int = 9600
-    timeout_s: float = 1.0
-    await_timeout_s: float = 30.0  # longest move
-    settle_s: float = 0.1  # quiet time when draining the port at start-up
-    reconnect_attempts: int = 1
-    reconnect_delay_s: float = 0.5
+    baudrate: int = bounded(9600, ge=50, le=4_000_000)
+    timeout_s: float = bounded(1.0, gt=0.0, le=3600.0)
+    await_timeout_s: float = bounded(30.0, gt=0.0, le=36000.0)  # longest move
+    settle_s: float = bounded(0.1, ge=0.0, le=60.0)  # quiet time when draining the port at start-up
+    reconnect_attempts: int = bounded(1, ge=0, le=1000)
+    reconnect_delay_s: float = bounded(0.5, ge=0.0, le=3600.0)
 
 
 class PTU46(SerialDeviceMixin, PanTiltPlugin):

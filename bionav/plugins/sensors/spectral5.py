@@ -27,6 +27,7 @@ import numpy as np
 from bionav.errors import DeviceError
 from bionav.plugins.sensors.base import SensorPlugin
 from bionav.spectral.protocol import RAW_SCHEMA, RAW_SCHEMA_NAME, reading_message
+from bionav.validation import bounded
 
 
 class BadReply(DeviceError):
@@ -79,10 +80,10 @@ class Spectral5Serial(_Spectral5Base):
         """
 
         port: str = "/dev/ttyUSB0"
-        baudrate: int = 9600
-        timeout_s: float = 2.0
-        retries: int = 1
-        readings_per_point: int = 1
+        baudrate: int = bounded(9600, ge=50, le=4_000_000)
+        timeout_s: float = bounded(2.0, gt=0.0, le=3600.0)
+        retries: int = bounded(1, ge=0, le=1000)
+        readings_per_point: int = bounded(1, ge=1, le=100_000)
 
     def __init__(self, config: "Spectral5Serial.Config | None" = None, **_ignored) -> None:
         self.config = config or self.Config()
@@ -253,9 +254,9 @@ class Spectral5Sim(_Spectral5Base):
             Seed of the noise until an experiment attaches its generator.
         """
 
-        noise_counts: float = 4.0
-        readings_per_point: int = 1
-        seed: int = 0
+        noise_counts: float = bounded(4.0, ge=0.0, le=1e6)
+        readings_per_point: int = bounded(1, ge=1, le=100_000)
+        seed: int = bounded(0, ge=0)
 
     def __init__(self, config: "Spectral5Sim.Config | None" = None, **_ignored) -> None:
         from bionav.spectral.sensor_model import LogSensorModel

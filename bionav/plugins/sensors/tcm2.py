@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 from bionav.errors import UserError
 from bionav.plugins.sensors.base import SensorPlugin, SerialDeviceMixin
+from bionav.validation import bounded
 
 READING_SCHEMA = {
     "type": "object",
@@ -41,11 +42,11 @@ class TCM2Config:
     """Parameters of ``sensor=tcm2``."""
 
     port: str = "/dev/ttyUSB2"
-    baudrate: int = 9600
-    timeout_s: float = 1.0
-    output: str = "standard"  # standard | nmea | keep (leave the device's setting)
-    reconnect_attempts: int = 1
-    reconnect_delay_s: float = 0.5
+    baudrate: int = bounded(9600, ge=50, le=4_000_000)
+    timeout_s: float = bounded(1.0, gt=0.0, le=3600.0)
+    output: str = bounded("standard", choices=("standard", "nmea", "keep"))  # standard | nmea | keep (leave the device's setting)
+    reconnect_attempts: int = bounded(1, ge=0, le=1000)
+    reconnect_delay_s: float = bounded(0.5, ge=0.0, le=3600.0)
 
 
 class TCM2(SerialDeviceMixin, SensorPlugin):

@@ -14,15 +14,17 @@ from dataclasses import dataclass
 from bionav.errors import UserError
 from bionav.plugins.sensors.base import SensorPlugin
 from bionav.plugins.sensors.tcm2 import READING_SCHEMA
+from bionav.validation import bounded
 
 
 @dataclass
 class TCM2SimConfig:
     """Parameters of ``sensor=tcm2_sim``."""
 
-    noise_deg: float = 0.3  # heading noise, one standard deviation
-    mounting_offset_deg: float = 0.0  # TCM2 forward axis relative to the polarized-light compass' x axis (CCW)
-    output: str = "standard"  # standard | nmea
+    noise_deg: float = bounded(0.3, ge=0.0, le=180.0)  # heading noise, one standard deviation
+    # TCM2 forward axis relative to the polarized-light compass' x axis (CCW)
+    mounting_offset_deg: float = bounded(0.0, ge=-360.0, le=360.0)
+    output: str = bounded("standard", choices=("standard", "nmea"))
 
 
 def simulated_attitude(scene, rng, *, noise_deg: float, mounting_offset_deg: float = 0.0) -> tuple[float, float, float]:

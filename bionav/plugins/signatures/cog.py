@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.homing.signatures.base import Signature
+from bionav.validation import bounded
 
 
 @dataclass
@@ -29,8 +30,8 @@ class CogConfig:
         state it.
     """
 
-    rings: int = 20
-    inner_radius: float = 0.2
+    rings: int = bounded(20, ge=1, le=1000)
+    inner_radius: float = bounded(0.2, ge=0.0, lt=1.0)
 
 
 def _cog(signature: Signature, image, raw) -> np.ndarray:

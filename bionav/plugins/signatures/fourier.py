@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.homing.signatures.base import Signature
+from bionav.validation import bounded
 
 
 @dataclass
@@ -34,7 +35,7 @@ class FourierConfig:
         sweep: 1-20, 25, 30, 35, 40; its best results use 4-20).
     """
 
-    n_coeffs: int = 8
+    n_coeffs: int = bounded(8, ge=1, le=1000)
 
 
 class _RowSpectrum(Signature):

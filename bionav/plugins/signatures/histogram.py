@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.homing.signatures.base import Signature
+from bionav.validation import bounded
 
 
 @dataclass
@@ -30,9 +31,9 @@ class HistogramConfig:
         at the price of depending on two extreme pixels.
     """
 
-    rings: int = 20
-    bins: int = 16
-    bin_range: str = "unit"
+    rings: int = bounded(20, ge=1, le=1000)
+    bins: int = bounded(16, ge=2, le=4096)
+    bin_range: str = bounded("unit", choices=("unit", "image"))
 
 
 def _value_range(signature):

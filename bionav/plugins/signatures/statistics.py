@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.homing.signatures.base import Signature
+from bionav.validation import bounded
 
 
 @dataclass
@@ -21,7 +22,7 @@ class RingsConfig:
         thesis' best ring-based results mostly use 20 or 25).
     """
 
-    rings: int = 20
+    rings: int = bounded(20, ge=1, le=1000)
 
 
 class Mean(Signature):

@@ -1,0 +1,472 @@
+"""Typed configs of the experiments: one dataclass per ``experiment=<name>``, defaults in one place.
+
+Each dataclass is stored in Hydra's ConfigStore as ``experiment_schema/<name>``
+(:func:`register`); the preset ``conf/experiment/<name>.yaml`` puts it under
+``experiment`` first in its defaults list and then sets only what differs or
+what refers to other keys. Hydra therefore rejects unknown keys and values of
+the wrong type at composition; :func:`experiment_config` fills the defaults
+for configs built without Hydra and checks every value against its range
+(:func:`bionav.validation.check_config`), naming the key (``experiment.<key>``).
+
+Units: metres and grid units as named; angles in degrees only in keys ending
+``_deg``; times ISO 8601 with zone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+from omegaconf import II, DictConfig, OmegaConf
+
+from bionav.validation import Range, bounded, check_config
+
+_STEP = dict(gt=0.0, le=10.0)  # agent step length, grid units (thesis 3.2.3: 0.5)
+_RADIUS = dict(gt=0.0, le=100.0)  # success radius, grid units (thesis: 1.0)
+_LAT = Range(ge=-90.0, le=90.0)
+
+
+# --------------------------------------------------------------------------- homing on grids
+@dataclass
+class GridHomingConfig:
+    """``experiment=grid_homing``: every snapshot position against every other position.
+
+    step_length, success_radius : agent step and success radius, grid units (thesis 3.2.3).
+    n_quiver_plots : quiver plots of home-vector fields for this many snapshots.
+    snapshots : only these snapshot indices (None = all); handy for quick looks.
+    """
+
+    name: str = "grid_homing"
+    step_length: float = bounded(0.5, **_STEP)
+    success_radius: float = bounded(1.0, **_RADIUS)
+    n_quiver_plots: int = bounded(4, ge=0, le=1000)
+    snapshots: Optional[list[int]] = bounded(None, length=(1, 1_000_000), item=Range(ge=0, le=10**8))
+
+
+@dataclass
+class CrossDbConfig:
+    """``experiment=cross_db`` (thesis 5.1.4, fig. 5.6): snapshots from one database, current views from another.
+
+    family : databases sharing one grid (``db.image_size``, ``db.seed``, ``db.noise`` apply to all).
+    snapshot_stride : evaluate every k-th grid cell along x and y as snapshot (1 = all, as the thesis).
+    """
+
+    name: str = "cross_db"
+    family: list[str] = bounded(
+        ["sim_original", "sim_arboreal", "sim_chairs", "sim_day", "sim_doorlit", "sim_screen", "sim_twilight",
+         "sim_winlit"], length=(2, 100))
+    snapshot_stride: int = bounded(2, ge=1, le=1000)
+    step_length: float = bounded(0.5, **_STEP)
+    success_radius: float = bounded(1.0, **_RADIUS)
+
+
+@dataclass
+class ParamSweepConfig:
+    """``experiment=param_sweep`` (thesis 5.2.1, tables 5.5-5.7), run as a multirun.
+
+    grid : which sweep grid of ``grids`` the sweeper and the jobs use (``full`` = the thesis', ``ci`` = reduced).
+    grids : named sweep grids: ``signature``, ``image_size``, ``preprocess`` (sweeper values) and
+        ``rings``, ``n_coeffs`` (evaluated inside each job); the preset ``conf/experiment/param_sweep.yaml``
+        holds ``full`` (the thesis') and ``ci`` next to the sweeper parameters that use them.
+    rings, n_coeffs : the values each job evaluates (from the selected grid unless overridden).
+    """
+
+    name: str = "param_sweep"
+    grid: str = "full"
+    grids: dict[str, Any] = field(default_factory=dict)
+    rings: list[int] = bounded(II("experiment.grids.${experiment.grid}.rings"), length=(1, 1000),
+                               item=Range(ge=1, le=1000))
+    n_coeffs: list[int] = bounded(II("experiment.grids.${experiment.grid}.n_coeffs"), length=(1, 1000),
+                                  item=Range(ge=1, le=1000))
+    step_length: float = bounded(0.5, **_STEP)
+    success_radius: float = bounded(1.0, **_RADIUS)
+
+
+# --------------------------------------------------------------------------- spectral / skyline
+@dataclass
+class LearnSamplesConfig:
+    """Labelled samples the separation lines are learned on (thesis: the natural samples)."""
+
+    name: str = bounded("sim_natural", choices=("sim_natural", "sim_artificial"))
+    seed: int = bounded(II("seed"), ge=0, le=2**32 - 1)
+    n_objects: int = bounded(239, ge=2, le=1_000_000)
+    n_sky: int = bounded(233, ge=2, le=1_000_000)
+
+
+@dataclass
+class ContrastLdaConfig:
+    """``experiment=contrast_lda`` (thesis 6.2-6.3): sky/object discrimination per spectral feature.
+
+    sigma : receptor noise for J_sigma, ADC counts (thesis: 30).
+    n_resamples : bootstrap data sets for the significance tables (0 = skip).
+    """
+
+    name: str = "contrast_lda"
+    sigma: float = bounded(30.0, gt=0.0, le=1e6)
+    n_resamples: int = bounded(10000, ge=0, le=10_000_000)
+    plots: bool = True
+
+
+def _scan_times() -> list[str]:
+    return ["2009-06-17T11:27:04+02:00", "2009-06-17T12:06:19+02:00", "2009-06-17T12:46:02+02:00",
+            "2009-06-17T13:25:05+02:00", "2009-06-17T14:07:52+02:00", "2009-06-17T14:47:21+02:00",
+            "2009-06-17T15:26:36+02:00", "2009-06-17T16:07:15+02:00", "2009-06-17T16:46:10+02:00",
+            "2009-06-17T17:26:10+02:00", "2009-06-17T18:44:09+02:00", "2009-06-17T19:24:41+02:00",
+            "2009-06-17T20:03:57+02:00", "2009-06-17T20:43:36+02:00"]
+
+
+@dataclass
+class ContrastScanConfig:
+    """``experiment=contrast_scan`` (thesis 6.4): 2-D scans with the five-channel sensor over a day.
+
+    times : one scan per time (ISO 8601 with zone); default: the one-day data set of 17 June 2009 (appendix D.3).
+    cloud_cover, cloud_optical_depth : simulated weather per scan (one value or one per time).
+    scan_minutes : simulated duration of one scan (sun and clouds move meanwhile).
+    n_pan, pan_step_deg, pan_centre_deg, n_tilt, tilt_step_deg, tilt_start_deg : the scan grid
+        (thesis 6.4.1: 113 pan x 26 tilt steps of 2 and 3 degrees); tilt = elevation of the optical axis.
+    sigma : receptor noise of the J_sigma separation lines, counts.
+    """
+
+    name: str = "contrast_scan"
+    times: list[str] = field(default_factory=_scan_times)
+    # one value, or a list with one value per time
+    cloud_cover: Any = bounded([0.85, 0.9, 0.8, 0.85, 0.9, 0.75, 0.7, 0.8, 0.6, 0.45, 0.3, 0.2, 0.15, 0.1],
+                               ge=0.0, le=1.0)
+    cloud_optical_depth: Any = bounded([35, 40, 35, 45, 40, 35, 30, 35, 25, 20, 15, 12, 10, 10], ge=0.0, le=1000.0)
+    turbidity: float = bounded(0.1, ge=0.0, le=100.0)
+    cloud_seed: int = bounded(0, ge=0, le=2**32 - 1)
+    scene_seed: int = bounded(0, ge=0, le=2**32 - 1)
+    scan_minutes: float = bounded(20.0, ge=0.0, le=24 * 60.0)
+    n_pan: int = bounded(113, ge=1, le=100_000)
+    pan_step_deg: float = bounded(2.0, gt=0.0, le=360.0)
+    pan_centre_deg: float = bounded(0.0, ge=-360.0, le=360.0)
+    n_tilt: int = bounded(26, ge=1, le=100_000)
+    tilt_step_deg: float = bounded(3.0, gt=0.0, le=180.0)
+    tilt_start_deg: float = bounded(-45.0, ge=-90.0, le=90.0)
+    plots: bool = True
+    sigma: float = bounded(30.0, gt=0.0, le=1e6)
+    learn: LearnSamplesConfig = field(default_factory=LearnSamplesConfig)
+
+
+@dataclass
+class SkyConditionConfig:
+    """One light condition of ``experiment=skyline_homing``."""
+
+    name: str = "noon_overcast"
+    time: str = "2009-06-17T12:00:00+02:00"
+    cloud_cover: float = bounded(0.95, ge=0.0, le=1.0)
+    cloud_optical_depth: float = bounded(40.0, ge=0.0, le=1000.0)
+
+
+def _conditions() -> list[SkyConditionConfig]:
+    return [SkyConditionConfig("noon_overcast", "2009-06-17T12:00:00+02:00", 0.95, 40),
+            SkyConditionConfig("afternoon_broken", "2009-06-17T16:00:00+02:00", 0.5, 25),
+            SkyConditionConfig("evening_clear", "2009-06-17T20:00:00+02:00", 0.1, 10)]
+
+
+@dataclass
+class SkylineHomingConfig:
+    """``experiment=skyline_homing``: outdoor homing from five-channel images under changing light.
+
+    world : ``garden`` (shrubs, trees, buildings, tree line) or ``campus`` (the sim_uni world in 5 bands).
+    grid : grid cells (x, y) of the garden (the campus has its own 10 x 17 at 1 m).
+    image_width, image_height : panorama columns (3 degrees each at 120) and rows from ``elevation_top_deg`` down.
+    noise_counts : sensor noise per pixel, ADC counts.
+    conditions : snapshots under one condition, current views under another.
+    representations : single channels, dual contrasts, binary skylines (``skyline:<feature>``).
+    snapshot_stride : every k-th cell along x and y is a snapshot.
+    square_test, square_side_m : thesis 6.5.2, corners of a square.
+    sigma : receptor noise of the J_sigma skyline lines.
+    """
+
+    name: str = "skyline_homing"
+    world: str = bounded("garden", choices=("garden", "campus"))
+    world_seed: int = bounded(0, ge=0, le=2**32 - 1)
+    grid: list[int] = bounded([9, 9], length=2, item=Range(ge=1, le=1000))
+    spacing_m: float = bounded(0.5, gt=0.0, le=100.0)
+    image_width: int = bounded(120, ge=8, le=8192)
+    image_height: int = bounded(20, ge=2, le=8192)
+    elevation_top_deg: float = bounded(45.0, gt=-90.0, le=90.0)
+    noise_counts: float = bounded(4.0, ge=0.0, le=1e6)
+    turbidity: float = bounded(0.1, ge=0.0, le=100.0)
+    conditions: list[SkyConditionConfig] = field(default_factory=_conditions)
+    representations: list[str] = field(default_factory=lambda: [
+        "UV", "B", "G", "R", "IR", "UV-B", "UV-G", "UV-R", "UV-IR", "B-G", "B-R", "B-IR", "G-R", "G-IR", "R-IR",
+        "skyline:UV", "skyline:UV-G", "skyline:UV-IR", "skyline:B-IR", "skyline:all"])
+    snapshot_stride: int = bounded(2, ge=1, le=1000)
+    step_length: float = bounded(0.5, **_STEP)
+    success_radius: float = bounded(1.0, **_RADIUS)
+    square_test: bool = True
+    square_side_m: float = bounded(2.0, gt=0.0, le=1000.0)
+    sigma: float = bounded(30.0, gt=0.0, le=1e6)
+    plots: bool = True
+    learn: LearnSamplesConfig = field(default_factory=LearnSamplesConfig)
+
+
+# --------------------------------------------------------------------------- polarized-light compass
+@dataclass
+class PolSkyConfig:
+    """Simulated sky, and the sun the compass assumes (azimuths counter-clockwise from east).
+
+    time : ISO-8601 time (or ``now``): sun from time and place via ephem; None: the angles below.
+    turbidity : Preetham turbidity; sets the maximum degree of polarization (``max_degree`` overrides it).
+    neutral_point_separation_deg : > 0: Berry et al. (2004) model with four neutral points.
+    mount_heading_deg : simulated heading of the pan-tilt mount at pan 0.
+    """
+
+    time: Optional[str] = None
+    latitude_deg: float = bounded(52.03, ge=-90.0, le=90.0)
+    longitude_deg: float = bounded(8.53, ge=-180.0, le=360.0)
+    sun_elevation_deg: float = bounded(30.0, ge=-90.0, le=90.0)
+    sun_azimuth_deg: float = bounded(0.0, ge=-360.0, le=360.0)
+    turbidity: float = bounded(1.25, ge=1.0, le=100.0)
+    max_degree: Optional[float] = bounded(None, ge=0.0, le=1.0)
+    neutral_point_separation_deg: float = bounded(0.0, ge=0.0, le=90.0)
+    cloud_cover: float = bounded(0.0, ge=0.0, le=1.0)
+    cloud_correlation_deg: float = bounded(15.0, gt=0.0, le=180.0)
+    mount_heading_deg: float = bounded(20.0, ge=-360.0, le=360.0)
+    magnetic_declination_deg: float = bounded(0.0, ge=-180.0, le=180.0)
+
+
+@dataclass
+class PolFilterConfig:
+    """``filter_test``: the extra polarizer over unpolarized light."""
+
+    axis_deg: float = bounded(0.0, ge=-360.0, le=360.0)
+    efficiency: float = bounded(0.99, ge=0.0, le=1.0)
+
+
+@dataclass
+class PolVsEmConfig:
+    """``vs_em_compass``: positions and samples per position."""
+
+    positions: int = bounded(18, ge=1, le=100_000)
+    samples: int = bounded(100, ge=1, le=1_000_000)
+
+
+@dataclass
+class PolScanConfig:
+    """``evector_scan`` grid."""
+
+    pan_step_deg: float = bounded(20.0, gt=0.0, le=360.0)
+    tilts_deg: list[float] = bounded([-45.0, -30.0, -15.0, 0.0, 15.0, 30.0], length=(1, 10_000),
+                                     item=Range(ge=-90.0, le=90.0))
+    samples: int = bounded(5, ge=1, le=1_000_000)
+
+
+@dataclass
+class PolPartialConfig:
+    """``partial_sky`` conditions (simulation)."""
+
+    sun_elevations_deg: list[float] = bounded([15.0, 30.0, 45.0, 60.0], length=(1, 10_000),
+                                              item=Range(ge=-90.0, le=90.0))
+    cloud_covers: list[float] = bounded([0.0, 0.3, 0.5, 0.7, 0.85, 0.95], length=(1, 10_000),
+                                        item=Range(ge=0.0, le=1.0))
+    trials: int = bounded(4, ge=1, le=100_000)
+    pan_step_deg: float = bounded(45.0, gt=0.0, le=360.0)
+    tilts_deg: list[float] = bounded([-45.0, -30.0, -15.0, 0.0, 15.0, 30.0], length=(1, 10_000),
+                                     item=Range(ge=-90.0, le=90.0))
+    samples: int = bounded(1, ge=1, le=1_000_000)
+
+
+@dataclass
+class PolCompassConfig:
+    """``experiment=pol_compass`` (thesis chapter 4); ``mode=<name>`` picks the sub-experiment.
+
+    samples_per_step, step_deg : readings per pan position and pan step (rotation, filter_test).
+    pan_range_deg : ``[min, max]``; None = the pan-tilt unit's whole range.
+    tilt_deg : rotation: 0 looks at the zenith (axial result); tilted views resolve the pair.
+    solver : ``least_squares`` (three units) or ``two_unit`` (eqs. 4.4-4.6 on units 1 and 2).
+    calibration : ``auto`` (from the rotation at tilt 0, else nominal), ``rotation``, ``nominal``,
+        ``file`` (``calibration_path``: calibration.json of an earlier rotation run).
+    unit_angles_deg : nominal polarizer angles of the POL-OP units.
+    ambiguity_margin : error-function difference needed to call the candidate pair resolved.
+    min_degree : scans: readings with a lower degree of polarization (clouds) are ignored.
+    fake_devices : serve fake devices on pseudo-terminals for the serial plugins (demo/tests).
+    reference : vs_em_compass: the electromagnetic compass, a sensor plugin node (``name`` and its parameters).
+    """
+
+    name: str = "pol_compass"
+    mode: str = bounded("rotation", choices=("filter_test", "rotation", "vs_em_compass", "evector_scan",
+                                             "partial_sky"))
+    samples_per_step: int = bounded(10, ge=1, le=1_000_000)
+    step_deg: float = bounded(3.0, gt=0.0, le=360.0)
+    pan_range_deg: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-360.0, le=360.0))
+    tilt_deg: float = bounded(0.0, ge=-90.0, le=90.0)
+    solver: str = bounded("least_squares", choices=("least_squares", "two_unit"))
+    calibration: str = bounded("auto", choices=("auto", "rotation", "nominal", "file"))
+    calibration_path: Optional[str] = None
+    unit_angles_deg: list[float] = bounded([0.0, 60.0, 120.0], length=(2, 8), item=Range(ge=-360.0, le=360.0))
+    ambiguity_margin: float = bounded(1.0e-4, ge=0.0, le=1.0)
+    min_degree: float = bounded(0.05, ge=0.0, le=1.0)
+    fake_devices: bool = False
+    sky: PolSkyConfig = field(default_factory=PolSkyConfig)
+    filter: PolFilterConfig = field(default_factory=PolFilterConfig)
+    reference: dict[str, Any] = field(default_factory=lambda: {"name": "tcm2_sim"})
+    vs_em: PolVsEmConfig = field(default_factory=PolVsEmConfig)
+    scan: PolScanConfig = field(default_factory=PolScanConfig)
+    partial: PolPartialConfig = field(default_factory=PolPartialConfig)
+
+
+# --------------------------------------------------------------------------- cleaning robot
+@dataclass
+class CleaningCameraConfig:
+    """The robot's panoramic camera (thesis 7.2: unfolded images of 335 x 40).
+
+    height_m : camera height above the floor. horizon_row : None = the middle row (square pixels).
+    noise : pixel noise std before 8-bit quantisation (seeded per run and capture).
+    """
+
+    width: int = bounded(335, ge=8, le=8192)
+    height: int = bounded(40, ge=2, le=8192)
+    height_m: float = bounded(0.30, gt=0.0, le=100.0)
+    horizon_row: Optional[float] = bounded(None, ge=-100_000.0, le=100_000.0)
+    noise: float = bounded(0.01, ge=0.0, le=1.0)
+
+
+@dataclass
+class CleaningOracleConfig:
+    """``vision=oracle``: home vectors from the true geometry plus Gaussian noise."""
+
+    angle_noise_deg: float = bounded(5.0, ge=0.0, le=180.0)
+    compass_noise_deg: float = bounded(3.0, ge=0.0, le=180.0)
+
+
+@dataclass
+class CleaningConfig:
+    """``experiment=cleaning`` (thesis chapter 7; Gerstmayr et al. 2009): the lane controller.
+
+    runs : runs per configuration (the top-level ``runs`` is a shortcut).
+    vision : ``render`` (panoramas rendered at the true pose, homing with ``cfg.homing``) or ``oracle``.
+    wheel_error : static wheel-speed error, +e left / -e right for the first half of the runs, swapped after.
+    track_width, robot_radius, robot_height : wheel distance, footprint radius, height (m).
+    start_position_std, start_heading_std_deg : manual placement at the start.
+    dt : control period (s). time_limit_factor : a run ends after this multiple of the ideal meander's time.
+    raster_cell, raster_margin : coverage raster (m) and how far it extends beyond the target area.
+    log_images : also log every grabbed image (lossless) to run.mcap.
+    """
+
+    name: str = "cleaning"
+    runs: int = bounded(II("runs"), ge=1, le=100_000)
+    vision: str = bounded("render", choices=("render", "oracle"))
+    world: str = "apartment"
+    world_seed: int = bounded(0, ge=0, le=2**32 - 1)
+    camera: CleaningCameraConfig = field(default_factory=CleaningCameraConfig)
+    oracle: CleaningOracleConfig = field(default_factory=CleaningOracleConfig)
+    wheel_error: float = bounded(0.05, ge=-0.5, le=0.5)
+    track_width: float = bounded(0.30, gt=0.0, le=5.0)
+    robot_radius: float = bounded(0.17, gt=0.0, le=5.0)
+    robot_height: float = bounded(0.35, gt=0.0, le=10.0)
+    start_position_std: float = bounded(0.01, ge=0.0, le=10.0)
+    start_heading_std_deg: float = bounded(1.0, ge=0.0, le=180.0)
+    dt: float = bounded(0.1, gt=0.0, le=10.0)
+    time_limit_factor: float = bounded(3.0, gt=0.0, le=1000.0)
+    raster_cell: float = bounded(0.01, ge=0.001, le=1.0)
+    raster_margin: float = bounded(0.5, ge=0.0, le=100.0)
+    log_images: bool = False
+
+
+# --------------------------------------------------------------------------- top-level run settings
+@dataclass
+class RunSettings:
+    """Top-level keys of every run (``conf/config.yaml``): ``seed=``, ``workers=``."""
+
+    seed: int = bounded(0, ge=0, le=2**32 - 1)
+    workers: int = bounded(2, ge=1, le=1024)
+
+
+def check_run_settings(cfg: DictConfig) -> None:
+    """Check the top-level ``seed`` and ``workers`` against :class:`RunSettings` (key, value, range)."""
+    from bionav.errors import UserError
+
+    values = {}
+    for f in ("seed", "workers"):
+        value = cfg.get(f) if isinstance(cfg, DictConfig) else None
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise UserError(f"bad value {f}={value}: it must be an integer; allowed: "
+                            f"{RunSettings.__dataclass_fields__[f].metadata['range'].describe(integer=True)}.")
+        values[f] = value
+    check_config(RunSettings(**values), prefix="")
+
+
+#: experiment name -> its config dataclass
+EXPERIMENT_CONFIGS: dict[str, type] = {
+    "grid_homing": GridHomingConfig,
+    "cross_db": CrossDbConfig,
+    "param_sweep": ParamSweepConfig,
+    "contrast_lda": ContrastLdaConfig,
+    "contrast_scan": ContrastScanConfig,
+    "skyline_homing": SkylineHomingConfig,
+    "pol_compass": PolCompassConfig,
+    "cleaning": CleaningConfig,
+}
+
+
+def register(store=None) -> None:
+    """Store every experiment's dataclass as ``experiment_schema/<name>`` in Hydra's ConfigStore."""
+    from hydra.core.config_store import ConfigStore
+
+    store = store or ConfigStore.instance()
+    for name, cls in EXPERIMENT_CONFIGS.items():
+        store.store(group="experiment_schema", name=name, node=cls, provider="bionav")
+
+
+def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
+    """The run's ``experiment`` node typed by its dataclass, defaults filled, every value checked.
+
+    Parameters
+    ----------
+    cfg : DictConfig
+        The whole run config (``experiment.name`` selects the dataclass;
+        interpolations such as ``${seed}`` resolve against it, ``seed``
+        defaulting to 0).
+    name : str, optional
+        The experiment to assume when the node has no ``name`` (an experiment
+        module passes its own).
+
+    Returns
+    -------
+    DictConfig
+        A structured node (attribute access, ``.get``, typed assignment) of
+        :data:`EXPERIMENT_CONFIGS` ``[name]``; an experiment without a
+        dataclass gets its node back unchanged.
+
+    Raises
+    ------
+    UserError
+        An unknown key (the message lists the valid ones and the closest), a
+        value of the wrong type, or a value outside its range (key, value and
+        allowed range named).
+    """
+    from omegaconf.errors import OmegaConfBaseException
+
+    from bionav.config import unknown_key_message
+    from bionav.errors import UserError
+
+    node = cfg.get("experiment") if isinstance(cfg, DictConfig) else None
+    if node is not None and node.get("name") is not None:
+        name = str(node.get("name"))
+    schema = EXPERIMENT_CONFIGS.get(name or "")
+    if schema is None:
+        return node
+    try:
+        root = OmegaConf.merge(OmegaConf.create({"seed": 0, "experiment": OmegaConf.structured(schema)}), cfg)
+        exp = root.experiment
+        instance = OmegaConf.to_object(exp)
+    except OmegaConfBaseException as exc:
+        key = str(getattr(exc, "full_key", "") or "")
+        kind = type(exc).__name__
+        if kind in ("ConfigKeyError", "ConfigAttributeError") and key:
+            parent, bad = key.rsplit(".", 1) if "." in key else ("", key)
+            where = OmegaConf.select(OmegaConf.structured(schema), parent.partition(".")[2]) if "." in parent \
+                else OmegaConf.structured(schema)
+            valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
+            raise UserError(unknown_key_message(parent, bad, valid, what=f"experiment={name}")) from None
+        raise UserError(
+            f"bad value for {key or 'experiment'} (experiment={name}): {str(exc).splitlines()[0]}. "
+            f"Give it a value of the declared type (see {schema.__name__} in bionav/experiments/configs.py)."
+        ) from None
+    check_config(instance, prefix="experiment")
+    return exp

@@ -1,0 +1,492 @@
+"""``experiment=pol_recordings``: the polarized-light compass on real skies.
+
+Decodes field recordings of a real POL-OP compass (Gkanias et al. 2023,
+doi:10.1038/s44172-023-00132-w: eight units tilted 45 degrees, four
+photodiodes each, on a robot turning in place; loader and format in
+:mod:`bionav.polcompass.recordings`) with every decoder plugin
+(``bionav.decoders``) and scores every sample::
+
+    error = wrap(decoded heading - yaw - c)
+
+with ``c`` one constant per session, the circular mean of ``decoded - yaw``
+over the session's rotations (the IMU yaw has an arbitrary zero, the sun moves
+little within a session). Each sample is decoded only from the units read at
+that moment; units found faulty from the session's counts are dropped with
+``recordings.exclude_units=auto``.
+
+Outputs: ``metrics.json`` (the chosen ``decoder=``: ``heading_mae_deg``,
+``heading_rmse_deg``, ``n_samples``, ``n_rotations``,
+``ambiguity_resolved_fraction``, plus pooled values per condition),
+``sessions.csv`` (one row per session and decoder), ``pooled.csv``,
+``faults.csv``, ``summary.md``, ``run.mcap`` and ``plots/``. With
+``experiment.simulate=true`` each session is also simulated in bionav's sky
+model (same array, time, place, yaw samples, excluded units; clouds for canopy
+sessions) and decoded the same way: the sim-to-real gap.
+"""
+
+from __future__ import annotations
+
+import csv
+import logging
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig, ListConfig, OmegaConf
+
+from bionav.errors import UserError
+from bionav.geometry import wrap_angle
+
+log = logging.getLogger(__name__)
+
+GROUPS = ("tod_daylight", "tod_dusk", "canopy")
+SESSION_TOPIC = "/pol_recordings/session"
+ROTATION_TOPIC = "/pol_recordings/rotation"
+FAULT_TOPIC = "/pol_recordings/faults"
+
+
+def _check(name, value, lo=None, hi=None):
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        raise UserError(f"recordings.{name}={value!r} is out of range; allowed: [{lo}, {hi}].")
+
+
+@dataclass
+class RecordingsConfig:
+    """``recordings.*``: where the recordings are and how the hardware reads.
+
+    Angles in degrees where the name says ``_deg``.
+    """
+
+    path: str | None = None  # folder of sessions (or one session folder / one rotation file)
+    exclude_units: Any = "auto"  # auto (faults detected from the counts) | none | list of unit numbers
+    saturation_counts: float = 11000.0  # counts at or above: saturated / overflowing photodiode, (0, inf)
+    dark_counts: float = 5.0  # counts below: too dark to measure, [0, inf)
+    imbalance_decades: float = 0.15  # POL-OP light imbalance beyond which a reading / unit is bad, (0, 3]
+    blind_fraction: float = 0.5  # fraction of identical orthogonal readings: polarization-blind unit, (0, 1]
+    tilt_deg: float = 45.0  # zenith angle of the units, [0, 90]
+    azimuth_sign: float = -1.0  # file azimuths: -1 clockwise from the front (recorded fan), +1 CCW
+    photodiode_angles_deg: list = field(default_factory=lambda: [-45.0, 45.0, 0.0, 90.0])  # unit frame, file order
+    pairs: list = field(default_factory=lambda: [[2, 3], [1, 0]])  # POL-OPs as photodiode index pairs
+    latitude_deg: float = 39.2  # recording site (Sardinia; the files do not say where exactly), [-90, 90]
+    longitude_deg: float = 9.1  # [-180, 180]
+    utc_offset_hours: float = 2.0  # local time in folder names (CEST), [-14, 14]
+    dusk_elevation_deg: float = 10.0  # tod sessions with the sun lower than this count as dusk, [-90, 90]
+    on_bad_file: str = "error"  # error: score the good files, then stop with the message | skip: warn only
+
+    def __post_init__(self):
+        _check("saturation_counts", self.saturation_counts, 1e-9, None)
+        _check("dark_counts", self.dark_counts, 0.0, None)
+        _check("imbalance_decades", self.imbalance_decades, 1e-9, 3.0)
+        _check("blind_fraction", self.blind_fraction, 1e-9, 1.0)
+        _check("tilt_deg", self.tilt_deg, 0.0, 90.0)
+        _check("latitude_deg", self.latitude_deg, -90.0, 90.0)
+        _check("longitude_deg", self.longitude_deg, -180.0, 180.0)
+        _check("utc_offset_hours", self.utc_offset_hours, -14.0, 14.0)
+        _check("dusk_elevation_deg", self.dusk_elevation_deg, -90.0, 90.0)
+        if self.azimuth_sign not in (-1.0, 1.0):
+            raise UserError(f"recordings.azimuth_sign={self.azimuth_sign!r} must be -1 (clockwise) or 1 (counter-clockwise).")
+        if self.on_bad_file not in ("error", "skip"):
+            raise UserError(f"recordings.on_bad_file={self.on_bad_file!r} is unknown; choose error or skip.")
+        ex = self.exclude_units
+        if isinstance(ex, str):
+            if ex not in ("auto", "none"):
+                raise UserError(f"recordings.exclude_units={ex!r} is unknown; give auto, none or a list such as [5,7].")
+        elif ex is None:
+            self.exclude_units = "none"
+        else:
+            try:
+                self.exclude_units = [int(u) for u in ex]
+            except (TypeError, ValueError):
+                raise UserError(f"recordings.exclude_units={ex!r}: give auto, none or a list of unit numbers such as [5,7].") from None
+
+
+@dataclass
+class PolRecordingsConfig:
+    """``experiment.*`` of ``experiment=pol_recordings``."""
+
+    compare: list = field(default_factory=lambda: ["sky_fit", "two_unit", "sol", "four_zeros", "eigenvector", "mean_vector"])
+    simulate: bool = True  # also decode each session simulated in the sky model (sim-to-real gap)
+    sim_noise: float = 0.01  # simulated count noise, fraction of the count, [0, 1]
+    sim_gain_sigma: float = 0.05  # simulated photodiode gain spread (log-normal sigma), [0, 1]
+    sim_canopy_cover: float = 0.5  # cloud-model cover standing in for canopy gaps, [0, 1]
+    sim_max_degree: float = 0.5  # maximum degree of the simulated sky, (0, 1]
+    record_samples: bool = True  # write every decoded sample of the chosen decoder to run.mcap
+
+    def __post_init__(self):
+        _check_exp("sim_noise", self.sim_noise, 0.0, 1.0)
+        _check_exp("sim_gain_sigma", self.sim_gain_sigma, 0.0, 1.0)
+        _check_exp("sim_canopy_cover", self.sim_canopy_cover, 0.0, 1.0)
+        _check_exp("sim_max_degree", self.sim_max_degree, 1e-6, 1.0)
+
+
+def _check_exp(name, value, lo, hi):
+    if not lo <= value <= hi:
+        raise UserError(f"experiment.{name}={value!r} is out of range; allowed: [{lo}, {hi}].")
+
+
+def _typed(cls, node, prefix):
+    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, (DictConfig, ListConfig)) else dict(node or {})
+    names = {f for f in cls.__dataclass_fields__}
+    unknown = sorted(set(plain) - names - {"name"})
+    if unknown:
+        raise UserError(f"{prefix} has no option(s) {', '.join(unknown)}; its options are {', '.join(sorted(names))}.")
+    return cls(**{k: v for k, v in plain.items() if k in names})
+
+
+# ---------------------------------------------------------------------------
+# scoring
+# ---------------------------------------------------------------------------
+def circular_offset(decoded, yaw) -> float:
+    """``c``: circular mean of ``decoded - yaw`` over finite samples (radians)."""
+    d = np.asarray(decoded, float) - np.asarray(yaw, float)
+    d = d[np.isfinite(d)]
+    return float(np.angle(np.mean(np.exp(1j * d)))) if d.size else 0.0
+
+
+def session_errors(decoded, yaw, *, undecoded_error: float = np.pi / 2.0):
+    """Errors ``wrap(decoded - yaw - c)`` with one ``c`` for the session; undecoded samples get ``undecoded_error``.
+
+    A sample a decoder cannot decode (NaN) counts as a 90 degree error, the
+    mean absolute error of a guess; ``sessions.csv`` also gives the MAE over
+    decoded samples only (``mae_decoded_deg``) and the decoded fraction.
+
+    Returns
+    -------
+    errors : ndarray, radians in ``[-pi, pi)``
+    c : float
+    """
+    c = circular_offset(decoded, yaw)
+    err = wrap_angle(np.asarray(decoded, float) - np.asarray(yaw, float) - c)
+    return np.where(np.isfinite(err), err, undecoded_error), c
+
+
+def error_stats(errors_rad) -> dict:
+    """MAE, RMSE (degrees) and fractions within 5 and 15 degrees."""
+    e = np.abs(np.degrees(np.asarray(errors_rad, float)))
+    if e.size == 0:
+        return {"n_samples": 0, "mae_deg": None, "rmse_deg": None, "within_5": None, "within_15": None}
+    return {
+        "n_samples": int(e.size),
+        "mae_deg": float(np.mean(e)),
+        "rmse_deg": float(np.sqrt(np.mean(e**2))),
+        "within_5": float(np.mean(e <= 5.0)),
+        "within_15": float(np.mean(e <= 15.0)),
+    }
+
+
+def build_array(rc: RecordingsConfig, file_azimuths):
+    """The :class:`~bionav.polcompass.array.PolArray` of the recorded sensor."""
+    from bionav.polcompass.array import PolArray
+
+    return PolArray.fan(
+        np.degrees(rc.azimuth_sign * np.asarray(file_azimuths, float)),
+        tilt_deg=rc.tilt_deg,
+        photodiode_angles_deg=rc.photodiode_angles_deg,
+        pairs=rc.pairs,
+    )
+
+
+def excluded_units(rc: RecordingsConfig, faults, k: int) -> list[int]:
+    if rc.exclude_units == "auto":
+        return [f.unit for f in faults if f.excluded]
+    if rc.exclude_units == "none":
+        return []
+    bad = [u for u in rc.exclude_units if not 0 <= u < k]
+    if bad:
+        raise UserError(f"recordings.exclude_units lists unit(s) {bad}, but the recordings have units 0..{k - 1}.")
+    return sorted(set(rc.exclude_units))
+
+
+@dataclass
+class SessionData:
+    """Everything one session needs for decoding, computed once."""
+
+    session: Any
+    array: Any
+    counts: np.ndarray  # (N, K, P)
+    yaw: np.ndarray
+    rotation_index: np.ndarray
+    valid: np.ndarray
+    evectors: Any
+    faults: list
+    excluded: list
+    sun: Any
+    period: str
+
+
+def prepare_session(session, rc: RecordingsConfig) -> SessionData:
+    """Counts, validity, e-vectors and the sun position of one session."""
+    from bionav.polcompass.array import evectors_from_counts
+    from bionav.polcompass.recordings import detect_faults, sample_validity
+    from bionav.light import sun_position
+
+    rots = session.rotations
+    counts = np.concatenate([r.counts for r in rots])
+    yaw = np.concatenate([r.yaw for r in rots])
+    index = np.concatenate([np.full(r.yaw.size, i) for i, r in enumerate(rots)])
+    array = build_array(rc, rots[0].file_azimuths)
+    faults = detect_faults(counts, saturation_counts=rc.saturation_counts, dark_counts=rc.dark_counts,
+                           imbalance_decades=rc.imbalance_decades, blind_fraction=rc.blind_fraction)
+    excluded = excluded_units(rc, faults, counts.shape[1])
+    valid = sample_validity(counts, saturation_counts=rc.saturation_counts, dark_counts=rc.dark_counts,
+                            imbalance_decades=rc.imbalance_decades)
+    valid[:, excluded] = False
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ev = evectors_from_counts(counts, array)
+    valid &= np.isfinite(ev.angle)
+    when = session.time_utc(rc.utc_offset_hours)
+    if when is None:
+        raise UserError(
+            f"The session folder {session.name} does not say when it was recorded; name it HH-MM__<Day>_dd-mm-yy "
+            "(local time, e.g. 13-00__Thursday_12-05-22) so the sun position can be computed."
+        )
+    sun = sun_position(when, latitude_deg=rc.latitude_deg, longitude_deg=rc.longitude_deg)
+    if session.condition == "canopy":
+        period = "canopy"
+    else:
+        period = "tod_daylight" if np.degrees(sun.elevation) >= rc.dusk_elevation_deg else "tod_dusk"
+    return SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period)
+
+
+def decode_session(decoder, data: SessionData):
+    """Decode every sample of a session; returns ``(heading, resolved, seconds)``."""
+    from bionav.polcompass.decoders import heading_from_sun
+
+    t0 = time.perf_counter()
+    est = decoder.decode(data.evectors, data.valid, array=data.array, sun_elevation=float(data.sun.elevation))
+    heading = heading_from_sun(est.azimuth, data.sun.azimuth)
+    return heading, np.asarray(est.resolved, bool), time.perf_counter() - t0
+
+
+def simulate_session(data: SessionData, exp: PolRecordingsConfig, rng) -> SessionData:
+    """The same sensor, samples and exclusions under bionav's sky model at the session's time and place.
+
+    Photodiode counts from :func:`bionav.polcompass.array.stokes_from_sky`
+    (point optics) scaled to the session's median count, with a log-normal
+    gain spread, proportional noise and the same saturation; canopy sessions
+    get a cloud field of ``sim_canopy_cover``.
+    """
+    from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
+    from bionav.light import SkyModel, random_cloud_map
+
+    clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
+    model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
+    mount = float(rng.uniform(-np.pi, np.pi))
+    intensity, q, u = stokes_from_sky(model, data.array, mount + data.yaw)
+    counts = counts_from_stokes(intensity, q, u, data.array)
+    lit = data.counts[data.counts > 0]
+    scale = (np.median(lit) if lit.size else 1000.0) / max(float(np.median(counts)), 1e-12)
+    gains = np.exp(exp.sim_gain_sigma * rng.standard_normal(counts.shape[1:]))
+    counts = counts * scale * gains
+    counts = counts * (1.0 + exp.sim_noise * rng.standard_normal(counts.shape))
+    counts = np.clip(np.round(counts), 0, None)
+    saturation = float(np.max(data.counts)) if data.counts.size else np.inf
+    valid = (counts.max(axis=-1) < saturation) & (counts.min(axis=-1) > 0)
+    valid[:, data.excluded] = False
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ev = evectors_from_counts(counts, data.array)
+    valid &= np.isfinite(ev.angle)
+    return SessionData(data.session, data.array, counts, data.yaw, data.rotation_index, valid, ev, data.faults,
+                       data.excluded, data.sun, data.period)
+
+
+# ---------------------------------------------------------------------------
+# files
+# ---------------------------------------------------------------------------
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    if not rows:
+        path.write_text("")
+        return
+    keys = list(rows[0])
+    for r in rows[1:]:
+        keys += [k for k in r if k not in keys]
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: ("" if r.get(k) is None else (f"{r[k]:.4g}" if isinstance(r.get(k), float) else r.get(k))) for k in keys})
+
+
+def _fmt(v, digits=1):
+    return "-" if v is None else f"{v:.{digits}f}"
+
+
+def summary_markdown(session_rows, pooled_rows, decoders) -> str:
+    """Per-session and pooled MAE tables (degrees) as Markdown."""
+    lines = ["Per session: MAE / RMSE (degrees) per decoder", ""]
+    lines.append("| session | condition | sun elev. (deg) | " + " | ".join(decoders) + " | sim (" + decoders[0] + ") |")
+    lines.append("|" + "---|" * (4 + len(decoders)))
+    by = {}
+    for r in session_rows:
+        by.setdefault(r["session"], {})[r["decoder"]] = r
+    for name, rows in by.items():
+        first = next(iter(rows.values()))
+        cells = [f"{_fmt(rows[d]['mae_deg'])} / {_fmt(rows[d]['rmse_deg'])}" if d in rows else "-" for d in decoders]
+        sim = rows.get(decoders[0], {}).get("sim_mae_deg")
+        lines.append(f"| {first['day']} {first['time_of_day']} | {first['period']} | {_fmt(first['sun_elevation_deg'])} | "
+                     + " | ".join(cells) + f" | {_fmt(sim)} |")
+    lines += ["", "Pooled: MAE / RMSE (degrees), fraction within 5 degrees", ""]
+    lines.append("| decoder | " + " | ".join(GROUPS) + " |")
+    lines.append("|" + "---|" * (1 + len(GROUPS)))
+    pooled = {(r["decoder"], r["group"]): r for r in pooled_rows}
+    for d in decoders:
+        cells = []
+        for g in GROUPS:
+            r = pooled.get((d, g))
+            cells.append("-" if r is None or r["mae_deg"] is None else
+                         f"{_fmt(r['mae_deg'])} / {_fmt(r['rmse_deg'])} ({r['within_5']:.2f})")
+        lines.append(f"| {d} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------------------
+# run
+# ---------------------------------------------------------------------------
+def _decoder(ctx, cfg, name):
+    node = cfg.decoder if cfg.get("decoder") is not None and cfg.decoder.get("name") == name else {"name": name}
+    return ctx.plugin("decoder", node)
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    """Entry point called by :func:`bionav.experiments.runner.run_experiment`."""
+    from bionav.experiments import pol_recordings_plots as plots
+    from bionav.polcompass.recordings import load_sessions
+
+    rc = _typed(RecordingsConfig, cfg.get("recordings"), "recordings")
+    exp = _typed(PolRecordingsConfig, {k: v for k, v in OmegaConf.to_container(cfg.experiment, resolve=True).items()
+                                        if k != "name"}, "experiment")
+    if not rc.path:
+        raise UserError(
+            "experiment=pol_recordings needs recordings.path=DIR, a folder of POL-OP recordings "
+            "(e.g. recordings.path=../shared/data/celestial-compass)."
+        )
+    if cfg.get("decoder") is None or not cfg.decoder.get("name"):
+        raise UserError("experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them).")
+    chosen = str(cfg.decoder.name)
+    names = [chosen] + [str(n) for n in exp.compare if str(n) != chosen]
+    decoders = {n: _decoder(ctx, cfg, n) for n in names}
+
+    sessions, bad_files = load_sessions(rc.path)
+    for path, message in bad_files:
+        log.warning("%s", message)
+    if not sessions:
+        raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
+
+    rng_sim = ctx.rng.spawn(1)[0]
+    session_rows, fault_rows = [], []
+    errors = {n: {g: [] for g in GROUPS} for n in names}
+    chosen_err, chosen_res = [], []
+    sim_err = {g: [] for g in GROUPS}
+    real_err = {g: [] for g in GROUPS}
+    per_session_plot = []
+    n_rotations = 0
+    decode_times = []
+    for session in ctx.progress(sessions, desc="sessions", total=len(sessions)):
+        data = prepare_session(session, rc)
+        n_rotations += len(session.rotations)
+        for f in data.faults:
+            row = {"session": session.name, **f.to_dict()}
+            fault_rows.append(row)
+        ctx.log.write(FAULT_TOPIC, {"session": session.name, "excluded": data.excluded,
+                                    "units": [f.to_dict() for f in data.faults]}, schema_name="bionav.PolOpFaults")
+        sim_data = simulate_session(data, exp, rng_sim) if exp.simulate else None
+        base = {
+            "session": session.name,
+            "day": session.day,
+            "time_of_day": session.time_of_day,
+            "condition": session.condition,
+            "period": data.period,
+            "sun_elevation_deg": float(np.degrees(data.sun.elevation)),
+            "sun_azimuth_deg": float(np.degrees(data.sun.azimuth)),
+            "n_rotations": len(session.rotations),
+            "excluded_units": " ".join(str(u) for u in data.excluded),
+        }
+        for name, dec in decoders.items():
+            heading, resolved, seconds = decode_session(dec, data)
+            err, c = session_errors(heading, data.yaw)
+            stats = error_stats(err)
+            decoded = np.isfinite(heading)
+            row = {**base, "decoder": name, **stats,
+                   "decoded_fraction": float(np.mean(decoded)),
+                   "mae_decoded_deg": error_stats(err[decoded])["mae_deg"],
+                   "resolved_fraction": float(np.mean(resolved)),
+                   "offset_deg": float(np.degrees(c)),
+                   "decode_ms": 1000.0 * seconds}
+            errors[name][data.period].append(err)
+            if name == chosen:
+                decode_times.append(seconds)
+                chosen_err.append(err)
+                chosen_res.append(resolved)
+                real_err[data.period].append(err)
+                per_session_plot.append((session, data, err))
+                if sim_data is not None:
+                    sim_heading, _, _ = decode_session(dec, sim_data)
+                    s_err, _ = session_errors(sim_heading, sim_data.yaw)
+                    s_stats = error_stats(s_err)
+                    row["sim_mae_deg"] = s_stats["mae_deg"]
+                    row["sim_rmse_deg"] = s_stats["rmse_deg"]
+                    sim_err[data.period].append(s_err)
+                if exp.record_samples:
+                    for r in range(len(session.rotations)):
+                        sel = data.rotation_index == r
+                        ctx.log.write(ROTATION_TOPIC, {
+                            "session": session.name, "file": session.rotations[r].path.name, "decoder": name,
+                            "yaw": data.yaw[sel].tolist(),
+                            "heading": [float(v) if np.isfinite(v) else None for v in heading[sel]],
+                            "error": err[sel].tolist(), "resolved": resolved[sel].tolist()},
+                            schema_name="bionav.PolRecordingRotation")
+            session_rows.append(row)
+            ctx.log.write(SESSION_TOPIC, row, schema_name="bionav.PolRecordingSession")
+
+    pooled_rows = []
+    for name in names:
+        for g in GROUPS:
+            if errors[name][g]:
+                pooled_rows.append({"decoder": name, "group": g, **error_stats(np.concatenate(errors[name][g]))})
+        all_e = [e for g in GROUPS for e in errors[name][g]]
+        pooled_rows.append({"decoder": name, "group": "all", **error_stats(np.concatenate(all_e))})
+    _write_csv(ctx.dir / "sessions.csv", session_rows)
+    _write_csv(ctx.dir / "pooled.csv", pooled_rows)
+    _write_csv(ctx.dir / "faults.csv", fault_rows)
+    (ctx.dir / "summary.md").write_text(summary_markdown(session_rows, pooled_rows, names))
+
+    plot_dir = ctx.plots
+    plots.error_vs_time_of_day(plot_dir / "error_vs_time_of_day.png", session_rows, names)
+    plots.session_distributions(plot_dir / "session_errors.png", per_session_plot, chosen)
+    first = per_session_plot[0]
+    plots.raw_rotation(plot_dir / "raw_unit_responses.png", first[0], first[1])
+    plots.clear_vs_canopy(plot_dir / "clear_vs_canopy.png", real_err, chosen)
+    if exp.simulate:
+        plots.sim_vs_real(plot_dir / "sim_vs_real.png", real_err, sim_err, chosen)
+
+    all_err = np.concatenate(chosen_err)
+    stats = error_stats(all_err)
+    metrics: dict[str, Any] = {
+        "decoder": chosen,
+        "heading_mae_deg": stats["mae_deg"],
+        "heading_rmse_deg": stats["rmse_deg"],
+        "n_samples": stats["n_samples"],
+        "n_rotations": int(n_rotations),
+        "n_sessions": len(sessions),
+        "ambiguity_resolved_fraction": float(np.mean(np.concatenate(chosen_res))),
+        "decode_ms_per_session_max": float(1000.0 * max(decode_times)),
+        "n_bad_files": len(bad_files),
+    }
+    for r in pooled_rows:
+        if r["decoder"] == chosen and r["group"] in GROUPS:
+            metrics[f"{r['group']}_mae_deg"] = r["mae_deg"]
+            metrics[f"{r['group']}_rmse_deg"] = r["rmse_deg"]
+    if exp.simulate:
+        for g in GROUPS:
+            if sim_err[g]:
+                metrics[f"sim_{g}_mae_deg"] = error_stats(np.concatenate(sim_err[g]))["mae_deg"]
+    if bad_files and rc.on_bad_file == "error":
+        listed = " ".join(m for _p, m in bad_files[:3])
+        more = f" ({len(bad_files) - 3} more, see the log)" if len(bad_files) > 3 else ""
+        raise UserError(
+            f"{len(bad_files)} recording file(s) are unusable; the other {n_rotations} rotations were scored and "
+            f"sessions.csv is written. {listed}{more} Set recordings.on_bad_file=skip to only warn."
+        )
+    return metrics

@@ -1,0 +1,107 @@
+"""Figures of ``experiment=pol_recordings``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bionav.report.figures import pyplot, save_figure
+
+DPI = 110
+
+
+def _hours(hhmm: str) -> float:
+    h, m = hhmm.split(":")
+    return int(h) + int(m) / 60.0
+
+
+def error_vs_time_of_day(path, session_rows, decoders) -> None:
+    """MAE per session against local time of day, one line per decoder; sun elevation on a second axis."""
+    plt = pyplot()
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4), sharey=True, gridspec_kw={"width_ratios": [3, 1]})
+    tod = [r for r in session_rows if r["condition"] == "tod" and r["time_of_day"]]
+    canopy = [r for r in session_rows if r["condition"] == "canopy" and r["time_of_day"]]
+    for d in decoders:
+        for axis, rows in ((ax[0], tod), (ax[1], canopy)):
+            pts = sorted((_hours(r["time_of_day"]), r["mae_deg"], r["day"]) for r in rows if r["decoder"] == d)
+            if pts:
+                axis.plot([p[0] for p in pts], [p[1] for p in pts], "o", ms=4, label=d if axis is ax[0] else None)
+    ax[0].set_yscale("log")
+    ax[0].set_xlabel("local time (h)")
+    ax[0].set_ylabel("MAE (deg)")
+    ax[0].set_title("time-of-day sessions")
+    ax[1].set_title("canopy sessions")
+    ax[1].set_xlabel("local time (h)")
+    twin = ax[0].twinx()
+    el = sorted({(_hours(r["time_of_day"]), r["sun_elevation_deg"]) for r in tod})
+    if el:
+        twin.plot([e[0] for e in el], [e[1] for e in el], "k.", ms=3, alpha=0.4)
+    twin.set_ylabel("sun elevation (deg), black dots")
+    ax[0].legend(fontsize=7, ncol=2)
+    save_figure(fig, path, dpi=DPI)
+
+
+def session_distributions(path, per_session, decoder) -> None:
+    """Box plot of absolute errors per session (chosen decoder)."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(per_session) + 2), 4))
+    data = [np.abs(np.degrees(err)) for _s, _d, err in per_session]
+    labels = [f"{s.day[5:]} {s.time_of_day}{' C' if d.period == 'canopy' else ''}" for s, d, _e in per_session]
+    ax.boxplot(data, showfliers=False)
+    ax.set_xticks(range(1, len(labels) + 1))
+    ax.set_xticklabels(labels, rotation=90, fontsize=7)
+    ax.set_yscale("log")
+    ax.set_ylabel("|error| (deg)")
+    ax.set_title(f"per-session error distributions, decoder={decoder} (C: canopy)")
+    save_figure(fig, path, dpi=DPI)
+
+
+def raw_rotation(path, session, data) -> None:
+    """The four photodiode counts of every unit during the session's first rotation."""
+    plt = pyplot()
+    sel = data.rotation_index == 0
+    yaw = np.degrees(np.unwrap(data.yaw[sel]))
+    k = data.counts.shape[1]
+    fig, axes = plt.subplots(2, (k + 1) // 2, figsize=(12, 5), sharex=True)
+    for u, ax in enumerate(np.ravel(axes)[:k]):
+        for p in range(data.counts.shape[2]):
+            ax.plot(yaw, data.counts[sel, u, p], lw=0.8, label=f"pd {p}")
+        tag = " (excluded)" if u in data.excluded else ""
+        ax.set_title(f"unit {u}{tag}", fontsize=8)
+        ax.tick_params(labelsize=7)
+    np.ravel(axes)[0].legend(fontsize=6)
+    fig.suptitle(f"raw counts, {session.name}, rotation 1 (x: yaw, deg)", fontsize=9)
+    save_figure(fig, path, dpi=DPI)
+
+
+def clear_vs_canopy(path, errors_by_group, decoder) -> None:
+    """Error histograms: time-of-day daylight vs canopy (chosen decoder)."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    bins = np.linspace(0, 45, 46)
+    for g, label in (("tod_daylight", "clear (tod, daylight)"), ("canopy", "canopy")):
+        if errors_by_group.get(g):
+            e = np.abs(np.degrees(np.concatenate(errors_by_group[g])))
+            ax.hist(np.minimum(e, 45), bins=bins, density=True, alpha=0.5, label=f"{label}: MAE {e.mean():.1f} deg")
+    ax.set_xlabel("|error| (deg, clipped at 45)")
+    ax.set_ylabel("density")
+    ax.set_title(f"clear vs canopy, decoder={decoder}")
+    ax.legend(fontsize=8)
+    save_figure(fig, path, dpi=DPI)
+
+
+def sim_vs_real(path, real, sim, decoder) -> None:
+    """Cumulative error distributions, real vs simulated, per condition."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for g, color in (("tod_daylight", "C0"), ("tod_dusk", "C1"), ("canopy", "C2")):
+        for src, style, name in ((real, "-", "real"), (sim, "--", "sim")):
+            if src.get(g):
+                e = np.sort(np.abs(np.degrees(np.concatenate(src[g]))))
+                ax.plot(e, np.arange(1, e.size + 1) / e.size, style, color=color, label=f"{g} {name} (MAE {e.mean():.1f})")
+    ax.set_xscale("log")
+    ax.set_xlim(0.1, 180)
+    ax.set_xlabel("|error| (deg)")
+    ax.set_ylabel("fraction of samples")
+    ax.set_title(f"sim-to-real gap, decoder={decoder}")
+    ax.legend(fontsize=7)
+    save_figure(fig, path, dpi=DPI)

@@ -1,0 +1,1 @@
+"""Decoder plugins (``decoder=<name>``): solar azimuth from a POL-OP array's e-vectors."""

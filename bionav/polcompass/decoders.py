@@ -1,0 +1,463 @@
+"""Solar azimuth from the e-vectors of a POL-OP array, one sample at a time.
+
+Every decoder takes what the units of an array (:mod:`bionav.polcompass.array`)
+read at one moment, :class:`~bionav.polcompass.array.UnitEvectors` and a
+``valid`` mask (units dropped as faulty or saturated at that sample), and
+returns a :class:`SunEstimate`: the solar azimuth in the *sensor frame*
+(radians, counter-clockwise from the sensor front, ``[-pi, pi)``), the other
+member of the eq. 4.6 candidate pair, and whether the pair was resolved. No
+decoder looks at other samples. A heading follows as ``sun_world_azimuth -
+sun_sensor_azimuth`` (:func:`heading_from_sun`).
+
+Decoders
+--------
+``sky_fit`` (bionav's default)
+    Least squares over all units against the sky model's e-vector pattern
+    for tilted units: the solar azimuth ``phi`` minimising
+    ``E(phi) = sum_k w_k (1 - cos 2(a_k - a^_k(phi)))`` with the sun elevation
+    known from time and place, ``w_k = d_k^2`` (measured degree); a grid,
+    then a parabolic refinement. The candidate pair is the best ``phi`` and
+    the best one within 45 degrees of its antipode (eq. 4.6 generalised to tilted
+    units); the lower error wins, and where the errors differ by less than
+    the margin the brighter side of the sky (first harmonic of the units'
+    intensities) decides.
+``two_unit`` (the thesis' solution)
+    Eqs. 4.4-4.5 give each unit's e-vector; for single scattering the sun is
+    perpendicular to every e-vector, so two units give ``s = +-(e_i x e_j)``
+    (Lambrinos et al. 2000 use the zenith case of this). The pair with the
+    largest ``d_i d_j |e_i x e_j|`` is used; the eq. 4.6 pair ``(s, -s)`` is
+    resolved by the error function ``|elevation - expected elevation|``.
+``eigenvector``
+    The sun vector is the eigenvector of the smallest eigenvalue of
+    ``M = sum_k w_k e_k e_k^T`` (the e-vectors are all perpendicular to it;
+    e.g. Lu et al. 2015, Opt. Express 23:7248, doi:10.1364/OE.23.007248),
+    with ``w_k = d_k``; sign: the sun is above the horizon.
+``mean_vector``
+    The weighted mean of the pairwise sun vectors ``e_i x e_j`` each turned
+    to the upper hemisphere (weights ``d_i d_j |e_i x e_j|``).
+``sol``
+    The sinusoidal population decoder of Gkanias et al. (2019), PLoS Comput.
+    Biol. 15:e1007123, doi:10.1371/journal.pcbi.1007123, with the responses of
+    Gkanias et al. (2023), doi:10.1038/s44172-023-00132-w: each unit gives a
+    POL response ``p_k`` (normalised POL-OP difference), an intensity
+    response ``i_k`` and their difference ``c_k = i_k - p_k``; ``n_sol`` SOL
+    neurons with preferred directions ``theta_z`` respond
+    ``r_z = (n_sol / n_units) sum_k sin(theta_k - theta_z + pi/2) r_k``, and
+    the solar azimuth is the phase of their first Fourier harmonic,
+    ``arg sum_z r_z exp(i theta_z)``. No ambiguity to resolve (a vector, not
+    an axis), reported as resolved where the population vector is non-zero.
+``four_zeros``
+    Smith & Stewart (2014), doi:10.5220/0004792100210026: around a ring of
+    sky points, the angle ``chi`` between e-vector and local meridian passes
+    through +-45 degrees at four azimuths placed symmetrically about the
+    solar meridian; the meridian is the axis of their first harmonic, found
+    here by linear interpolation of ``cos 2 chi`` between neighbouring units
+    (the axis about which the zero set is most nearly mirror-symmetric);
+    the brighter side picks the sun's end (eq. 4.6 pair).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bionav.geometry import wrap_angle
+from bionav.polcompass.array import PolArray, UnitEvectors, stokes_from_sky
+
+
+@dataclass(frozen=True)
+class SunEstimate:
+    """Solar azimuth of every sample in the sensor frame.
+
+    Attributes
+    ----------
+    azimuth : ndarray, shape ``(N,)``
+        Radians CCW from the sensor front, ``[-pi, pi)``; NaN where the units
+        read at that sample cannot give one.
+    alternative : ndarray, shape ``(N,)``
+        The other member of the candidate pair (about a half turn away).
+    resolved : ndarray of bool, shape ``(N,)``
+        Whether the choice between the two was clear (margin exceeded).
+    """
+
+    azimuth: np.ndarray
+    alternative: np.ndarray
+    resolved: np.ndarray
+
+
+def heading_from_sun(sun_sensor_azimuth, sun_world_azimuth):
+    """Sensor heading (radians CCW from east) from the solar azimuth in the sensor frame."""
+    return wrap_angle(np.asarray(sun_world_azimuth, float) - np.asarray(sun_sensor_azimuth, float))
+
+
+def _weights(ev: UnitEvectors, valid, power: float):
+    ok = np.asarray(valid, bool) & np.isfinite(ev.angle) & np.isfinite(ev.degree)
+    return np.where(ok, np.nan_to_num(ev.degree) ** power, 0.0)
+
+
+def brightness_azimuth(ev: UnitEvectors, valid, array: PolArray):
+    """Azimuth of the first harmonic of the units' intensities (towards the bright sky), shape ``(N,)``.
+
+    Intensities are normalised by their mean over the valid units of each sample.
+    """
+    ok = np.asarray(valid, bool) & np.isfinite(ev.intensity)
+    i = np.where(ok, np.nan_to_num(ev.intensity), 0.0)
+    n = np.maximum(ok.sum(axis=-1), 1)
+    mean = i.sum(axis=-1) / n
+    rel = np.where(ok, i / np.maximum(mean, 1e-12)[:, None] - 1.0, 0.0)
+    z = np.sum(rel * np.sin(array.unit_tilts) * np.exp(1j * array.unit_azimuths), axis=-1)
+    return np.where(np.abs(z) > 0, np.angle(z), np.nan)
+
+
+def _choose_by_brightness(first, second, bright):
+    """Pick the candidate nearer the bright side."""
+    d1 = np.abs(wrap_angle(first - bright))
+    d2 = np.abs(wrap_angle(second - bright))
+    return np.where(np.isfinite(bright) & (d2 < d1), second, first), np.where(np.isfinite(bright) & (d2 < d1), first, second)
+
+
+@dataclass(frozen=True)
+class SkyTable:
+    """Expected e-vectors of every unit for a grid of solar azimuths (one sun elevation).
+
+    Attributes
+    ----------
+    azimuths : ndarray, shape ``(G,)``
+        Solar azimuths in the sensor frame, ``2 pi g / G``.
+    cos2, sin2 : ndarray, shape ``(G, K)``
+        ``cos 2a^``, ``sin 2a^`` of the predicted e-vector angle in each unit frame.
+    degree : ndarray, shape ``(G, K)``
+        Predicted degree.
+    """
+
+    azimuths: np.ndarray
+    cos2: np.ndarray
+    sin2: np.ndarray
+    degree: np.ndarray
+
+
+def sky_table(array: PolArray, sun_elevation: float, *, n_grid: int = 720, max_degree: float = 0.76,
+              neutral_point_separation: float = 0.0) -> SkyTable:
+    """Tabulate the sky model's e-vector pattern seen by the array (:class:`bionav.light.SkyModel`).
+
+    Parameters
+    ----------
+    array : PolArray
+    sun_elevation : float
+        Radians.
+    n_grid : int
+        Number of solar azimuths.
+    max_degree, neutral_point_separation : float
+        Sky model parameters (Rayleigh for separation 0, else Berry et al. 2004).
+    """
+    from bionav.light import SkyModel, SunPosition
+
+    phis = 2.0 * np.pi * np.arange(n_grid) / n_grid
+    model = SkyModel(SunPosition(0.0, float(sun_elevation)), max_degree=max_degree,
+                     neutral_point_separation=neutral_point_separation)
+    # the sun at sensor azimuth phi = a sensor heading of -phi under a sun at world azimuth 0
+    _, q, u = stokes_from_sky(model, array, -phis)
+    degree = np.hypot(q, u)
+    a2 = np.arctan2(u, q)
+    return SkyTable(phis, np.cos(a2), np.sin(a2), degree)
+
+
+def sun_directions(azimuths, elevation):
+    """Unit sun vectors in the sensor frame for solar azimuths (sensor frame) at one elevation, shape ``(G, 3)``."""
+    az = np.asarray(azimuths, float)
+    return np.stack([np.cos(elevation) * np.cos(az), np.cos(elevation) * np.sin(az), np.full(az.shape, np.sin(elevation))], axis=-1)
+
+
+def _pick_pair(score, azimuths, total, margin):
+    """Best grid column, best column more than a quarter turn away, both refined; normalised gap."""
+    n, g = score.shape
+    rows = np.arange(n)
+    best = np.argmax(score, axis=1)
+    # the eq. 4.6 partner: the best candidate within 45 degrees of the antipode
+    far = (best[:, None] + g // 2 - g // 8 + np.arange(2 * (g // 8) + 1)[None, :]) % g
+    alt = far[rows, np.argmax(np.take_along_axis(score, far, axis=1), axis=1)]
+    step = 2.0 * np.pi / g
+
+    def refine(j):
+        y0, y1, y2 = score[rows, (j - 1) % g], score[rows, j], score[rows, (j + 1) % g]
+        den = y0 - 2.0 * y1 + y2
+        ok = np.abs(den) > 1e-15
+        shift = np.where(ok, 0.5 * (y0 - y2) / np.where(ok, den, 1.0), 0.0)
+        return wrap_angle(azimuths[j] + np.clip(shift, -0.5, 0.5) * step)
+
+    gap = (score[rows, best] - score[rows, alt]) / np.maximum(total, 1e-12)
+    return best, refine(best), refine(alt), gap
+
+
+def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, sun_elevation: float | None = None,
+                     residual: str = "perpendicular", weight_power: float = 1.0, robust_iterations: int = 2,
+                     robust_scale: float = np.deg2rad(10.0), margin: float = 0.01) -> SunEstimate:
+    """bionav's least-squares fit of the sky model's pattern (see the module docstring).
+
+    Parameters
+    ----------
+    ev : UnitEvectors
+    valid : ndarray of bool, shape ``(N, K)``
+    table : SkyTable
+        From :func:`sky_table` for the session's sun elevation.
+    array : PolArray
+    sun_elevation : float, optional
+        Radians; needed for ``residual="perpendicular"``.
+    residual : {'perpendicular', 'angle'}
+        ``perpendicular``: the single-scattering pattern's condition that
+        every e-vector is perpendicular to the sun, ``E = sum_k w_k (e_k .
+        s(phi))^2`` with ``s(phi)`` at the known elevation; ``angle``:
+        ``E = sum_k w_k (1 - cos 2(a_k - a^_k(phi)))`` against the tabulated
+        model angles (any sky model, e.g. with neutral points).
+    weight_power : float
+        Unit weight ``d_k ** weight_power``.
+    robust_iterations : int
+        Re-weighting rounds with Cauchy weights ``1 / (1 + (r_k / scale)^2)``
+        of each unit's residual at the current solution (units contradicting
+        the others at that sample, e.g. glare, count less).
+    robust_scale : float
+        Residual scale of the re-weighting (radians for ``angle``; the
+        perpendicular residual ``e . s`` is compared with its sine).
+    margin : float
+        Minimum difference of the normalised errors of the pair for a
+        resolved choice; below it the brighter side decides.
+
+    Returns
+    -------
+    SunEstimate
+    """
+    w0 = _weights(ev, valid, weight_power)
+    w = w0
+    total = w0.sum(axis=-1)
+    if residual == "perpendicular":
+        if sun_elevation is None:
+            raise ValueError("residual='perpendicular' needs the sun elevation")
+        e = np.nan_to_num(ev.evector)
+        v = sun_directions(table.azimuths, float(sun_elevation))  # (G, 3)
+        scale = np.sin(robust_scale)
+        iu, ju = np.triu_indices(3)
+        mono = v[:, iu] * v[:, ju] * np.where(iu == ju, 1.0, 2.0)  # (G, 6): quadratic form as a matmul
+        for it in range(robust_iterations + 1):
+            m6 = np.einsum("nk,nki,nki->ni", w, e[..., iu], e[..., ju])  # upper triangle of sum_k w e e^T
+            score = -(m6 @ mono.T)
+            best = np.argmax(score, axis=1)
+            if it < robust_iterations:
+                r = np.einsum("nki,ni->nk", e, v[best])
+                w = w0 / (1.0 + (r / scale) ** 2)
+    elif residual == "angle":
+        a2 = 2.0 * np.nan_to_num(ev.angle)
+        ca, sa = np.cos(a2), np.sin(a2)
+        for it in range(robust_iterations + 1):
+            score = (w * ca) @ table.cos2.T + (w * sa) @ table.sin2.T  # (N, G)
+            best = np.argmax(score, axis=1)
+            if it < robust_iterations:
+                r = 0.5 * np.arccos(np.clip(ca * table.cos2[best] + sa * table.sin2[best], -1.0, 1.0))
+                w = w0 / (1.0 + (r / robust_scale) ** 2)
+    else:
+        raise ValueError(f"residual must be 'perpendicular' or 'angle', got {residual!r}")
+    _, first, second, gap = _pick_pair(score, table.azimuths, np.maximum(w.sum(axis=-1), 1e-12), margin)
+    resolved = gap > margin
+    bright = brightness_azimuth(ev, valid, array)
+    by_light, other = _choose_by_brightness(first, second, bright)
+    azimuth = np.where(resolved, first, by_light)
+    alternative = np.where(resolved, second, other)
+    usable = total > 0
+    return SunEstimate(np.where(usable, azimuth, np.nan), np.where(usable, alternative, np.nan), resolved & usable)
+
+
+def _sun_candidates(s, expected_elevation, margin):
+    """Eq. 4.6 pair for sun vectors ``+-s``: choose by the elevation error function."""
+    s = np.asarray(s, float)
+    norm = np.linalg.norm(s, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = s / norm[..., None]
+    el = np.arcsin(np.clip(s[..., 2], -1.0, 1.0))
+    az = np.arctan2(s[..., 1], s[..., 0])
+    err_plus = np.abs(el - expected_elevation)
+    err_minus = np.abs(-el - expected_elevation)
+    flip = err_minus < err_plus
+    first = np.where(flip, wrap_angle(az + np.pi), az)
+    second = wrap_angle(first + np.pi)
+    resolved = np.abs(err_plus - err_minus) > margin
+    bad = ~np.isfinite(az) | (norm < 1e-12)
+    return SunEstimate(np.where(bad, np.nan, first), np.where(bad, np.nan, second), resolved & ~bad)
+
+
+def _pair_index(k):
+    i, j = np.triu_indices(k, 1)
+    return i, j
+
+
+def sun_from_two_units(ev: UnitEvectors, valid, *, sun_elevation, margin: float = np.deg2rad(2.0)) -> SunEstimate:
+    """The thesis' two-unit solution generalised to tilted units (see the module docstring).
+
+    Parameters
+    ----------
+    sun_elevation : float or ndarray, shape ``(N,)``
+        Expected sun elevation (radians), the error function's reference.
+    margin : float
+        Minimum difference of the elevation errors for a resolved choice, radians.
+    """
+    w = _weights(ev, valid, 1.0)
+    e = np.nan_to_num(ev.evector)
+    i, j = _pair_index(e.shape[1])
+    cross = np.cross(e[:, i], e[:, j])  # (N, pairs, 3)
+    score = w[:, i] * w[:, j] * np.linalg.norm(cross, axis=-1)
+    best = np.argmax(score, axis=1)
+    s = cross[np.arange(len(best)), best]
+    s = np.where((score[np.arange(len(best)), best] > 0)[:, None], s, np.nan)
+    return _sun_candidates(s, np.asarray(sun_elevation, float), margin)
+
+
+def sun_from_eigenvector(ev: UnitEvectors, valid, *, margin: float = np.deg2rad(2.0)) -> SunEstimate:
+    """Eigenvector method: the direction most perpendicular to all weighted e-vectors."""
+    w = _weights(ev, valid, 1.0)
+    e = np.nan_to_num(ev.evector)
+    m = np.einsum("nk,nki,nkj->nij", w, e, e)
+    _, vecs = np.linalg.eigh(m)
+    s = vecs[..., 0]
+    s = np.where((np.sum(w > 0, axis=1) >= 2)[:, None], s, np.nan)
+    return _up(s, margin)
+
+
+def _up(s, margin):
+    """Resolve ``+-s`` by "the sun is above the horizon"; resolved where ``|s_z| > sin(margin)``."""
+    s = np.asarray(s, float)
+    norm = np.linalg.norm(s, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = s / norm[..., None]
+    s = np.where((s[..., 2] < 0)[..., None], -s, s)
+    az = np.arctan2(s[..., 1], s[..., 0])
+    bad = ~np.isfinite(az) | ~(norm > 1e-12)
+    resolved = np.abs(s[..., 2]) > np.sin(margin)
+    return SunEstimate(np.where(bad, np.nan, az), np.where(bad, np.nan, wrap_angle(az + np.pi)), resolved & ~bad)
+
+
+def sun_from_mean_vector(ev: UnitEvectors, valid, *, margin: float = np.deg2rad(2.0)) -> SunEstimate:
+    """Mean-vector method: weighted mean of pairwise sun vectors turned upwards."""
+    w = _weights(ev, valid, 1.0)
+    e = np.nan_to_num(ev.evector)
+    i, j = _pair_index(e.shape[1])
+    cross = np.cross(e[:, i], e[:, j])
+    cross = np.where((cross[..., 2] < 0)[..., None], -cross, cross)  # |e_i x e_j| already weights by angle
+    s = np.einsum("np,npi->ni", w[:, i] * w[:, j], cross)
+    return _up(s, margin)
+
+
+def sol_responses(ev: UnitEvectors, valid, *, response: str = "c", analyser: float = np.pi / 2.0):
+    """Per-unit responses of Gkanias et al. (2023): ``p`` (POL), ``i`` (intensity) or ``c = i - p``.
+
+    ``p_k = d_k cos(2 (a_k - analyser))`` is the normalised POL-OP response
+    ``(s_par - s_perp) / (s_par + s_perp)`` of an analyser at ``analyser`` in
+    the unit frame (``pi/2``: horizontal, perpendicular to the unit's
+    meridian, i.e. largest for units on the solar meridian); ``i_k`` is the
+    unit's intensity divided by the mean over the valid units, minus one.
+    """
+    ok = np.asarray(valid, bool) & np.isfinite(ev.intensity) & np.isfinite(ev.angle)
+    p = np.where(ok, np.nan_to_num(ev.degree) * np.cos(2.0 * (np.nan_to_num(ev.angle) - analyser)), 0.0)
+    n = np.maximum(ok.sum(axis=-1), 1)
+    inten = np.where(ok, np.nan_to_num(ev.intensity), 0.0)
+    mean = inten.sum(axis=-1) / n
+    i = np.where(ok, inten / np.maximum(mean, 1e-12)[:, None] - 1.0, 0.0)
+    if response == "p":
+        return p, ok
+    if response == "i":
+        return i, ok
+    if response == "c":
+        return i - p, ok
+    raise ValueError(f"response must be p, i or c, got {response!r}")
+
+
+def sun_from_sol(ev: UnitEvectors, valid, *, array: PolArray, n_sol: int = 8, response: str = "c",
+                 analyser: float = np.pi / 2.0) -> SunEstimate:
+    """Sinusoidal population (SOL) decoder (see the module docstring)."""
+    r, ok = sol_responses(ev, valid, response=response, analyser=analyser)
+    theta_z = 2.0 * np.pi * np.arange(n_sol) / n_sol
+    theta_k = array.unit_azimuths
+    n_units = np.maximum(ok.sum(axis=-1), 1)
+    weights = np.sin(theta_k[None, :] - theta_z[:, None] + np.pi / 2.0)  # (n_sol, K)
+    r_sol = (n_sol / n_units)[:, None] * (r @ weights.T)  # (N, n_sol)
+    z = r_sol @ np.exp(1j * theta_z)
+    if response == "p":  # the POL population points away from the sun (Gkanias et al. 2023, fig. 2c)
+        z = -z
+    az = np.angle(z)
+    good = np.abs(z) > 1e-12
+    return SunEstimate(np.where(good, az, np.nan), np.where(good, wrap_angle(az + np.pi), np.nan), good)
+
+
+def _ring_fit(values, valid, azimuths, grid, n_harmonics):
+    """Weighted least-squares trigonometric interpolation of per-unit values around the ring, on ``grid``."""
+    def basis(t):
+        cols = [np.ones_like(t)]
+        for m in range(1, n_harmonics + 1):
+            cols += [np.cos(m * t), np.sin(m * t)]
+        return np.stack(cols, axis=-1)
+
+    b = basis(np.asarray(azimuths, float))  # (K, P)
+    w = np.asarray(valid, float)
+    a = np.einsum("nk,kp,kq->npq", w, b, b) + 1e-9 * np.eye(b.shape[1])
+    rhs = np.einsum("nk,kp,nk->np", w, b, np.nan_to_num(values))
+    coef = np.linalg.solve(a, rhs[..., None])[..., 0]
+    return coef @ basis(grid).T  # (N, G)
+
+
+def sun_from_four_zeros(ev: UnitEvectors, valid, *, array: PolArray, n_harmonics: int = 3, n_grid: int = 720) -> SunEstimate:
+    """Four-zeros method (see the module docstring).
+
+    ``cos 2 chi`` (``chi`` = e-vector angle from the unit's meridian, the unit
+    frame's ``x_u``) is interpolated around the ring by a trigonometric
+    least-squares fit with up to ``n_harmonics`` harmonics (fewer when fewer
+    units are valid) and cut at ``chi = +-45`` degrees, else (Smith & Stewart's
+    other options) at ``+-(45 + 60)`` or ``+-(45 - 60)`` degrees; samples whose
+    curve crosses none of these levels exactly four times are not decoded. The four zeros form two pairs placed
+    symmetrically about the solar meridian; of the two ways to pair
+    neighbouring zeros (mirror pairs are nested) the one whose pair bisectors
+    lie most nearly on one line gives the meridian; the brighter side picks the sun's end.
+    """
+    n, k = ev.angle.shape
+    ok = np.asarray(valid, bool) & np.isfinite(ev.angle)
+    count = ok.sum(axis=1)
+    grid = 2.0 * np.pi * np.arange(n_grid) / n_grid
+    f = np.cos(2.0 * np.nan_to_num(ev.angle))
+    curve = np.full((n, n_grid), np.nan)
+    for h in range(1, n_harmonics + 1):
+        rows = (count >= 2 * h + 1) & ((h == n_harmonics) | (count < 2 * h + 3))
+        if rows.any():
+            curve[rows] = _ring_fit(f[rows], ok[rows], array.unit_azimuths, grid, h)
+    nxt = np.roll(np.arange(n_grid), -1)
+    azimuth = np.full(n, np.nan)
+    alternative = np.full(n, np.nan)
+    resolved = np.zeros(n, bool)
+    bright_all = brightness_azimuth(ev, valid, array)
+    # Smith & Stewart's three options: chi = +-45, +-(45 + 60), +-(45 - 60) degrees
+    for level in (0.0, -np.cos(np.pi / 6.0), np.cos(np.pi / 6.0)):
+        g = curve - level
+        crossing = (np.sign(g) != np.sign(g[:, nxt])) & np.isfinite(g) & np.isfinite(g[:, nxt])
+        four = (crossing.sum(axis=1) == 4) & np.isnan(azimuth)
+        if not four.any():
+            continue
+        rows, cols = np.nonzero(crossing[four])
+        c0, c1 = g[four][rows, cols], g[four][rows, nxt[cols]]
+        step = 2.0 * np.pi / n_grid
+        z = (grid[cols] + c0 / (c0 - c1) * step).reshape(-1, 4)  # sorted around the ring
+
+        def mid(a, b):
+            return np.angle(np.exp(1j * a) + np.exp(1j * b))
+
+        best_axis, best_err = None, None
+        for pairing in (((0, 1), (2, 3)), ((1, 2), (3, 0))):
+            m1 = mid(z[:, pairing[0][0]], z[:, pairing[0][1]])
+            m2 = mid(z[:, pairing[1][0]], z[:, pairing[1][1]])
+            err = np.abs(wrap_angle(2.0 * (m1 - m2)))  # both bisectors lie on the meridian (a line)
+            axis = 0.5 * np.angle(np.exp(2j * m1) + np.exp(2j * m2))
+            if best_axis is None:
+                best_axis, best_err = axis, err
+            else:
+                better = err < best_err
+                best_axis = np.where(better, axis, best_axis)
+                best_err = np.where(better, err, best_err)
+        bright = bright_all[four]
+        first, second = _choose_by_brightness(best_axis, wrap_angle(best_axis + np.pi), bright)
+        azimuth[four], alternative[four], resolved[four] = first, second, np.isfinite(bright)
+    return SunEstimate(azimuth, alternative, resolved)

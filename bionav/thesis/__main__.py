@@ -1,0 +1,166 @@
+"""``python -m bionav.thesis [--preset quick|full] [--only ITEMS] --out DIR``.
+
+Runs every bionav experiment the thesis' tables and figures need (through
+``python -m bionav``, reusing completed runs in DIR and the per-image cache)
+and writes ``report.md``, ``report.html``, ``items.csv`` and one figure/table
+per item into DIR. ``--launcher joblib`` (or ``submitit_slurm``,
+``submitit_local``, any Hydra launcher) runs the needed runs as multiruns
+through that launcher; ``--dry-run`` prints the commands only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+from bionav.errors import UserError
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from bionav.thesis.items import REGISTRY
+    from bionav.thesis.presets import PUBLIC_PRESETS
+
+    p = argparse.ArgumentParser(
+        prog="python -m bionav.thesis",
+        description="Reproduce the thesis' tables and figures with bionav and report them side by side "
+                    "(report.md, report.html, items.csv and one figure per item in --out).",
+        epilog="items: " + ", ".join(REGISTRY) + ". Thesis numbers work too (--only 5.3,B.1,6.26).",
+    )
+    p.add_argument("--preset", default="quick", help=f"how much to run: {' | '.join(PUBLIC_PRESETS)} (default quick)")
+    p.add_argument("--only", default=None, metavar="ITEMS", help="comma-separated items (ids or thesis numbers)")
+    p.add_argument("--out", required=True, metavar="DIR", help="report directory; runs go to DIR/runs (reused when re-run)")
+    p.add_argument("--launcher", default=None, metavar="NAME",
+                   help="run through a Hydra launcher (joblib, submitit_slurm, submitit_local, ...) as multiruns")
+    p.add_argument("--launcher-arg", action="append", default=[], metavar="KEY=VALUE",
+                   help="extra launcher override, e.g. hydra.launcher.partition=cpu (repeatable)")
+    p.add_argument("--dry-run", action="store_true", help="print the bionav commands and write nothing")
+    p.add_argument("--report-only", action="store_true", help="run nothing; report from the runs already in DIR")
+    return p
+
+
+def _launcher_overrides(name: str | None, extra: list[str]) -> list[str]:
+    if not name:
+        if extra:
+            raise UserError("--launcher-arg needs --launcher NAME (e.g. --launcher joblib).")
+        return []
+    for e in extra:
+        if "=" not in e:
+            raise UserError(f"--launcher-arg {e!r} must be KEY=VALUE, e.g. hydra.launcher.n_jobs=2.")
+    return [f"hydra/launcher={name}", *extra]
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return run(args)
+    except UserError as exc:
+        print(f"bionav.thesis: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # full disk, permissions while writing the report
+        print(f"bionav.thesis: error: cannot write {getattr(exc, 'filename', None) or args.out}: "
+              f"{exc.strerror or exc}. Free space or choose another --out; completed runs are kept and reused.",
+              file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"bionav.thesis: interrupted; completed runs are kept in {args.out}/runs and are reused when you run "
+              f"the same command again.", file=sys.stderr)
+        return 130
+
+
+def run(args) -> int:
+    from bionav.thesis.items import Context, select_items
+    from bionav.thesis.outcome import Outcome
+    from bionav.thesis.presets import PRESETS
+    from bionav.thesis.reference import load_reference
+    from bionav.thesis.report import Section, markdown_to_html, report_markdown, verdict_counts, write_csv
+    from bionav.thesis.runs import Runner, tool_env
+
+    started = time.time()
+    load_start = _loadavg()
+    if args.preset not in PRESETS:
+        raise UserError(f"unknown --preset {args.preset!r}; choose quick or full.")
+    preset = PRESETS[args.preset]
+    items = select_items(args.only)
+    out = Path(args.out).resolve()
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out} is a file; give a directory.")
+    if not args.dry_run:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+            probe = out / ".write_test"
+            probe.write_text("")
+            probe.unlink()
+        except OSError as exc:
+            raise UserError(f"cannot write the report directory {out}: {exc.strerror}. Choose another with --out.") from None
+    ref_all = load_reference()
+    specs = {it.id: it.runs(preset) for it in items}
+    launcher = _launcher_overrides(args.launcher, args.launcher_arg)
+    runner = Runner(out=out, launcher=launcher, dry_run=args.dry_run, echo=lambda s: print(s, flush=True),
+                    env=tool_env())
+    all_specs = [s for ss in specs.values() for s in ss]
+    if args.report_only:
+        from bionav.thesis.runs import RunResult, index_runs, read_json
+
+        index = index_runs(out)
+        results = {}
+        for s in all_specs:
+            d = index.get(s.key)
+            results[s.key] = RunResult(s, d, None if d is None else read_json(d / "metrics.json") if not s.multirun
+                                       else {"status": "completed"}, None if d else "not run (--report-only)", reused=True)
+    else:
+        results = runner.run_all(all_specs)
+    if args.dry_run:
+        return 0
+
+    sections = []
+    for it in items:
+        ref = ref_all.get(it.id, {})
+        ctx = Context(preset=preset, out=out, ref=ref, results=results, ref_id=it.id)
+        try:
+            outcome = it.evaluate(ctx, specs[it.id])
+        except Exception as exc:  # a report section must never take the whole report down
+            outcome = Outcome(missing=[f"evaluating this item failed: {type(exc).__name__}: {exc}"])
+        claims = list(ref.get("claims", []))
+        if it.id.startswith("tableB"):
+            claims += list(ref_all.get("appendix_b_claims", []))
+        sections.append(Section(it.id, it.label, ref.get("title", it.label), ref.get("source", ""), it.rule,
+                                outcome, [results[s.key] for s in {s.key: s for s in specs[it.id]}.values()], claims))
+    wall = time.time() - started
+    command = "python -m bionav.thesis " + " ".join(argv_for_display(args))
+    cpu = sum(r.cpu_seconds or 0.0 for r in results.values())
+    machine = f"{os.cpu_count()} CPUs, 1-minute load average {load_start} at the start and {_loadavg()} at the end"
+    md = report_markdown(sections, preset=preset, out=out, wall_s=wall, command=command, cpu_s=cpu or None,
+                         machine=machine)
+    (out / "report.md").write_text(md)
+    (out / "report.html").write_text(markdown_to_html(md, out))
+    write_csv(out / "items.csv", sections)
+    counts = verdict_counts(sections)
+    print(f"bionav.thesis: {len(sections)} items in {wall:.0f} s: " +
+          ", ".join(f"{v} {counts.get(v, 0)}" for v in ("holds", "partly", "does not hold", "not produced")))
+    print(f"report: {out / 'report.md'} ({out / 'report.html'}, {out / 'items.csv'})")
+    return 0
+
+
+def _loadavg() -> str:
+    try:
+        return f"{os.getloadavg()[0]:.1f}"
+    except OSError:
+        return "unknown"
+
+
+def argv_for_display(args) -> list[str]:
+    words = [f"--preset {args.preset}"]
+    if args.only:
+        words.append(f"--only {args.only}")
+    words.append(f"--out {args.out}")
+    if args.launcher:
+        words.append(f"--launcher {args.launcher}")
+    words += [f"--launcher-arg {a}" for a in args.launcher_arg]
+    return words
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,165 @@
+"""Presets of ``python -m bionav.thesis``: how much of each thesis experiment to run.
+
+``full`` uses the thesis' own sizes and counts. ``quick`` runs every item on
+reduced inputs (snapshot subsets, fewer runs, reduced sweeps; every reduction is
+listed in the report) within about 20 minutes on two cores. ``tiny`` exists for
+the tests: the whole code path on the smallest inputs that still run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+#: the eight variants of the original database (thesis 3.1, fig. 5.6)
+CROSS_DB_FAMILY = ("sim_original", "sim_arboreal", "sim_chairs", "sim_day", "sim_doorlit", "sim_screen",
+                   "sim_twilight", "sim_winlit")
+#: fig. 5.4: 0.03 ... 0.1 in steps of 0.01, then 0.2 ... 1.0 in steps of 0.1
+THESIS_CUTOFFS = tuple(round(0.03 + 0.01 * i, 2) for i in range(8)) + tuple(round(0.2 + 0.1 * i, 1) for i in range(9))
+DAY_SERIES = 14
+
+
+@dataclass(frozen=True)
+class Preset:
+    """Sizes and counts of one preset (see the module docstring).
+
+    ``snapshots``: snapshots per grid-homing run, spread evenly over the
+    database's images (None: every image is a snapshot, as the thesis).
+    Image sizes are ``(W, H)`` in pixels.
+    """
+
+    name: str
+    summary: str
+    snapshots: int | None
+    sift_size: tuple[int, int]
+    warping: tuple[str, ...]
+    warping_snapshots: int | None
+    warping_size: tuple[int, int] | None
+    fig54_sizes: tuple[tuple[int, int], ...]
+    fig54_cutoffs: tuple[float, ...]
+    fig55_sizes: tuple[tuple[int, int], ...]
+    b_sizes: tuple[tuple[int, int], ...]
+    cross_db_family: tuple[str, ...]
+    cross_db_stride: int
+    cross_db_size: tuple[int, int] | None
+    cross_db_homing: tuple[str, ...]
+    param_grid: str
+    lda_resamples: int
+    scan: dict = field(default_factory=dict)
+    scan_times: int = DAY_SERIES
+    example_scan: dict = field(default_factory=dict)
+    skyline: tuple[str, ...] = ()
+    pol_samples: int = 100
+    pol_vs_em_samples: int = 100
+    cleaning_runs: int = 10
+    reductions: tuple[str, ...] = ()
+
+
+FULL = Preset(
+    name="full",
+    summary="the thesis' own sizes and counts",
+    snapshots=None,
+    sift_size=(1122, 162),
+    warping=("warping2d_thesis", "minwarping_thesis"),
+    warping_snapshots=None,
+    warping_size=None,
+    fig54_sizes=((346, 50), (561, 81), (1122, 162)),
+    fig54_cutoffs=THESIS_CUTOFFS,
+    fig55_sizes=((346, 50), (561, 81), (1122, 162)),
+    b_sizes=((1672, 206), (836, 103), (418, 52), (209, 52)),
+    cross_db_family=CROSS_DB_FAMILY,
+    cross_db_stride=1,
+    cross_db_size=None,
+    cross_db_homing=("sift", "warping2d_thesis"),
+    param_grid="full",
+    lda_resamples=10000,
+    scan={},
+    scan_times=DAY_SERIES,
+    example_scan={},
+    skyline=(),
+    pol_samples=100,
+    pol_vs_em_samples=100,
+    cleaning_runs=10,
+    reductions=(),
+)
+
+QUICK = Preset(
+    name="quick",
+    summary="every item on reduced inputs (about 20 minutes on two idle cores)",
+    snapshots=6,
+    sift_size=(561, 81),
+    warping=("warping2d", "minwarping"),
+    warping_snapshots=2,
+    warping_size=None,
+    fig54_sizes=((346, 50), (561, 81)),
+    fig54_cutoffs=(0.05, 0.1, 0.3, 1.0),
+    fig55_sizes=((346, 50), (561, 81)),
+    b_sizes=((418, 52), (209, 52)),
+    cross_db_family=("sim_original", "sim_arboreal", "sim_chairs", "sim_doorlit", "sim_screen", "sim_winlit"),
+    cross_db_stride=9,
+    cross_db_size=(346, 50),
+    cross_db_homing=("sift", "warping2d"),
+    param_grid="ci",
+    lda_resamples=1000,
+    scan={"experiment.n_pan": 38, "experiment.pan_step_deg": 6.0, "experiment.n_tilt": 9,
+          "experiment.tilt_step_deg": 9.0},
+    scan_times=DAY_SERIES,
+    example_scan={"experiment.n_pan": 57, "experiment.pan_step_deg": 4.0, "experiment.n_tilt": 13,
+                  "experiment.tilt_step_deg": 6.0},
+    skyline=("experiment.snapshot_stride=4",),
+    pol_samples=100,
+    pol_vs_em_samples=100,
+    cleaning_runs=2,
+    reductions=(
+        "grid homing: 6 snapshots per database (evenly spread over the images) instead of all; "
+        "min-/2D-warping: 2 snapshots",
+        "SIFT homing (table 5.3, fig. 5.6) at the stand-ins' native 561 x 81 instead of 1122 x 162",
+        "table 5.4: the fast warping presets (homing=warping2d, homing=minwarping) instead of the thesis' "
+        "parameters (warping2d_thesis, minwarping_thesis)",
+        "fig. 5.4: cutoffs 0.05, 0.1, 0.3, 1.0 at 346 x 50 and 561 x 81 (thesis: 17 cutoffs, three sizes)",
+        "fig. 5.5: 346 x 50 and 561 x 81 (thesis: also 1122 x 162)",
+        "appendix B: 418 x 52 and 209 x 52 (thesis: also 1672 x 206 and 836 x 103)",
+        "fig. 5.6: six of the eight databases (no day, twilight), 4 snapshots per database (stride 9), "
+        "images 346 x 50, the fast 2D-warping preset",
+        "tables 5.5-5.7: the reduced parameter grid experiment.grid=ci (one image size, no preprocessing, "
+        "two ring counts and two Fourier-coefficient counts; thesis: 5202 configurations per database)",
+        "tables 6.3/6.5: 1000 bootstrap resamples (thesis: 10000)",
+        "figs. 6.10-6.15: scans of 38 x 9 points (6 and 9 degree steps) instead of 200 x 51; "
+        "figs. 6.16-6.25: 57 x 13 points instead of 113 x 26",
+        "figs. 6.26/6.27: the skyline-homing grid with snapshot stride 4 (the square test itself is complete)",
+        "figs. 7.3/7.4: 2 cleaning runs per layout (thesis: 10)",
+    ),
+)
+
+TINY = Preset(
+    name="tiny",
+    summary="the smallest inputs that run the whole code path (for tests; numbers mean nothing)",
+    snapshots=2,
+    sift_size=(120, 18),
+    warping=("warping2d",),
+    warping_snapshots=1,
+    warping_size=(120, 18),
+    fig54_sizes=((120, 18),),
+    fig54_cutoffs=(0.3, 1.0),
+    fig55_sizes=((120, 18),),
+    b_sizes=((120, 18),),
+    cross_db_family=("sim_original", "sim_doorlit"),
+    cross_db_stride=9,
+    cross_db_size=(120, 18),
+    cross_db_homing=("sift",),
+    param_grid="ci",
+    lda_resamples=50,
+    scan={"experiment.n_pan": 12, "experiment.pan_step_deg": 15.0, "experiment.n_tilt": 5,
+          "experiment.tilt_step_deg": 15.0},
+    scan_times=3,
+    example_scan={"experiment.n_pan": 12, "experiment.pan_step_deg": 15.0, "experiment.n_tilt": 5,
+                  "experiment.tilt_step_deg": 15.0},
+    skyline=("experiment.snapshot_stride=8",),
+    pol_samples=2,
+    pol_vs_em_samples=2,
+    cleaning_runs=1,
+    reductions=("tiny preset: every size and count reduced to a minimum; for tests only",),
+)
+
+PRESETS = {p.name: p for p in (QUICK, FULL, TINY)}
+#: presets offered by ``--help`` (tiny is for tests)
+PUBLIC_PRESETS = ("quick", "full")

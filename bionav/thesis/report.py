@@ -1,0 +1,202 @@
+"""Writing the thesis report: ``report.md``, ``report.html`` (figures inline) and ``items.csv``."""
+
+from __future__ import annotations
+
+import base64
+import csv
+import html
+import re
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+from bionav.thesis.outcome import MISSING, VERDICT_RULE, Outcome, fmt
+from bionav.thesis.presets import Preset
+
+CSV_COLUMNS = ("item", "label", "quantity", "thesis", "bionav", "difference", "tolerance", "verdict", "level")
+
+
+@dataclass
+class Section:
+    """One item's part of the report."""
+
+    id: str
+    label: str
+    title: str
+    source: str
+    rule: str
+    outcome: Outcome
+    runs: list  # RunResult
+    claims: list[str]
+
+
+def csv_rows(sections: Sequence[Section]) -> list[dict[str, str]]:
+    """items.csv: one row per item (its verdict), per check and per value."""
+    rows = []
+    for s in sections:
+        o = s.outcome
+        passed, total = o.score
+        rows.append({"item": s.id, "label": s.label, "quantity": "(item verdict)", "thesis": "", "bionav": f"{passed}/{total} checks pass",
+                     "difference": "", "tolerance": "", "verdict": o.verdict, "level": "item"})
+        for c in o.checks:
+            rows.append({"item": s.id, "label": s.label, "quantity": c.rule, "thesis": "claim", "bionav": c.detail,
+                         "difference": "", "tolerance": "",
+                         "verdict": "" if c.passed is None else ("holds" if c.passed else "does not hold"), "level": "check"})
+        for r in o.rows:
+            rows.append({"item": s.id, "label": s.label, "quantity": r.quantity,
+                         "thesis": "" if r.thesis is None else fmt(r.thesis, 6),
+                         "bionav": "" if r.bionav is None else fmt(r.bionav, 6),
+                         "difference": "" if r.difference is None else fmt(r.difference, 6),
+                         "tolerance": "" if r.tolerance is None else fmt(r.tolerance, 6),
+                         "verdict": r.verdict, "level": "value"})
+    return rows
+
+
+def write_csv(path: Path, sections: Sequence[Section]) -> None:
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(CSV_COLUMNS))
+        w.writeheader()
+        w.writerows(csv_rows(sections))
+
+
+def verdict_counts(sections: Sequence[Section]) -> Counter:
+    return Counter(s.outcome.verdict for s in sections)
+
+
+def _run_lines(section: Section, out: Path) -> list[str]:
+    lines = []
+    for r in section.runs:
+        where = "" if r.dir is None else str(Path(r.dir).relative_to(out)) if str(r.dir).startswith(str(out)) else str(r.dir)
+        state = "completed" if r.ok else f"not completed: {r.error}"
+        t = "" if r.seconds is None else f", {r.seconds:.0f} s wall" + (
+            "" if r.cpu_seconds is None else f", {r.cpu_seconds:.0f} s CPU")
+        reused = ", reused" if r.reused else ""
+        lines.append(f"- `python -m bionav {'-m ' if r.spec.multirun else ''}{' '.join(r.spec.overrides)}` "
+                     f"-> `{where}` ({state}{t}{reused})")
+    return lines
+
+
+def section_markdown(s: Section, out: Path) -> str:
+    o = s.outcome
+    passed, total = o.score
+    md = [f"## {_heading(s)}", "", f"*Source:* {s.source}.  ", f"*Verdict:* **{o.verdict}** "
+          f"({passed} of {total} checks pass).  ", f"*Rule:* {s.rule}.", ""]
+    if s.claims:
+        md += ["The thesis claims:", *[f"- {c}" for c in s.claims], ""]
+    if o.missing:
+        md += ["**Not produced / incomplete:**", *[f"- {m}" for m in o.missing], ""]
+    if o.rows:
+        md += ["| quantity | thesis | bionav | difference | tolerance | verdict |", "|---|---|---|---|---|---|"]
+        md += [f"| {r.quantity} | {fmt(r.thesis)} | {fmt(r.bionav)} | {fmt(r.difference)} | "
+               f"{'' if r.tolerance is None else fmt(r.tolerance)} | {r.verdict} |" for r in o.rows]
+        md.append("")
+    if o.checks:
+        md += ["| check | result | detail |", "|---|---|---|"]
+        md += [f"| {c.rule} | {'n/a' if c.passed is None else ('pass' if c.passed else 'fail')} | {c.detail} |"
+               for c in o.checks]
+        md.append("")
+    for n in o.notes:
+        md.append(f"*Note:* {n}  ")
+    if o.tables:
+        md += ["", "Tables: " + ", ".join(f"[{t}]({t})" for t in o.tables)]
+    md.append("")
+    for fig in o.figures:
+        md += [f"![{s.label}: {fig}]({fig})", ""]
+    runs = _run_lines(s, out)
+    if runs:
+        md += ["<details><summary>runs</summary>", "", *runs, "", "</details>", ""]
+    return "\n".join(md)
+
+
+def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, wall_s: float, command: str,
+                    cpu_s: float | None = None, machine: str = "") -> str:
+    counts = verdict_counts(sections)
+    head = [
+        "# The thesis, reproduced by bionav", "",
+        f"Command: `{command}`  ", f"Preset: **{preset.name}** ({preset.summary}).  ",
+        f"Wall time of this invocation: {wall_s:.0f} s" + (f" (CPU of the runs it executed: {cpu_s:.0f} s)" if cpu_s else "")
+        + (f"; machine: {machine}" if machine else "") + ".",
+        "",
+        "bionav runs on synthetic stand-ins of the thesis' databases, sensors and scenes; many verdicts are honestly "
+        "'does not hold' because the stand-ins are not calibrated to the thesis' environments.", "",
+        VERDICT_RULE, "",
+        "| verdict | items |", "|---|---|",
+        *[f"| {v} | {counts.get(v, 0)} |" for v in ("holds", "partly", "does not hold", MISSING)], "",
+    ]
+    if preset.reductions:
+        head += ["Reductions of this preset against the thesis:", *[f"- {r}" for r in preset.reductions], ""]
+    head += ["| item | verdict | checks |", "|---|---|---|"]
+    head += [f"| [{s.label}](#{_anchor(s)}) | {s.outcome.verdict} | {s.outcome.score[0]}/{s.outcome.score[1]} |"
+             for s in sections]
+    head.append("")
+    return "\n".join(head + [section_markdown(s, out) for s in sections])
+
+
+def _heading(s: Section) -> str:
+    return s.title if s.title.lower().startswith(s.label.split(" /")[0].lower()) else f"{s.label}: {s.title}"
+
+
+def _anchor(s: Section) -> str:
+    text = _heading(s).lower()
+    return re.sub(r"[^a-z0-9 -]", "", text).replace(" ", "-")
+
+
+def markdown_to_html(md: str, out: Path) -> str:
+    """A small Markdown renderer for the report (headings, tables, lists, images inline as base64)."""
+    body, table, in_list = [], [], False
+
+    def inline(text: str) -> str:
+        t = html.escape(text, quote=False)
+        t = re.sub(r"`([^`]+)`", r"<code>\1</code>", t)
+        t = re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", t)
+        t = re.sub(r"\*([^*]+)\*", r"<i>\1</i>", t)
+        t = re.sub(r"\[([^\]]+)\]\(#([^)]+)\)", r'<a href="#\2">\1</a>', t)
+        return re.sub(r"\[([^\]]+)\]\(([^)]+)\)", r'<a href="\2">\1</a>', t)
+
+    def flush_table():
+        if table:
+            rows = [r for r in table if not re.match(r"^\|[-| ]+\|$", r)]
+            cells = [[c.strip() for c in r.strip("|").split("|")] for r in rows]
+            h = "".join(f"<th>{inline(c)}</th>" for c in cells[0])
+            b = "".join("<tr>" + "".join(f"<td>{inline(c)}</td>" for c in row) + "</tr>" for row in cells[1:])
+            body.append(f"<table><tr>{h}</tr>{b}</table>")
+            table.clear()
+
+    for line in md.splitlines():
+        if line.startswith("|"):
+            table.append(line)
+            continue
+        flush_table()
+        if in_list and not line.startswith("- "):
+            body.append("</ul>")
+            in_list = False
+        m = re.match(r"^!\[([^\]]*)\]\(([^)]+)\)$", line)
+        if m:
+            path = out / m.group(2)
+            if path.is_file():
+                data = base64.b64encode(path.read_bytes()).decode()
+                body.append(f'<figure><img alt="{html.escape(m.group(1))}" src="data:image/png;base64,{data}">'
+                            f"<figcaption>{html.escape(m.group(2))}</figcaption></figure>")
+            continue
+        if line.startswith("#"):
+            level = len(line) - len(line.lstrip("#"))
+            text = line[level:].strip()
+            anchor = re.sub(r"[^a-z0-9 -]", "", text.lower()).replace(" ", "-")
+            body.append(f'<h{level} id="{anchor}">{inline(text)}</h{level}>')
+        elif line.startswith("- "):
+            if not in_list:
+                body.append("<ul>")
+                in_list = True
+            body.append(f"<li>{inline(line[2:])}</li>")
+        elif line.startswith("<details") or line.startswith("</details"):
+            body.append(line)
+        elif line.strip():
+            body.append(f"<p>{inline(line)}</p>")
+    flush_table()
+    if in_list:
+        body.append("</ul>")
+    style = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}table{border-collapse:collapse;"
+             "font-size:85%}td,th{border:1px solid #ccc;padding:2px 6px}img{max-width:100%}code{font-size:85%}")
+    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>bionav: the thesis reproduced</title>"
+            f"<style>{style}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n")

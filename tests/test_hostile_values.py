@@ -1,0 +1,172 @@
+"""Hostile values on the command line (issue 13 items 4 and 5, issue 14's typed experiment configs).
+
+Every case runs ``python -m bionav ...`` and expects a non-zero exit, one paragraph that names the
+key, the bad value and what is allowed, and no traceback.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+
+import pytest
+from helpers import run_bionav
+
+from bionav.validation import Range, bounded, check_config, range_of
+
+
+def clean_error(proc, *needles, absent=()):
+    """Non-zero exit, no traceback, exactly one ``bionav: error:`` paragraph containing ``needles``."""
+    assert proc.returncode != 0, proc.stdout + proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    errors = [line for line in proc.stderr.splitlines() if line.startswith("bionav: error:")]
+    assert len(errors) == 1, proc.stderr
+    message = errors[0]
+    for needle in needles:
+        assert needle in message, message
+    for needle in absent:
+        assert needle not in proc.stderr, proc.stderr
+    return message
+
+
+# (overrides, strings the message must contain)
+BAD_VALUES = [
+    (["homing.sigma=-1"], ["homing.sigma=-1", "> 0", "default: 1.6"]),
+    (["homing.n_features=-5"], ["homing.n_features=-5", "an integer >= 0"]),
+    (["homing.sigma=nan"], ["homing.sigma=nan", "NaN"]),
+    (["homing.sigma=inf"], ["homing.sigma=inf", "infinite"]),
+    (["homing.combine=maximum"], ["homing.combine=maximum", "one of average, max"]),
+    (["homing=minwarping", "homing.n_alpha=0"], ["homing.n_alpha=0", ">= 4"]),
+    (["homing=minwarping", "homing.image_size=[4,50]"], ["homing.image_size=[4,50]", "a list of 2 items"]),
+    (["homing=warping2d", "homing.rho_max=1.5"], ["homing.rho_max=1.5", "< 1"]),
+    (["homing=mfdid", "homing.lowpass_sigma=-0.1"], ["homing.lowpass_sigma=-0.1"]),
+    (["homing=hiss", "homing.ratio=0"], ["homing.ratio=0", "> 0"]),
+    (["homing=parameter", "homing.gradient=steepest"], ["homing.gradient=steepest", "test_steps"]),
+    (["homing=parameter", "signature=hist", "signature.bins=1"], ["signature.bins=1", ">= 2"]),
+    (["homing=parameter", "signature=mffc_phase", "signature.n_coeffs=0"], ["signature.n_coeffs=0"]),
+    (["db.image_size=[100000,20000]"], ["db.image_size=[100000,20000]", "16384"]),
+    (["db.noise=-0.5"], ["db.noise=-0.5", ">= 0"]),
+    (["db.on_bad_image=ignore"], ["db.on_bad_image=ignore", "error, skip"]),
+    (["experiment.step_length=0"], ["experiment.step_length=0", "> 0"]),
+    (["experiment.snapshots=[]"], ["experiment.snapshots=[]", "1 to"]),
+    (["experiment=cross_db", "experiment.snapshot_stride=0"], ["experiment.snapshot_stride=0"]),
+    (["experiment=pol_compass", "experiment.sky.turbidity=-3"], ["experiment.sky.turbidity=-3", ">= 1"]),
+    (["experiment=pol_compass", "experiment.solver=magic"], ["experiment.solver=magic", "least_squares"]),
+    (["experiment=pol_compass", "sensor.noise_v=-1"], ["sensor.noise_v=-1"]),
+    (["experiment=pol_compass", "pantilt.resolution_arcsec=0"], ["pantilt.resolution_arcsec=0"]),
+    (["experiment=cleaning", "runs=0"], ["experiment.runs=0", ">= 1"]),
+    (["experiment=cleaning", "controller.fix_gain=2"], ["controller.fix_gain=2", "<= 1"]),
+    (["experiment=contrast_scan", "experiment.cloud_cover=[0.5,1.5]"], ["experiment.cloud_cover", "1.5"]),
+    (["experiment=skyline_homing", "experiment.image_width=0"], ["experiment.image_width=0"]),
+    (["workers=0"], ["workers=0", "an integer >= 1"]),
+    (["seed=-1"], ["seed=-1", "an integer >= 0"]),
+]
+
+
+@pytest.mark.parametrize("overrides,needles", BAD_VALUES, ids=[" ".join(o) for o, _ in BAD_VALUES])
+def test_bad_value_is_named_with_its_range(tmp_path, overrides, needles):
+    proc = run_bionav(*overrides, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    clean_error(proc, "bad value", "allowed", *needles)
+    assert proc.returncode == 2
+    assert not (tmp_path / "run").exists()  # refused before a run directory was made
+
+
+MISSPELT = [
+    (["homing.combin=max"], "homing.combin", "Did you mean homing.combine?", "combine, window"),
+    (["+homing.combin=max"], "homing.combin", "Did you mean homing.combine?", "window"),
+    (["db.image_sise=[150,25]"], "db.image_sise", "Did you mean db.image_size?", "grid_shape"),
+    (["db.unfold.sise=[10,2]"], "db.unfold.sise", "Did you mean db.unfold.size?", "outer_radius"),
+    (["experiment.step_lenght=1"], "experiment.step_lenght", "Did you mean experiment.step_length?", "success_radius"),
+    (["experiment=pol_compass", "experiment.sky.turbiditty=2"], "experiment.sky.turbiditty",
+     "Did you mean experiment.sky.turbidity?", "latitude_deg"),
+    (["homing=minwarping", "homing.n_alfa=32"], "homing.n_alfa", "Did you mean homing.n_alpha?", "n_psi"),
+]
+
+
+@pytest.mark.parametrize("overrides,key,hint,listed", MISSPELT, ids=[" ".join(o) for o, *_ in MISSPELT])
+def test_misspelt_key_names_the_node_keys_and_the_closest(tmp_path, overrides, key, hint, listed):
+    proc = run_bionav(*overrides, cwd=tmp_path)
+    clean_error(proc, f"unknown key {key}", hint, listed, absent=("+homing.", "To append to your config use"))
+
+
+def test_snapshot_index_beyond_the_database_is_named(tmp_path):
+    proc = run_bionav("homing=mfdid", "experiment.snapshots=[0,500]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    clean_error(proc, "experiment.snapshots=[0, 500]", "0..169")
+
+
+def test_wrong_type_names_key_and_value(tmp_path):
+    proc = run_bionav("homing.n_features=abc", cwd=tmp_path)
+    clean_error(proc, "homing.n_features=abc", "Integer")
+
+
+def test_memory_bound_refuses_image_stack_before_allocating(tmp_path):
+    # inside the per-side range, but 170 images of 16000 x 16000 pixels do not fit in memory
+    proc = run_bionav("db.image_size=[16000,16000]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    clean_error(proc, "db.image_size=[16000,16000]", "memory", "choose a smaller db.image_size")
+
+
+# --------------------------------------------------------------------------- the mechanism itself
+@dataclasses.dataclass
+class _Demo:
+    rate: float = bounded(0.5, gt=0.0, le=1.0)
+    count: int = bounded(3, ge=1)
+    mode: str = bounded("a", choices=("a", "b"))
+    size: typing.Optional[list[int]] = bounded(None, length=2, item=Range(ge=8, le=64))
+    free: float = 1.0  # no declared range: must still be finite
+
+
+@pytest.mark.parametrize("field,value,needle", [
+    ("rate", 0.0, "> 0"), ("rate", 1.5, "<= 1"), ("rate", float("nan"), "NaN"), ("count", 0, "an integer >= 1"),
+    ("mode", "c", "one of a, b"), ("size", [8], "a list of 2 items"), ("size", [8, 65], "65"),
+    ("free", float("inf"), "infinite"),
+])
+def test_check_config_names_key_value_and_range(field, value, needle):
+    from bionav.errors import UserError
+
+    cfg = _Demo(**{field: value})
+    with pytest.raises(UserError, match=rf"demo\.{field}=") as err:
+        check_config(cfg, prefix="demo")
+    assert needle in str(err.value) and "allowed" in str(err.value)
+    check_config(_Demo(), prefix="demo")  # defaults pass
+
+
+#: string options that are free text (paths, ports, names resolved elsewhere, times)
+FREE_TEXT = {"port", "path", "topic", "signature", "time", "name", "calibration_path", "world", "grid"}
+
+
+def _all_config_classes():
+    from bionav import registry
+    from bionav.db.config import DatabaseConfig
+    from bionav.experiments.configs import EXPERIMENT_CONFIGS
+
+    out = [("db", DatabaseConfig)]
+    for kind in registry.GROUPS:
+        for name, plugin in registry.plugins_of(kind, warn=False).items():
+            if plugin.cls is not None and plugin.entry.distribution == "bionav":
+                out.append((f"{kind}={name}", plugin.cls.Config))
+    out += [(f"experiment={name}", cls) for name, cls in EXPERIMENT_CONFIGS.items()]
+    return out
+
+
+def _fields(cls, prefix=""):
+    hints = typing.get_type_hints(cls)
+    for f in dataclasses.fields(cls):
+        hint = hints[f.name]
+        if dataclasses.is_dataclass(hint):
+            yield from _fields(hint, f"{prefix}{f.name}.")
+        else:
+            yield f"{prefix}{f.name}", f, hint
+
+
+def test_every_built_in_value_declares_its_range():
+    """Every numeric or enumerated option of every built-in plugin, the db and each experiment has a range."""
+    undeclared = []
+    for owner, cls in _all_config_classes():
+        check_config(cls(), prefix=owner)  # defaults are valid
+        for key, f, hint in _fields(cls):
+            text = str(hint)
+            if hint is bool or "dict" in text or key.split(".")[-1] in FREE_TEXT:
+                continue
+            if range_of(f) is None and not ("SkyCondition" in text or text == "list[str]"):
+                undeclared.append(f"{owner}: {key} ({text})")
+    assert not undeclared, "\n".join(undeclared)

@@ -1,0 +1,69 @@
+"""Hydra UX: --help lists each config group once; bash completion works for `python -m bionav`."""
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+from helpers import run_bionav
+
+from bionav.config import config_dirs
+
+
+def _groups(help_text: str) -> list[str]:
+    section = help_text.split("== Configuration groups ==", 1)[1].split("== Config ==", 1)[0]
+    return [m.group(1) for m in re.finditer(r"^([\w/.-]+): ", section, re.MULTILINE)]
+
+
+def test_help_lists_each_group_once(tmp_path):
+    proc = run_bionav("--help", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    groups = _groups(proc.stdout)
+    assert len(groups) == len(set(groups)), groups
+    assert not [g for g in groups if "/" in g], groups  # no conf/... duplicates
+    assert {"experiment", "db", "homing", "signature", "preprocess"} <= set(groups)
+
+
+def test_primary_search_path_is_bionavs_config_folder(tmp_path):
+    proc = run_bionav("--info", "searchpath", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    own = dict(config_dirs())["bionav"]
+    rows = [line for line in proc.stdout.splitlines() if "file://" in line or "pkg://" in line]
+    assert any(re.search(rf"\|\s*main\s*\|\s*file://{re.escape(str(own))}\s*\|", r) for r in rows), rows
+    assert sum(str(own) in r for r in rows) == 1, rows  # searched once
+    assert not any("pkg://bionav" in r for r in rows), rows
+
+
+def _complete(line: str, tmp_path) -> list[str]:
+    env = dict(os.environ, COMP_LINE=line, COMP_POINT=str(len(line)), BIONAV_CACHE=str(tmp_path / "cache"))
+    proc = subprocess.run([sys.executable, "-m", "bionav", "-sc", "query=bash"], env=env, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout.split()
+
+
+def test_completion_query_for_python_m_bionav(tmp_path):
+    assert _complete("python -m bionav homing=m", tmp_path) == [
+        "homing=mfdid", "homing=minwarping", "homing=minwarping_cleaning", "homing=minwarping_thesis"]
+    groups = [c for c in _complete("python -m bionav ", tmp_path) if c.endswith("=") and "." not in c]
+    assert len(groups) == len(set(groups)) and not [g for g in groups if "/" in g]
+    assert "experiment=" in groups and "signature=" in groups
+    assert _complete("python3 -m bionav homing.search_r", tmp_path) == ["homing.search_radius="]
+
+
+@pytest.mark.skipif(shutil.which("bash") is None, reason="needs bash")
+def test_installed_bash_completion_completes_python_m_bionav(tmp_path):
+    script = run_bionav("-sc", "install=bash", cwd=tmp_path)
+    assert script.returncode == 0, script.stderr
+    line = f"{sys.executable} -m bionav db=sim_ha"
+    driver = (
+        f'{script.stdout}\n'
+        f'COMP_LINE="{line}"; COMP_POINT=${{#COMP_LINE}}; COMP_CWORD=3\n'
+        f'_bionav_completion\nprintf "%s\\n" "${{COMPREPLY[@]}}"\n'
+    )
+    proc = subprocess.run(["bash", "-c", driver], capture_output=True, text=True, timeout=120, cwd=tmp_path,
+                          env=dict(os.environ, BIONAV_CACHE=str(tmp_path / "cache")))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["db=sim_hall1", "db=sim_hall2"]
