@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
 import sys
+import tempfile
 from pathlib import Path
 
 from bionav.errors import UserError
@@ -56,7 +58,7 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
                         f"Run `python -m bionav.plugins` to see every installed plugin."
                     )
         if key in ("hydra.run.dir", "hydra.sweep.dir"):
-            _check_writable(Path(str(override.value())))
+            _check_writable(Path(str(override.value())), sweep=key == "hydra.sweep.dir")
 
 
 def _concrete_overrides(argv: list[str]) -> list[str] | None:
@@ -159,16 +161,29 @@ def _has_yaml(group: str, value: str) -> bool:
     return value in _yaml_options(group)
 
 
-def _check_writable(path: Path) -> None:
+def _check_writable(path: Path, *, sweep: bool = False) -> None:
+    """The output directory can be created and written, and no live run holds it."""
+    from bionav.experiments.runlock import check_free
+
+    fix = "Choose another one with hydra.run.dir=... (or hydra.sweep.dir=... for -m)."
     probe = path
     while not probe.exists() and probe != probe.parent:
         probe = probe.parent
     if not probe.is_dir() or not os.access(probe, os.W_OK):
         what = "is not a directory" if not probe.is_dir() else "is not writable"
-        raise UserError(
-            f"cannot write the output directory {path}: {probe} {what}. "
-            f"Choose another one with hydra.run.dir=... (or hydra.sweep.dir=... for -m)."
-        )
+        raise UserError(f"cannot write the output directory {path}: {probe} {what}. {fix}")
+    if "${" in str(path):
+        return  # resolved by Hydra (e.g. ${now:...}); the probe above is all we can check
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise UserError(f"cannot write the output directory {path}: {exc.strerror or exc}. {fix}") from None
+    check_free(path)
+    if sweep:
+        for job in sorted(p.parent for p in path.glob("*/.bionav.lock")):
+            check_free(job)
 
 
 def _task(cfg) -> float | None:
@@ -176,13 +191,14 @@ def _task(cfg) -> float | None:
     from hydra.core.hydra_config import HydraConfig
     from hydra.types import RunMode
 
-    from bionav.experiments.runner import run_experiment
-
     from bionav.experiments.objective import objective_from_config
+    from bionav.experiments.runner import run_experiment
 
     hc = HydraConfig.get()
     run_dir = Path(hc.runtime.output_dir)
     multirun = hc.mode == RunMode.MULTIRUN
+    if multirun:
+        _SWEEP["dir"] = Path(str(hc.sweep.dir))
     objective = None
     try:
         objective = objective_from_config(cfg.get("objective"))
@@ -193,6 +209,8 @@ def _task(cfg) -> float | None:
             return objective.worst if objective else None
         _fail(f"{exc} (run directory: {run_dir})")
     except KeyboardInterrupt:
+        if multirun:
+            raise  # main() writes the summary of the finished jobs
         _fail(f"interrupted; what was recorded so far is in {run_dir} (metrics.json says failed).", 130)
     except Exception as exc:
         if multirun:
@@ -219,6 +237,43 @@ def _print_result(metrics: dict) -> None:
     from bionav.report.table import format_metrics
 
     print(format_metrics(metrics))
+
+
+#: the sweep directory of the multirun in progress (set by the first job; read after an interrupt)
+_SWEEP: dict[str, Path] = {}
+
+
+def _interrupted_sweep() -> None:
+    """Ctrl-C during a sweep: write summary.csv/summary.md for the jobs so far, then exit 130."""
+    sweep_dir = _SWEEP.get("dir")
+    if sweep_dir is None or not sweep_dir.is_dir():
+        _fail("interrupted before the first job started; nothing was recorded.", 130)
+    from bionav.report.callback import write_sweep_summary
+
+    try:
+        n_jobs, n_failed, md_path = write_sweep_summary(sweep_dir)
+    except KeyboardInterrupt:
+        _fail(f"interrupted twice; the jobs' results are in {sweep_dir} (rebuild the summary with "
+              f"`python -m bionav.report {sweep_dir}`).", 130)
+    _fail(f"interrupted; the summary of the {n_jobs} jobs so far ({n_failed} failed or interrupted) is in {md_path}. "
+          f"Finish the sweep with the same command plus bionav.resume=true hydra.sweep.dir={sweep_dir}", 130)
+
+
+def _sweep_failures() -> None:
+    """After a multirun: exit 1 with the count of failed jobs (unless bionav.fail_on_job_error=false)."""
+    from bionav.report.callback import LAST_SWEEP
+
+    if not LAST_SWEEP or not LAST_SWEEP.get("n_failed") or not LAST_SWEEP.get("fail_on_job_error", True):
+        return
+    n_failed, n_jobs = LAST_SWEEP["n_failed"], LAST_SWEEP["n_jobs"]
+    _fail(f"{n_failed} of {n_jobs} jobs failed: {', '.join(LAST_SWEEP['failed'])} (their errors are in "
+          f"{LAST_SWEEP['summary']}); the other jobs' results are kept. Fix and re-run them with bionav.resume=true, "
+          f"or pass bionav.fail_on_job_error=false to exit with status 0 anyway.", 1)
+
+
+def _terminate(signum, frame) -> None:  # noqa: ARG001
+    """SIGTERM (``kill``, a cluster's time limit) ends a run like Ctrl-C: results so far are kept."""
+    raise KeyboardInterrupt
 
 
 def limit_blas_threads() -> None:
@@ -254,8 +309,25 @@ def main(argv: list[str] | None = None) -> None:
     except UserError as exc:
         _fail(str(exc))
 
+    multirun = any(a in ("-m", "--multirun") for a in argv)
+    shows = [a for a in argv if a in ("--cfg", "-c", "--info", "--shell-completion", "-sc") or a.startswith("--info")]
+    if multirun and shows:
+        _fail(f"{shows[0]} shows one composed config, so it cannot be combined with -m (a sweep): drop -m and "
+              f"give one value per key, e.g. homing=sift instead of homing=sift,mfdid.")
+
     import hydra
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    hydra_main()
+    try:
+        signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        hydra_main()
+    except KeyboardInterrupt:
+        if multirun:
+            _interrupted_sweep()
+        _fail("interrupted before the run started; nothing was recorded.", 130)
+    if multirun:
+        _sweep_failures()

@@ -153,9 +153,16 @@ class BionavSlurmLauncher(SlurmLauncher):
         return done
 
     def _job_return(self, job: Any, overrides: list[str], num: int, *, ended_without_result: bool) -> JobReturn:
+        from submitit.core.utils import FailedJobError
+
         if not ended_without_result:
             try:
                 return job.results()[0]
+            except FailedJobError as exc:  # the job ran and raised (bionav's task catches its own errors)
+                lines = [line for line in str(exc).strip().splitlines() if line.strip()]
+                return self._failed_return(
+                    overrides, num, f"SLURM job {job.job_id} raised an error: {lines[-1] if lines else exc!r}; its "
+                    f"output is in {Path(job.paths.stdout).parent}.")
             except Exception as exc:  # no result file: cancelled, killed, timed out, out of memory
                 reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         else:

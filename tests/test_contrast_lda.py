@@ -33,7 +33,10 @@ def test_contrast_lda_small_simulated_run(tmp_path):
         assert (tmp_path / f).stat().st_size > 0, f
     md = (tmp_path / "lda_table.md").read_text()
     assert "| J |" in md and "UV-IR" in md or "**UV**" in md
-    assert len(ctx.log.messages) == 110 and ctx.log.messages[0][0] == "/spectral5/samples"
+    samples = [m for m in ctx.log.messages if m[0] == "/spectral5/samples"]
+    features = [m for m in ctx.log.messages if m[0] == "/contrast_lda/features"]
+    assert len(samples) == 110 and ctx.log.messages[0][0] == "/spectral5/samples"
+    assert [m[1]["feature"] for m in features] == names and len(ctx.log.messages) == 110 + len(names)
 
 
 def test_contrast_lda_csv_round_trip_and_errors(tmp_path):
@@ -55,3 +58,25 @@ def test_contrast_lda_csv_round_trip_and_errors(tmp_path):
     bad = OmegaConf.create({"experiment": {"name": "contrast_lda"}, "data": {"name": "nope"}})
     with pytest.raises(UserError, match="sim_natural"):
         contrast_lda.run(bad, FakeContext(tmp_path))
+
+
+def test_documented_command_runs_with_the_committed_data_configs(tmp_path):
+    """`python -m bionav experiment=contrast_lda data=...` (conf/data/*.yaml, once hidden by .gitignore) runs;
+    the per-feature criteria are logged before the bootstrap and equal metrics.json's."""
+    import json
+
+    from helpers import run_bionav
+
+    from bionav.logs.reader import read_messages
+
+    for data in ("sim_natural", "sim_artificial"):
+        run_dir = tmp_path / data
+        proc = run_bionav("experiment=contrast_lda", f"data={data}", "data.n_objects=30", "data.n_sky=30",
+                          "experiment.n_resamples=20", "experiment.plots=false", f"hydra.run.dir={run_dir}",
+                          cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr
+        metrics = json.loads((run_dir / "metrics.json").read_text())
+        assert metrics["status"] == "completed" and metrics["n_objects"] == 30 and metrics["n_sky"] == 30
+        logged = {m["feature"]: m for topic, _, m in read_messages(run_dir / "run.mcap", ["/contrast_lda/features"])}
+        assert set(logged) == set(metrics["J"]) and len(logged) == 16
+        assert all(abs(logged[f]["J"] - metrics["J"][f]) < 1e-12 for f in logged)

@@ -58,6 +58,8 @@ BAD_VALUES = [
     (["experiment=cleaning", "controller.fix_gain=2"], ["controller.fix_gain=2", "<= 1"]),
     (["experiment=contrast_scan", "experiment.cloud_cover=[0.5,1.5]"], ["experiment.cloud_cover", "1.5"]),
     (["experiment=skyline_homing", "experiment.image_width=0"], ["experiment.image_width=0"]),
+    (["experiment=cleaning", "layout.n_lanes=-3"], ["layout.n_lanes=-3", ">= 1"]),
+    (["experiment=cleaning", "layout.turn=up"], ["layout.turn=up", "one of left, right"]),
     (["workers=0"], ["workers=0", "an integer >= 1"]),
     (["seed=-1"], ["seed=-1", "an integer >= 0"]),
 ]
@@ -80,6 +82,8 @@ MISSPELT = [
     (["experiment=pol_compass", "experiment.sky.turbiditty=2"], "experiment.sky.turbiditty",
      "Did you mean experiment.sky.turbidity?", "latitude_deg"),
     (["homing=minwarping", "homing.n_alfa=32"], "homing.n_alfa", "Did you mean homing.n_alpha?", "n_psi"),
+    (["experiment=cleaning", "layout.n_lane=3"], "layout.n_lane", "Did you mean layout.n_lanes?", "lane_length"),
+    (["bionav.resum=true"], "bionav.resum", "Did you mean bionav.resume?", "cache_prepared"),
 ]
 
 
@@ -103,6 +107,19 @@ def test_memory_bound_refuses_image_stack_before_allocating(tmp_path):
     # inside the per-side range, but 170 images of 16000 x 16000 pixels do not fit in memory
     proc = run_bionav("db.image_size=[16000,16000]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
     clean_error(proc, "db.image_size=[16000,16000]", "memory", "choose a smaller db.image_size")
+
+
+def test_data_node_is_typed():
+    from omegaconf import OmegaConf
+
+    from bionav.errors import UserError
+    from bionav.experiments.configs import check_group_nodes
+
+    check_group_nodes(OmegaConf.create({"seed": 4, "data": {"name": "sim_natural", "seed": "${seed}", "n_sky": 50}}))
+    with pytest.raises(UserError, match=r"data.n_sky=1: .*>= 2"):
+        check_group_nodes(OmegaConf.create({"data": {"name": "sim_natural", "n_sky": 1}}))
+    with pytest.raises(UserError, match=r"unknown key data.n_skyy.*Did you mean data.n_sky\?"):
+        check_group_nodes(OmegaConf.create({"data": {"name": "sim_natural", "n_skyy": 1}}))
 
 
 # --------------------------------------------------------------------------- the mechanism itself

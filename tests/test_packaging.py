@@ -85,3 +85,26 @@ def test_installed_wheel_help_lists_each_group_once(wheel, tmp_path):
     groups = [line.split(":", 1)[0] for line in section.splitlines() if ": " in line]
     assert "experiment" in groups and len(groups) == len(set(groups)), groups
     assert not [g for g in groups if g.startswith("conf")], groups
+
+
+def test_wheel_ships_the_seville_world_with_its_licence(wheel):
+    with zipfile.ZipFile(wheel) as z:
+        names = set(z.namelist())
+    for required in ("bionav/data/seville2009/world5000_gray.mat", "bionav/data/seville2009/AntRoutes.mat",
+                     "bionav/data/seville2009/LICENSE", "bionav/data/seville2009/CITATION.md",
+                     "bionav/conf/db/sim_seville.yaml", "bionav/conf/experiment/route_homing.yaml"):
+        assert required in names, required
+
+
+def test_seville_features_work_from_an_installed_wheel(wheel, tmp_path):
+    target = tmp_path / "site"
+    proc = _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    env = {"PYTHONPATH": str(target)}
+    proc = run_bionav("db=sim_seville", "db.grid_shape=[3,2]", "db.image_size=[60,12]", "homing=mfdid", "workers=1",
+                      f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path, env=env)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert '"status": "completed"' in (tmp_path / "run" / "metrics.json").read_text()
+    proc = run_bionav("experiment=route_homing", "db.route=Ant0_Route0", f"hydra.run.dir={tmp_path / 'r2'}",
+                      cwd=tmp_path, env=env)
+    assert proc.returncode == 2 and "133 routes" in proc.stderr

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from bionav.geometry import wrap_angle
+from bionav.light import SkyModel, SunPosition
 from bionav.polcompass.array import (
     PolArray,
     counts_from_stokes,
@@ -20,7 +21,6 @@ from bionav.polcompass.decoders import (
     sun_from_sol,
     sun_from_two_units,
 )
-from bionav.light import SkyModel, SunPosition
 
 
 def test_thesis_array_recovers_angle_and_degree_exactly():
@@ -109,3 +109,15 @@ def test_four_zeros_finds_the_sun_where_the_ring_has_four_zeros(elevation_deg):
     assert ok.sum() >= 5  # some headings give fewer than four crossings at every level: not decoded (NaN)
     err = np.degrees(np.abs(wrap_angle(est.azimuth[ok] - phi[ok])))
     assert np.all(err < 8.0), err  # 8 units: the interpolated zeros are approximate
+
+
+def test_decoder_bench_prints_one_json_line_per_decoder(capsys):
+    import json
+
+    from bionav.bench.decoders.__main__ import main
+
+    assert main(["--rotations", "1", "--samples", "16", "--repeat", "1"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [r["decoder"] for r in rows] == ["sky_fit", "two_unit", "sol", "four_zeros", "eigenvector", "mean_vector"]
+    assert all(r["n_samples"] == 16 and r["wall_ms_per_session"] > 0 and r["cpu_ms_per_session"] >= 0 for r in rows)
+    assert main(["--repeat", "0"]) == 2

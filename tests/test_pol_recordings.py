@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from helpers import run_bionav
 
+from bionav.light import SkyModel, sun_position
 from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
 from bionav.polcompass.recordings import RecordingError, detect_faults, load_rotation, load_sessions
-from bionav.light import SkyModel, sun_position
 
 REPO = Path(__file__).resolve().parents[1]
 EXTERNAL = Path(os.environ.get("BIONAV_EXTERNAL_DATA", REPO.parent / "shared" / "data"))
@@ -120,6 +120,15 @@ def test_bad_file_keeps_good_rows_and_names_file_and_field(tmp_path):
     proc = run_bionav("experiment=pol_recordings", f"recordings.path={root}", f"hydra.run.dir={tmp_path / 'skip'}",
                       "experiment.compare=[sky_fit]", "recordings.on_bad_file=skip", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
+    # a session folder whose name does not give the time: named, skipped, the other session still scored
+    (folder / "3.json").unlink()
+    shutil.copytree(folder, root / "canopy_data" / "somewhere")
+    out = tmp_path / "run2"
+    proc = run_bionav("experiment=pol_recordings", f"recordings.path={root}", f"hydra.run.dir={out}",
+                      "experiment.compare=[sky_fit]", "experiment.simulate=false", cwd=tmp_path)
+    assert proc.returncode == 2 and "somewhere" in proc.stderr and "HH-MM__" in proc.stderr, proc.stderr
+    rows = list(csv.DictReader(open(out / "sessions.csv")))
+    assert [r["time_of_day"] for r in rows] == ["13:00"]
 
 
 def test_bad_options_are_clean_errors(tmp_path):

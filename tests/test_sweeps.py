@@ -33,7 +33,8 @@ def test_sweep_summary_includes_the_failing_job(tmp_path, tiny_folder):
         "-m", "homing=mfdid", "db=folder", f"db.path={tiny_folder},{tmp_path / 'missing'}",
         f"hydra.sweep.dir={sweep}", cwd=tmp_path,
     )
-    assert proc.returncode == 0, proc.stderr
+    assert proc.returncode == 1, proc.stderr  # a failed job fails the sweep, after the summary is written
+    assert "1 of 2 jobs failed" in proc.stderr.strip().splitlines()[-1] and "Traceback" not in proc.stderr
     rows = _rows(sweep / "summary.csv")
     assert len(rows) == 2
     by_path = {r["db.path"]: r for r in rows}

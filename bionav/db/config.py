@@ -57,3 +57,13 @@ class DatabaseConfig:
     rotation_seed: int = bounded(0, ge=0, le=2**32 - 1)
     unfold: UnfoldConfig = field(default_factory=UnfoldConfig)
     extra: dict[str, Any] = field(default_factory=dict)
+    # mesh worlds (source: mesh | route; see bionav/db/mesh.py and docs/worlds.md)
+    world: Optional[str] = None  # a packaged world (seville2009) when no path is given
+    origin_m: Optional[list[float]] = None  # world (x, y) in metres of grid cell (0, 0); None = centred
+    camera_height_m: float = 0.01  # camera height over the local terrain, metres
+    ground: str = "auto"  # plane | mesh | auto (.mat: plane at z = 0, .obj/.ply: the mesh)
+    channels: str = "grey"  # grey | spectral (UV B G R IR)
+    clearance_m: Optional[float] = None  # a cell is missing if a triangle lies this close above it; None = any
+    route: Optional[str] = None  # route databases: Ant<a>_Route<r>
+    routes_path: Optional[str] = None  # .mat of routes; None = the packaged Seville routes
+    step_m: float = 0.1  # route databases: distance between views along the route, metres

@@ -12,6 +12,7 @@ image for a truncated JPEG.
 from __future__ import annotations
 
 import re
+import zlib
 from pathlib import Path
 
 import cv2
@@ -34,6 +35,46 @@ def _pnm_maxval(data: bytes) -> int | None:
     return int(match.group(4))
 
 
+_PNG_CHANNELS = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}
+
+
+def _check_png(data: bytes) -> None:
+    """Verify a PNG's chunk CRCs and its compressed pixel data before libpng sees it.
+
+    libpng prints ``libpng error: ...`` on stderr for corrupt data (before
+    OpenCV returns nothing); checking here gives one clean message instead.
+    """
+    pos, idat, header = 8, [], None
+    while pos + 12 <= len(data):
+        length = int.from_bytes(data[pos:pos + 4], "big")
+        kind = data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + length]
+        crc = data[pos + 8 + length:pos + 12 + length]
+        if len(body) != length or len(crc) != 4:
+            raise ImageReadError(f"the PNG file is truncated inside its {kind.decode('latin-1')!r} chunk")
+        if zlib.crc32(kind + body) != int.from_bytes(crc, "big"):
+            raise ImageReadError(f"the PNG file is corrupt (checksum error in its {kind.decode('latin-1')!r} chunk)")
+        if kind == b"IHDR":
+            header = body
+        elif kind == b"IDAT":
+            idat.append(body)
+        elif kind == b"IEND":
+            break
+        pos += 12 + length
+    if header is None or len(header) != 13 or not idat:
+        raise ImageReadError("the PNG file is corrupt (no IHDR header or no IDAT pixel data)")
+    try:
+        pixels = zlib.decompress(b"".join(idat))
+    except zlib.error as exc:
+        raise ImageReadError(f"the PNG file is corrupt (its pixel data does not decompress: {exc})") from None
+    width, height = int.from_bytes(header[0:4], "big"), int.from_bytes(header[4:8], "big")
+    depth, colour, interlace = header[8], header[9], header[12]
+    if interlace == 0 and colour in _PNG_CHANNELS:
+        need = height * (1 + (width * depth * _PNG_CHANNELS[colour] + 7) // 8)
+        if len(pixels) < need:
+            raise ImageReadError(f"the PNG file is corrupt ({len(pixels)} of {need} pixel bytes)")
+
+
 def _check_complete(data: bytes) -> None:
     """Raise ImageReadError if ``data`` is an image file that is cut short."""
     if len(data) == 0:
@@ -41,6 +82,7 @@ def _check_complete(data: bytes) -> None:
     if data.startswith(b"\x89PNG\r\n\x1a\n"):
         if data.rstrip(b"\x00")[-12:] != b"\x00\x00\x00\x00IEND\xaeB`\x82":
             raise ImageReadError("the PNG file is truncated (no IEND chunk at its end)")
+        _check_png(data)
     elif data.startswith(b"\xff\xd8"):
         if not data.rstrip(b"\x00\r\n ")[-2:] == b"\xff\xd9":
             raise ImageReadError("the JPEG file is truncated (no end-of-image marker)")

@@ -66,6 +66,18 @@ def _missing_folder_message(cfg: DatabaseConfig, folder: Path, data_dir: Path) -
             f"directly with db.path=DIR.{stand_in}")
 
 
+def _render_progress(name: str):
+    """A tqdm wrapper for render loops (stderr, cleared when done)."""
+    import sys
+
+    def wrap(iterable):
+        from tqdm.auto import tqdm
+
+        return tqdm(iterable, desc=f"rendering {name}", file=sys.stderr, leave=False)
+
+    return wrap
+
+
 def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> ImageDatabase:
     """Load the database a ``db`` config describes, as canonical panoramas.
 
@@ -122,8 +134,16 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
                                 "directory that holds the images.")
             raise UserError(_missing_folder_message(cfg, folder, Path(data_dir)))
         db = load_folder(cfg, folder)
+    elif source == "mesh":
+        from bionav.db.mesh import mesh_grid_database
+
+        db = mesh_grid_database(cfg, cache_dir=Path(cache_dir), progress=_render_progress(cfg.name))
+        size = None  # rendered directly at db.image_size
+    elif source == "route":
+        raise UserError(f"db={cfg.name} holds views along a route, not a grid; evaluate it with "
+                        "experiment=route_homing (grid experiments need a grid database such as db=sim_seville).")
     else:
-        raise UserError(f"db.source={cfg.source!r} is not a database source; use synthetic or folder.")
+        raise UserError(f"db.source={cfg.source!r} is not a database source; use synthetic, folder or mesh.")
     _check_image_memory(db, size)
     db = preprocess_database(db, preprocess)
     if size is not None:

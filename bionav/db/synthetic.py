@@ -169,6 +169,19 @@ def get_spec(name: str) -> SyntheticSpec:
     return SYNTHETIC_DATABASES[name]
 
 
+def read_cached_images(path: Path, key: str) -> np.ndarray | None:
+    """The ``images`` array of a cached ``.npz`` whose ``key`` matches; None if absent, stale or unreadable."""
+    if not Path(path).exists():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if str(z["key"]) == key:
+                return z["images"]
+    except (OSError, ValueError, KeyError):
+        pass  # unreadable cache file: the caller renders again and overwrites it
+    return None
+
+
 def quantise(images: np.ndarray, *, noise: float, rng: np.random.Generator) -> np.ndarray:
     """Add Gaussian camera noise (std ``noise``) and quantise to 8 bits.
 
@@ -287,14 +300,7 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     path = cdir / f"{name}-{w}x{h}-seed{int(seed)}-{key[:20]}.npz"
-    images_u8 = None
-    if path.exists():
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if str(z["key"]) == key:
-                    images_u8 = z["images"]
-        except (OSError, ValueError, KeyError):
-            images_u8 = None  # unreadable cache file: render again and overwrite
+    images_u8 = read_cached_images(path, key)
     cached = images_u8 is not None
     if not cached:
         imgs = render_world_images(world, positions, geometry, progress=progress, threads=threads)

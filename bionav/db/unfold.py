@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
 
@@ -14,9 +13,27 @@ def _unfold_maps(center: tuple[float, float], inner_radius: float, outer_radius:
         radius = outer_radius + (inner_radius - outer_radius) * np.arange(height) / (height - 1)
     else:
         radius = np.array([0.5 * (inner_radius + outer_radius)])
-    map_x = (center[0] + radius[:, None] * np.cos(phi)[None, :]).astype(np.float32)
-    map_y = (center[1] + radius[:, None] * np.sin(phi)[None, :]).astype(np.float32)
+    map_x = center[0] + radius[:, None] * np.cos(phi)[None, :]
+    map_y = center[1] + radius[:, None] * np.sin(phi)[None, :]
     return map_x, map_y
+
+
+def _bilinear(src: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
+    """Bilinear samples of ``src`` at ``(map_x, map_y)`` (column, row), pixels outside the frame 0.
+
+    Exact in float64 (``cv2.remap`` rounds coordinates to 1/32 pixel before OpenCV 5).
+    """
+    h, w = src.shape
+    x0, y0 = np.floor(map_x).astype(np.int64), np.floor(map_y).astype(np.int64)
+    fx, fy = map_x - x0, map_y - y0
+
+    def at(rows, cols):
+        inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+        return np.where(inside, src[np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)], 0.0)
+
+    top = (1.0 - fx) * at(y0, x0) + fx * at(y0, x0 + 1)
+    bottom = (1.0 - fx) * at(y0 + 1, x0) + fx * at(y0 + 1, x0 + 1)
+    return (1.0 - fy) * top + fy * bottom
 
 
 def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float, outer_radius: float, size) -> np.ndarray:
@@ -29,7 +46,7 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float, outer_radiu
     ``(cx + r cos(phi_j), cy + r sin(phi_j))``. Row ``i`` samples the radius
     ``r_i = outer_radius + (inner_radius - outer_radius) * i / (H - 1)``, so
     row 0 (top) lies on the outer circle and the last row on the inner circle.
-    Sampling is bilinear (``cv2.remap``); points outside the frame read 0.
+    Sampling is bilinear (exact, in float64); pixels outside the frame read 0.
 
     The unfolded image is an *on-disk* panorama: which azimuth direction and
     which column looks along the grid's +x depend on the mirror and the camera
@@ -56,6 +73,5 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float, outer_radiu
         raise ValueError(f"unfold size must be positive, got {size}")
     map_x, map_y = _unfold_maps((float(center[0]), float(center[1])), float(inner_radius),
                                 float(outer_radius), (width, height))
-    src = np.asarray(raw, dtype=np.float32)
-    return cv2.remap(src, map_x, map_y, interpolation=cv2.INTER_LINEAR,
-                     borderMode=cv2.BORDER_CONSTANT, borderValue=0.0)
+    src = np.asarray(raw, dtype=np.float64)
+    return _bilinear(src, map_x, map_y).astype(np.float32)

@@ -107,6 +107,7 @@ def home_vector_matrix(
     progress: Progress = _no_progress,
     prepared: tuple[list[Any], list[Any]] | None = None,
     cache: Any = None,
+    on_row: Callable[[int, np.ndarray, np.ndarray], None] | None = None,
     batch: bool = True,
 ) -> HomeVectorMatrix:
     """Home vectors from every current view to every (selected) snapshot.
@@ -130,6 +131,12 @@ def home_vector_matrix(
         Already prepared snapshot and current images (skips the per-image work).
     cache : PreparedCache, optional
         On-disk cache of per-image work.
+    on_row : callable, optional
+        ``on_row(snapshot, angles, compass)`` is called (in the caller's
+        thread, in order) as soon as a snapshot's row is finished:
+        ``snapshot`` is its index into ``snapshots``, ``angles`` and
+        ``compass`` have shape (C,), radians in the grid frame (NaN: none).
+        Experiments log rows here, so a crash loses no finished row.
     batch : bool
         Use the method's batch path (:meth:`HomingMethod.all_pairs_angles`)
         when it has one and snapshots and current views are one database;
@@ -162,8 +169,13 @@ def home_vector_matrix(
     if all_pairs is not None:
         angles = np.array(all_pairs, dtype=np.float64)[s_idx]
         angles[np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)] = np.nan
+        t2 = time.perf_counter()
+        if on_row is not None:
+            no_compass = np.full(len(currents), np.nan)
+            for row_angles, si in zip(angles, s_idx):
+                on_row(int(si), row_angles, no_compass)
         return HomeVectorMatrix(snapshot_index=s_idx, angles=angles, compass_error=None, prepare_s=t1 - t0,
-                                pairs_s=time.perf_counter() - t1, n_pairs=n_pairs)
+                                pairs_s=t2 - t1, n_pairs=n_pairs, prepared_stats=_prepared_stats(method, cur_prep))
 
     lut = currents.cell_index_map()
     nx, ny = currents.grid_shape
@@ -194,14 +206,16 @@ def home_vector_matrix(
         return wrap_angle(angles), wrap_angle(compass)
 
     with ThreadPoolExecutor(max(1, workers)) as pool:
-        rows = list(progress(pool.map(row, s_idx), desc="home vectors", total=len(s_idx)))
+        rows = []
+        for si, r in zip(s_idx, progress(pool.map(row, s_idx), desc="home vectors", total=len(s_idx))):
+            rows.append(r)
+            if on_row is not None:
+                on_row(int(si), r[0], r[1])
     t2 = time.perf_counter()
 
     angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))
     compass = np.array([r[1] for r in rows]).reshape(len(s_idx), len(currents))
     has_compass = bool(np.any(np.isfinite(compass)))
-    described = [method.describe_prepared(p) for p in cur_prep]
-    stats = {k: float(np.mean([d[k] for d in described])) for k in (described[0] if described else {})}
     return HomeVectorMatrix(
         snapshot_index=s_idx,
         angles=angles,
@@ -209,5 +223,11 @@ def home_vector_matrix(
         prepare_s=t1 - t0,
         pairs_s=t2 - t1,
         n_pairs=n_pairs,
-        prepared_stats=stats,
+        prepared_stats=_prepared_stats(method, cur_prep),
     )
+
+
+def _prepared_stats(method: HomingMethod, prepared: Sequence[Any]) -> dict[str, float]:
+    """Means over the images of :meth:`HomingMethod.describe_prepared` (e.g. keypoints per image)."""
+    described = [method.describe_prepared(p) for p in prepared]
+    return {k: float(np.mean([d[k] for d in described])) for k in (described[0] if described else {})}

@@ -366,6 +366,153 @@ class CleaningConfig:
     log_images: bool = False
 
 
+# --------------------------------------------------------------------------- compass on real skies
+@dataclass
+class RecordingsConfig:
+    """``recordings.*`` of ``experiment=pol_recordings``: where the recordings are, how the hardware reads.
+
+    path : folder of sessions (``<HH-MM>__<Day>_<dd-mm-yy>/<n>.json``), one session folder, or one file.
+    exclude_units : ``auto`` (faults detected from each session's counts), ``none``, or a list of unit
+        numbers (checked against the recordings' units).
+    saturation_counts : counts at or above: saturated or overflowing (the recorded sensor plateaus near
+        11,300 and overflows at 32,768). dark_counts : counts below: too dark.
+    imbalance_decades : POL-OP light imbalance beyond which a reading (per sample) or a unit (median
+        over the session) is bad. blind_fraction : share of identical orthogonal readings that makes a
+        unit polarization-blind.
+    tilt_deg, azimuth_sign, photodiode_angles_deg, pairs : array geometry (file azimuths clockwise:
+        ``azimuth_sign=-1``; photodiode angles in the unit frame in file order; POL-OPs as index pairs).
+    latitude_deg, longitude_deg, utc_offset_hours : the site and the folder names' time zone.
+    dusk_elevation_deg : time-of-day sessions with the sun lower count as ``tod_dusk``.
+    on_bad_file : ``error`` (score the good files, then stop naming the bad ones) or ``skip`` (warn).
+    """
+
+    path: Optional[str] = None
+    exclude_units: Any = bounded("auto")  # auto | none | [unit, ...]: checked in pol_recordings.excluded_units
+    saturation_counts: float = bounded(11000.0, gt=0.0, le=1e12)
+    dark_counts: float = bounded(5.0, ge=0.0, le=1e12)
+    imbalance_decades: float = bounded(0.15, gt=0.0, le=3.0)
+    blind_fraction: float = bounded(0.5, gt=0.0, le=1.0)
+    tilt_deg: float = bounded(45.0, ge=0.0, le=90.0)
+    azimuth_sign: float = bounded(-1.0, choices=(-1.0, 1.0))
+    photodiode_angles_deg: list[float] = bounded([-45.0, 45.0, 0.0, 90.0], length=(1, 16), item=Range(ge=-360.0, le=360.0))
+    pairs: list[list[int]] = bounded([[2, 3], [1, 0]], length=(1, 8), item=Range(length=2, item=Range(ge=0, le=15)))
+    latitude_deg: float = bounded(39.2, ge=-90.0, le=90.0)
+    longitude_deg: float = bounded(9.1, ge=-180.0, le=180.0)
+    utc_offset_hours: float = bounded(2.0, ge=-14.0, le=14.0)
+    dusk_elevation_deg: float = bounded(10.0, ge=-90.0, le=90.0)
+    on_bad_file: str = bounded("error", choices=("error", "skip"))
+
+
+@dataclass
+class PolRecordingsConfig:
+    """``experiment=pol_recordings`` (issue 15): decode recorded POL-OP rotations, score every sample.
+
+    compare : decoders scored in ``sessions.csv`` besides ``decoder=``.
+    simulate : also decode each session simulated in the sky model (the sim-to-real gap), with
+        ``sim_noise`` (count noise, fraction), ``sim_gain_sigma`` (photodiode gain spread),
+        ``sim_canopy_cover`` (cloud-map cover standing in for canopy gaps), ``sim_max_degree``.
+    record_samples : every decoded sample of the chosen decoder into run.mcap.
+    """
+
+    name: str = "pol_recordings"
+    compare: list[str] = field(
+        default_factory=lambda: ["sky_fit", "two_unit", "sol", "four_zeros", "eigenvector", "mean_vector"])
+    simulate: bool = True
+    sim_noise: float = bounded(0.01, ge=0.0, le=1.0)
+    sim_gain_sigma: float = bounded(0.05, ge=0.0, le=1.0)
+    sim_canopy_cover: float = bounded(0.5, ge=0.0, le=1.0)
+    sim_max_degree: float = bounded(0.5, gt=0.0, le=1.0)
+    record_samples: bool = True
+
+
+@dataclass
+class LayoutConfig:
+    """``layout=<name>`` of ``experiment=cleaning`` (``bionav/conf/layout/*.yaml``: thesis fig. 7.2).
+
+    n_lanes, lane_length, spacing : the meander's lanes (m); unit_width : cleaning width (m).
+    turn : side of the next lane seen from the first lane. wall_offset : first lane's distance from the
+    wall on its right (m). start, start_heading_deg : ``[x, y]`` in the world (m) and heading; None:
+    placed along a wall automatically.
+    """
+
+    name: str = "long_lanes"
+    n_lanes: int = bounded(7, ge=1, le=1000)
+    lane_length: float = bounded(4.0, gt=0.0, le=1000.0)
+    spacing: float = bounded(0.30, gt=0.0, le=100.0)
+    unit_width: float = bounded(0.30, gt=0.0, le=100.0)
+    turn: str = bounded("left", choices=("left", "right"))
+    wall_offset: float = bounded(0.25, ge=0.0, le=100.0)
+    start: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-1e4, le=1e4))
+    start_heading_deg: Optional[float] = bounded(None, ge=-360.0, le=360.0)
+
+
+@dataclass
+class DataConfig:
+    """``data=<name>`` of ``experiment=contrast_lda``: simulated labelled samples or a CSV file."""
+
+    name: str = bounded("sim_natural", choices=("sim_natural", "sim_artificial", "csv"))
+    path: Optional[str] = None
+    seed: int = bounded(0, ge=0, le=2**32 - 1)
+    n_objects: Optional[int] = bounded(None, ge=2, le=1_000_000)
+    n_sky: int = bounded(233, ge=2, le=1_000_000)
+    noise_counts: float = bounded(4.0, ge=0.0, le=1e6)
+    n_average: int = bounded(10, ge=1, le=100_000)
+
+
+#: other option groups with a typed schema: group -> dataclass (checked by :func:`check_group_nodes`)
+GROUP_CONFIGS: dict[str, type] = {"layout": LayoutConfig, "data": DataConfig}
+
+
+def typed_node(node: Any, schema: type, *, prefix: str, what: str) -> DictConfig:
+    """``node`` merged onto ``schema``: unknown keys and wrong types named, every value range-checked.
+
+    Parameters
+    ----------
+    node : DictConfig or Mapping
+        The (resolved) config node.
+    schema : type
+        Its dataclass.
+    prefix : str
+        The key users type for the node (``layout``).
+    what : str
+        Said in messages (``layout=short_lanes``).
+    """
+    from omegaconf.errors import OmegaConfBaseException
+
+    from bionav.config import unknown_key_message
+    from bionav.errors import UserError
+
+    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
+    try:
+        typed = OmegaConf.merge(OmegaConf.structured(schema), plain)
+        instance = OmegaConf.to_object(typed)
+    except OmegaConfBaseException as exc:
+        key = str(getattr(exc, "full_key", "") or "")
+        if type(exc).__name__ in ("ConfigKeyError", "ConfigAttributeError") and key:
+            parent, bad = key.rsplit(".", 1) if "." in key else ("", key)
+            where = OmegaConf.select(OmegaConf.structured(schema), parent) if parent else OmegaConf.structured(schema)
+            valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
+            full_parent = f"{prefix}.{parent}" if parent else prefix
+            raise UserError(unknown_key_message(full_parent, bad, valid, what=what)) from None
+        if type(exc).__name__ == "MissingMandatoryValue" and key:
+            raise UserError(f"{prefix}.{key} has no value ({what} needs it); add {prefix}.{key}=<value> "
+                            "on the command line.") from None
+        raise UserError(
+            f"bad value for {prefix}.{key or '<key>'} ({what}): {str(exc).splitlines()[0]}. "
+            f"Give it a value of the declared type (see {schema.__name__} in bionav/experiments/configs.py)."
+        ) from None
+    check_config(instance, prefix=prefix)
+    return typed
+
+
+def check_group_nodes(cfg: DictConfig) -> None:
+    """Check the ``layout`` and ``data`` nodes (when present) against :data:`GROUP_CONFIGS`."""
+    for group, schema in GROUP_CONFIGS.items():
+        node = cfg.get(group) if isinstance(cfg, DictConfig) else None
+        if node is not None:
+            typed_node(node, schema, prefix=group, what=f"{group}={node.get('name', '?')}")
+
+
 # --------------------------------------------------------------------------- top-level run settings
 @dataclass
 class RunSettings:
@@ -401,6 +548,7 @@ EXPERIMENT_CONFIGS: dict[str, type] = {
     "skyline_homing": SkylineHomingConfig,
     "pol_compass": PolCompassConfig,
     "cleaning": CleaningConfig,
+    "pol_recordings": PolRecordingsConfig,
 }
 
 
@@ -411,6 +559,8 @@ def register(store=None) -> None:
     store = store or ConfigStore.instance()
     for name, cls in EXPERIMENT_CONFIGS.items():
         store.store(group="experiment_schema", name=name, node=cls, provider="bionav")
+    # the top-level recordings.* node of experiment=pol_recordings
+    store.store(name="recordings_schema", node=RecordingsConfig, provider="bionav")
 
 
 def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
@@ -464,6 +614,9 @@ def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
                 else OmegaConf.structured(schema)
             valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
             raise UserError(unknown_key_message(parent, bad, valid, what=f"experiment={name}")) from None
+        if kind == "MissingMandatoryValue" and key:
+            raise UserError(f"{key} has no value (experiment={name} needs it); add {key}=<value> "
+                            "on the command line.") from None
         raise UserError(
             f"bad value for {key or 'experiment'} (experiment={name}): {str(exc).splitlines()[0]}. "
             f"Give it a value of the declared type (see {schema.__name__} in bionav/experiments/configs.py)."

@@ -25,7 +25,7 @@ DATASETS = ("sim_natural", "sim_artificial", "csv")
 
 
 def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator, out_dir, plots_dir,
-            title: str = "", plots: bool = True) -> dict:
+            title: str = "", plots: bool = True, on_features=None) -> dict:
     """Run the whole analysis on a sample set and write tables and plots.
 
     Parameters
@@ -42,6 +42,9 @@ def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator
         Title for tables and figures.
     plots : bool
         Draw the figures.
+    on_features : callable, optional
+        ``on_features(results)`` with the per-feature LDA results, called
+        before the (long) bootstrap, e.g. to log them at once.
 
     Returns
     -------
@@ -54,6 +57,8 @@ def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator
 
     out_dir, plots_dir = Path(out_dir), Path(plots_dir)
     results = la.analyse_features(samples, sigma=sigma)
+    if on_features is not None:
+        on_features(results)
     la.write_lda_table_csv(results, out_dir / "lda_table.csv")
     (out_dir / "lda_table.md").write_text(la.lda_table_markdown(results, title=title, sigma=sigma))
     write_samples_csv(samples, out_dir / "samples.csv")
@@ -92,6 +97,15 @@ SAMPLE_SCHEMA = {
     },
 }
 
+FEATURE_TOPIC = "/contrast_lda/features"
+FEATURE_SCHEMA = {
+    "type": "object",
+    "title": "bionav.SpectralFeatureLda",
+    "description": "Fisher LDA of one spectral feature: J, J_sigma (receptor noise) and the misclassified fraction n_f.",
+    "properties": {"feature": {"type": "string"}, "J": {"type": "number"}, "J_sigma": {"type": "number"},
+                   "n_f": {"type": "number"}},
+}
+
 
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
@@ -106,6 +120,13 @@ def run(cfg, ctx) -> dict:
                                      **{ch: float(v) for ch, v in zip(("uv", "b", "g", "r", "ir"), c)}},
                       schema_name="bionav.Spectral5Sample", schema=SAMPLE_SCHEMA)
     title = f"{samples.name}: {samples.n_objects} objects, {samples.n_sky} sky"
+
+    def log_features(results) -> None:
+        """Each feature's criteria as soon as known (the bootstrap that follows can take minutes)."""
+        for name, r in results.items():
+            ctx.log.write(FEATURE_TOPIC, {"feature": name, "J": r.J, "J_sigma": r.J_sigma, "n_f": r.n_f},
+                          schema_name="bionav.SpectralFeatureLda", schema=FEATURE_SCHEMA)
+
     return analyse(samples, sigma=float(exp.sigma), n_resamples=int(exp.n_resamples),
                    rng=ctx.rng, out_dir=ctx.dir, plots_dir=ctx.plots, title=title,
-                   plots=bool(exp.plots))
+                   plots=bool(exp.plots), on_features=log_features)

@@ -31,6 +31,21 @@ HOME_VECTOR_SCHEMA = {
     },
 }
 
+HOME_VECTOR_ROW_SCHEMA = {
+    "type": "object",
+    "description": "one snapshot's home vectors, logged as soon as computed (currents: every cell in database order)",
+    "properties": {
+        "snapshot": {"type": "array", "items": {"type": "integer"}, "description": "snapshot cell (x, y)"},
+        "angles": {"type": "array", "description": "home directions, radians CCW in the grid frame (null: none)"},
+        "ae": {"type": "array", "description": "angular errors, radians (null: none)"},
+        "compass_error": {"type": "array", "description": "estimated minus true rotation, radians (null: none)"},
+    },
+}
+
+
+def _finite_or_none(values) -> list[float | None]:
+    return [float(a) if np.isfinite(a) else None for a in np.asarray(values, dtype=float)]
+
 
 def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:
     with open(path, "w", newline="") as f:
@@ -54,9 +69,21 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             f"bad value experiment.snapshots={snapshots}: database {db.name!r} has {len(db)} images, so the "
             f"snapshot indices must be 0..{len(db) - 1}; drop the larger ones (null = every image)."
         )
+
+    def log_row(si: int, angles: np.ndarray, compass: np.ndarray) -> None:
+        """Each snapshot's home vectors as soon as they are computed (a crash loses no finished row)."""
+        ae_row = angular_errors(angles[None], ideal_home_angles(db.positions[[si]], db.positions))[0]
+        ctx.log.write(
+            "/grid_homing/snapshot_rows",
+            {"snapshot": db.positions[si], "angles": _finite_or_none(angles), "ae": _finite_or_none(ae_row),
+             "compass_error": _finite_or_none(compass)},
+            schema_name="bionav.HomeVectorRow",
+            schema=HOME_VECTOR_ROW_SCHEMA,
+        )
+
     hv = home_vector_matrix(
         method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
-        cache=prepared_cache(cfg),
+        cache=prepared_cache(cfg), on_row=log_row,
     )
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
@@ -73,8 +100,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             {
                 "snapshot": db.positions[si],
                 "currents": db.positions,
-                "angles": [None if not np.isfinite(a) else float(a) for a in hv.angles[row]],
-                "ae": [None if not np.isfinite(a) else float(a) for a in ae[row]],
+                "angles": _finite_or_none(hv.angles[row]),
+                "ae": _finite_or_none(ae[row]),
                 "success": success[row],
             },
             schema_name="bionav.HomeVectorField",

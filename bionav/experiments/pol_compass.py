@@ -513,7 +513,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             from bionav.plugins.sensors.recording import RecordingConfig
 
             cfg_dec = cfg.get("decoder")
-            devices["decoder"] = ctx.plugin("decoder", cfg_dec if cfg_dec is not None and cfg_dec.get("name") else {"name": "sky_fit"})
+            node = cfg_dec if cfg_dec is not None and cfg_dec.get("name") else {"name": "sky_fit"}
+            devices["decoder"] = ctx.plugin("decoder", node)
             devices["array_config"] = devices["sensor"].config if nodes["sensor"]["name"] == "recording" else RecordingConfig()
         metrics = run_session(
             exp,

@@ -29,12 +29,12 @@ from __future__ import annotations
 import csv
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, ListConfig, OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
 from bionav.geometry import wrap_angle
@@ -47,92 +47,38 @@ ROTATION_TOPIC = "/pol_recordings/rotation"
 FAULT_TOPIC = "/pol_recordings/faults"
 
 
-def _check(name, value, lo=None, hi=None):
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        raise UserError(f"recordings.{name}={value!r} is out of range; allowed: [{lo}, {hi}].")
+def recordings_config(cfg: DictConfig):
+    """The run's ``recordings`` node as a checked :class:`~bionav.experiments.configs.RecordingsConfig`."""
+    from omegaconf.errors import OmegaConfBaseException
 
+    from bionav.experiments.configs import RecordingsConfig
+    from bionav.validation import check_config
 
-@dataclass
-class RecordingsConfig:
-    """``recordings.*``: where the recordings are and how the hardware reads.
-
-    Angles in degrees where the name says ``_deg``.
-    """
-
-    path: str | None = None  # folder of sessions (or one session folder / one rotation file)
-    exclude_units: Any = "auto"  # auto (faults detected from the counts) | none | list of unit numbers
-    saturation_counts: float = 11000.0  # counts at or above: saturated / overflowing photodiode, (0, inf)
-    dark_counts: float = 5.0  # counts below: too dark to measure, [0, inf)
-    imbalance_decades: float = 0.15  # POL-OP light imbalance beyond which a reading / unit is bad, (0, 3]
-    blind_fraction: float = 0.5  # fraction of identical orthogonal readings: polarization-blind unit, (0, 1]
-    tilt_deg: float = 45.0  # zenith angle of the units, [0, 90]
-    azimuth_sign: float = -1.0  # file azimuths: -1 clockwise from the front (recorded fan), +1 CCW
-    photodiode_angles_deg: list = field(default_factory=lambda: [-45.0, 45.0, 0.0, 90.0])  # unit frame, file order
-    pairs: list = field(default_factory=lambda: [[2, 3], [1, 0]])  # POL-OPs as photodiode index pairs
-    latitude_deg: float = 39.2  # recording site (Sardinia; the files do not say where exactly), [-90, 90]
-    longitude_deg: float = 9.1  # [-180, 180]
-    utc_offset_hours: float = 2.0  # local time in folder names (CEST), [-14, 14]
-    dusk_elevation_deg: float = 10.0  # tod sessions with the sun lower than this count as dusk, [-90, 90]
-    on_bad_file: str = "error"  # error: score the good files, then stop with the message | skip: warn only
-
-    def __post_init__(self):
-        _check("saturation_counts", self.saturation_counts, 1e-9, None)
-        _check("dark_counts", self.dark_counts, 0.0, None)
-        _check("imbalance_decades", self.imbalance_decades, 1e-9, 3.0)
-        _check("blind_fraction", self.blind_fraction, 1e-9, 1.0)
-        _check("tilt_deg", self.tilt_deg, 0.0, 90.0)
-        _check("latitude_deg", self.latitude_deg, -90.0, 90.0)
-        _check("longitude_deg", self.longitude_deg, -180.0, 180.0)
-        _check("utc_offset_hours", self.utc_offset_hours, -14.0, 14.0)
-        _check("dusk_elevation_deg", self.dusk_elevation_deg, -90.0, 90.0)
-        if self.azimuth_sign not in (-1.0, 1.0):
-            raise UserError(f"recordings.azimuth_sign={self.azimuth_sign!r} must be -1 (clockwise) or 1 (counter-clockwise).")
-        if self.on_bad_file not in ("error", "skip"):
-            raise UserError(f"recordings.on_bad_file={self.on_bad_file!r} is unknown; choose error or skip.")
-        ex = self.exclude_units
-        if isinstance(ex, str):
-            if ex not in ("auto", "none"):
-                raise UserError(f"recordings.exclude_units={ex!r} is unknown; give auto, none or a list such as [5,7].")
-        elif ex is None:
-            self.exclude_units = "none"
-        else:
-            try:
-                self.exclude_units = [int(u) for u in ex]
-            except (TypeError, ValueError):
-                raise UserError(f"recordings.exclude_units={ex!r}: give auto, none or a list of unit numbers such as [5,7].") from None
-
-
-@dataclass
-class PolRecordingsConfig:
-    """``experiment.*`` of ``experiment=pol_recordings``."""
-
-    compare: list = field(default_factory=lambda: ["sky_fit", "two_unit", "sol", "four_zeros", "eigenvector", "mean_vector"])
-    simulate: bool = True  # also decode each session simulated in the sky model (sim-to-real gap)
-    sim_noise: float = 0.01  # simulated count noise, fraction of the count, [0, 1]
-    sim_gain_sigma: float = 0.05  # simulated photodiode gain spread (log-normal sigma), [0, 1]
-    sim_canopy_cover: float = 0.5  # cloud-model cover standing in for canopy gaps, [0, 1]
-    sim_max_degree: float = 0.5  # maximum degree of the simulated sky, (0, 1]
-    record_samples: bool = True  # write every decoded sample of the chosen decoder to run.mcap
-
-    def __post_init__(self):
-        _check_exp("sim_noise", self.sim_noise, 0.0, 1.0)
-        _check_exp("sim_gain_sigma", self.sim_gain_sigma, 0.0, 1.0)
-        _check_exp("sim_canopy_cover", self.sim_canopy_cover, 0.0, 1.0)
-        _check_exp("sim_max_degree", self.sim_max_degree, 1e-6, 1.0)
-
-
-def _check_exp(name, value, lo, hi):
-    if not lo <= value <= hi:
-        raise UserError(f"experiment.{name}={value!r} is out of range; allowed: [{lo}, {hi}].")
-
-
-def _typed(cls, node, prefix):
-    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, (DictConfig, ListConfig)) else dict(node or {})
-    names = {f for f in cls.__dataclass_fields__}
-    unknown = sorted(set(plain) - names - {"name"})
+    node = cfg.get("recordings")
+    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node or {})
+    names = set(RecordingsConfig.__dataclass_fields__)
+    unknown = sorted(set(plain) - names)
     if unknown:
-        raise UserError(f"{prefix} has no option(s) {', '.join(unknown)}; its options are {', '.join(sorted(names))}.")
-    return cls(**{k: v for k, v in plain.items() if k in names})
+        from bionav.config import unknown_key_message
+
+        raise UserError(unknown_key_message("recordings", unknown[0], sorted(names), what="experiment=pol_recordings"))
+    try:
+        rc = OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(RecordingsConfig), plain))
+    except OmegaConfBaseException as exc:
+        key = getattr(exc, "full_key", "") or "recordings"
+        raise UserError(f"bad value for recordings.{key}: {str(exc).splitlines()[0]}.") from None
+    check_config(rc, prefix="recordings")
+    ex = rc.exclude_units
+    if isinstance(ex, str) and ex not in ("auto", "none"):
+        raise UserError(f"bad value recordings.exclude_units={ex}: allowed: auto, none or a list of unit numbers such as [5,7].")
+    if not isinstance(ex, str):
+        try:
+            rc.exclude_units = [int(u) for u in (ex or [])]
+        except (TypeError, ValueError):
+            raise UserError(
+                f"bad value recordings.exclude_units={ex}: allowed: auto, none or a list of unit numbers such as [5,7]."
+            ) from None
+    return rc
 
 
 # ---------------------------------------------------------------------------
@@ -176,7 +122,7 @@ def error_stats(errors_rad) -> dict:
     }
 
 
-def build_array(rc: RecordingsConfig, file_azimuths):
+def build_array(rc, file_azimuths):
     """The :class:`~bionav.polcompass.array.PolArray` of the recorded sensor."""
     from bionav.polcompass.array import PolArray
 
@@ -188,7 +134,7 @@ def build_array(rc: RecordingsConfig, file_azimuths):
     )
 
 
-def excluded_units(rc: RecordingsConfig, faults, k: int) -> list[int]:
+def excluded_units(rc, faults, k: int) -> list[int]:
     if rc.exclude_units == "auto":
         return [f.unit for f in faults if f.excluded]
     if rc.exclude_units == "none":
@@ -216,11 +162,11 @@ class SessionData:
     period: str
 
 
-def prepare_session(session, rc: RecordingsConfig) -> SessionData:
+def prepare_session(session, rc) -> SessionData:
     """Counts, validity, e-vectors and the sun position of one session."""
+    from bionav.light import sun_position
     from bionav.polcompass.array import evectors_from_counts
     from bionav.polcompass.recordings import detect_faults, sample_validity
-    from bionav.light import sun_position
 
     rots = session.rotations
     counts = np.concatenate([r.counts for r in rots])
@@ -260,7 +206,7 @@ def decode_session(decoder, data: SessionData):
     return heading, np.asarray(est.resolved, bool), time.perf_counter() - t0
 
 
-def simulate_session(data: SessionData, exp: PolRecordingsConfig, rng) -> SessionData:
+def simulate_session(data: SessionData, exp, rng) -> SessionData:
     """The same sensor, samples and exclusions under bionav's sky model at the session's time and place.
 
     Photodiode counts from :func:`bionav.polcompass.array.stokes_from_sky`
@@ -268,8 +214,8 @@ def simulate_session(data: SessionData, exp: PolRecordingsConfig, rng) -> Sessio
     gain spread, proportional noise and the same saturation; canopy sessions
     get a cloud field of ``sim_canopy_cover``.
     """
-    from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
     from bionav.light import SkyModel, random_cloud_map
+    from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
 
     clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
     model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
@@ -295,6 +241,12 @@ def simulate_session(data: SessionData, exp: PolRecordingsConfig, rng) -> Sessio
 # ---------------------------------------------------------------------------
 # files
 # ---------------------------------------------------------------------------
+def _cell(value):
+    if value is None:
+        return ""
+    return f"{value:.4g}" if isinstance(value, float) else value
+
+
 def _write_csv(path: Path, rows: list[dict]) -> None:
     if not rows:
         path.write_text("")
@@ -306,7 +258,7 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         for r in rows:
-            w.writerow({k: ("" if r.get(k) is None else (f"{r[k]:.4g}" if isinstance(r.get(k), float) else r.get(k))) for k in keys})
+            w.writerow({k: _cell(r.get(k)) for k in keys})
 
 
 def _fmt(v, digits=1):
@@ -352,18 +304,20 @@ def _decoder(ctx, cfg, name):
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     """Entry point called by :func:`bionav.experiments.runner.run_experiment`."""
     from bionav.experiments import pol_recordings_plots as plots
+    from bionav.experiments.configs import experiment_config
     from bionav.polcompass.recordings import load_sessions
 
-    rc = _typed(RecordingsConfig, cfg.get("recordings"), "recordings")
-    exp = _typed(PolRecordingsConfig, {k: v for k, v in OmegaConf.to_container(cfg.experiment, resolve=True).items()
-                                        if k != "name"}, "experiment")
+    rc = recordings_config(cfg)
+    exp = experiment_config(cfg, "pol_recordings")
     if not rc.path:
         raise UserError(
             "experiment=pol_recordings needs recordings.path=DIR, a folder of POL-OP recordings "
             "(e.g. recordings.path=../shared/data/celestial-compass)."
         )
     if cfg.get("decoder") is None or not cfg.decoder.get("name"):
-        raise UserError("experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them).")
+        raise UserError(
+            "experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them)."
+        )
     chosen = str(cfg.decoder.name)
     names = [chosen] + [str(n) for n in exp.compare if str(n) != chosen]
     decoders = {n: _decoder(ctx, cfg, n) for n in names}
@@ -384,7 +338,12 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     n_rotations = 0
     decode_times = []
     for session in ctx.progress(sessions, desc="sessions", total=len(sessions)):
-        data = prepare_session(session, rc)
+        try:
+            data = prepare_session(session, rc)
+        except UserError as exc:  # e.g. a folder name without the recording time: skip that session, keep the rest
+            bad_files.append((Path(session.name), str(exc)))
+            log.warning("%s", exc)
+            continue
         n_rotations += len(session.rotations)
         for f in data.faults:
             row = {"session": session.name, **f.to_dict()}
@@ -440,6 +399,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             session_rows.append(row)
             ctx.log.write(SESSION_TOPIC, row, schema_name="bionav.PolRecordingSession")
 
+    if not session_rows:
+        raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
     pooled_rows = []
     for name in names:
         for g in GROUPS:
@@ -469,8 +430,9 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "heading_rmse_deg": stats["rmse_deg"],
         "n_samples": stats["n_samples"],
         "n_rotations": int(n_rotations),
-        "n_sessions": len(sessions),
+        "n_sessions": len({r["session"] for r in session_rows}),
         "ambiguity_resolved_fraction": float(np.mean(np.concatenate(chosen_res))),
+        "decode_ms_per_session_median": float(1000.0 * np.median(decode_times)),
         "decode_ms_per_session_max": float(1000.0 * max(decode_times)),
         "n_bad_files": len(bad_files),
     }
@@ -486,7 +448,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         listed = " ".join(m for _p, m in bad_files[:3])
         more = f" ({len(bad_files) - 3} more, see the log)" if len(bad_files) > 3 else ""
         raise UserError(
-            f"{len(bad_files)} recording file(s) are unusable; the other {n_rotations} rotations were scored and "
+            f"{len(bad_files)} recording file(s) or session(s) are unusable; the other {n_rotations} rotations were scored and "
             f"sessions.csv is written. {listed}{more} Set recordings.on_bad_file=skip to only warn."
         )
     return metrics

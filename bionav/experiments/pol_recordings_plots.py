@@ -34,8 +34,8 @@ def error_vs_time_of_day(path, session_rows, decoders) -> None:
     twin = ax[0].twinx()
     el = sorted({(_hours(r["time_of_day"]), r["sun_elevation_deg"]) for r in tod})
     if el:
-        twin.plot([e[0] for e in el], [e[1] for e in el], "k.", ms=3, alpha=0.4)
-    twin.set_ylabel("sun elevation (deg), black dots")
+        twin.plot([e[0] for e in el], [e[1] for e in el], "k+", ms=5, alpha=0.6)
+    twin.set_ylabel("sun elevation (deg), black crosses")
     ax[0].legend(fontsize=7, ncol=2)
     save_figure(fig, path, dpi=DPI)
 

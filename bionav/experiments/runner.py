@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import errno
 import importlib
 import json
 import logging
+import os
 import time
 import traceback
 from pathlib import Path
@@ -16,6 +18,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import __version__
 from bionav.errors import UserError
 from bionav.experiments.context import RunContext
+from bionav.experiments.runlock import RunLock
 from bionav.files import write_json_atomic
 from bionav.logs.writer import McapLog
 
@@ -44,7 +47,8 @@ def plugin_versions(cfg: DictConfig) -> dict[str, str]:
     from bionav import registry
 
     out = {"bionav": __version__}
-    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller", "decoder": "decoder"}
+    kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller"}
+    kinds["decoder"] = "decoder"
     for group, kind in kinds.items():
         node = cfg.get(group)
         if not node or not node.get("name"):
@@ -92,9 +96,10 @@ def validate_run_config(cfg: DictConfig) -> None:
     """
     from bionav.config import plugin_config
     from bionav.db.loading import as_database_config
-    from bionav.experiments.configs import check_run_settings, experiment_config
+    from bionav.experiments.configs import check_group_nodes, check_run_settings, experiment_config
 
     check_run_settings(cfg)
+    check_group_nodes(cfg)
     for group, kind in PLUGIN_NODES.items():
         node = cfg.get(group)
         if node and node.get("name"):
@@ -108,7 +113,9 @@ def validate_run_config(cfg: DictConfig) -> None:
 def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True) -> dict[str, Any]:
     """Run ``cfg.experiment.name`` in ``run_dir`` and write metrics.json and run.mcap.
 
-    metrics.json is written atomically with ``"status": "completed"`` on
+    The directory is locked for the run (a second run into it is refused;
+    see :mod:`bionav.experiments.runlock`). metrics.json first says
+    ``"status": "running"``, then, written atomically, ``"completed"`` on
     success, or ``"status": "failed"`` and ``"error"`` on any failure (the
     exception is re-raised); run.mcap is closed properly either way. With
     ``cfg.bionav.resume`` a run directory whose metrics say completed is
@@ -116,18 +123,28 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
     """
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
-    resume = bool(OmegaConf.select(cfg, "bionav.resume", default=False))
-    if resume and is_completed(run_dir):
-        log.info("resume: %s already completed, skipped", run_dir)
-        metrics = read_metrics(run_dir) or {}
-        metrics["resumed"] = True
-        return metrics
+    with RunLock(run_dir):
+        resume = bool(OmegaConf.select(cfg, "bionav.resume", default=False))
+        if resume and is_completed(run_dir):
+            log.info("resume: %s already completed, skipped", run_dir)
+            metrics = read_metrics(run_dir) or {}
+            metrics["resumed"] = True
+            return metrics
+        return _run_locked(cfg, run_dir, show_progress=show_progress)
 
+
+def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[str, Any]:
     name = str(cfg.experiment.name)
     started = time.time()
-    mcap = McapLog(run_dir / LOG_FILE)
     metrics: dict[str, Any] = {"experiment": name}
+    # a SIGKILL from here on leaves metrics.json saying "running" (and since when) next to a readable run.mcap
+    write_json_atomic(run_dir / METRICS_FILE, {
+        **metrics, "status": "running", "started": time.strftime("%Y-%m-%dT%H:%M:%S%z", time.localtime(started)),
+        "pid": os.getpid(),
+    })
+    mcap = None
     try:
+        mcap = McapLog(run_dir / LOG_FILE)
         mcap.attach("config.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode(), media_type="application/yaml")
         mcap.metadata("plugins", plugin_versions(cfg))
         validate_run_config(cfg)
@@ -148,15 +165,58 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
         metrics.update(result or {})
         metrics["status"] = "completed"
     except BaseException as exc:
+        full = disk_full_error(exc, run_dir)
         metrics["status"] = "failed"
-        metrics["error"] = str(exc) if isinstance(exc, UserError) else f"{type(exc).__name__}: {exc}"
-        if not isinstance(exc, (UserError, KeyboardInterrupt)):
-            (run_dir / "error.log").write_text(traceback.format_exc())
+        metrics["error"] = str(full or exc) if isinstance(full or exc, UserError) else f"{type(exc).__name__}: {exc}"
+        if full is None and not isinstance(exc, (UserError, KeyboardInterrupt)):
+            try:
+                (run_dir / "error.log").write_text(traceback.format_exc())
+            except OSError:
+                pass
+        _finish(run_dir, mcap, metrics, started, failing=True)
+        if full is not None:
+            raise full from None
         raise
-    finally:
-        metrics["wall_time_s"] = round(time.time() - started, 3)
+    _finish(run_dir, mcap, metrics, started, failing=False)
+    return metrics
+
+
+def _finish(run_dir: Path, mcap: McapLog | None, metrics: dict[str, Any], started: float, *, failing: bool) -> None:
+    """Close run.mcap and write the final metrics.json; on a failing run, errors here do not hide the first."""
+    metrics["wall_time_s"] = round(time.time() - started, 3)
+    try:
         try:
-            mcap.close()
+            if mcap is not None:
+                mcap.close()
         finally:
             write_json_atomic(run_dir / METRICS_FILE, json_safe(metrics))
-    return metrics
+    except OSError as exc:
+        if failing:
+            return
+        full = disk_full_error(exc, run_dir)
+        if full is not None:
+            raise full from None
+        raise
+
+
+def _mount_point(path: Path) -> Path:
+    path = path.resolve()
+    try:
+        dev = path.stat().st_dev
+        while path != path.parent and path.parent.stat().st_dev == dev:
+            path = path.parent
+    except OSError:
+        pass
+    return path
+
+
+def disk_full_error(exc: BaseException, run_dir: Path) -> UserError | None:
+    """A :class:`UserError` naming the device if ``exc`` means the disk (or quota) is full, else ``None``."""
+    if not (isinstance(exc, OSError) and exc.errno in (errno.ENOSPC, errno.EDQUOT)):
+        return None
+    what = "no space left" if exc.errno == errno.ENOSPC else "disk quota exceeded"
+    return UserError(
+        f"{what} on {_mount_point(run_dir)} (writing {exc.filename or 'the run directory'}); free space or choose "
+        f"hydra.run.dir=... on another disk. What was written before is kept in {run_dir}: metrics.json says failed, "
+        f"and a run.mcap cut short is repaired with `python -m bionav.logs recover {run_dir / LOG_FILE} fixed.mcap`."
+    )

@@ -54,6 +54,7 @@ def main(argv: list[str] | None = None) -> int:
     p_rec = sub.add_parser("recover", help="rewrite a truncated log into a valid, indexed one")
     p_rec.add_argument("input")
     p_rec.add_argument("output")
+    p_rec.add_argument("--force", action="store_true", help="overwrite an existing output file")
     args = parser.parse_args(argv)
     try:
         if args.command == "info":
@@ -61,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             from bionav.logs.recover import recover
 
-            report = recover(args.input, args.output)
+            report = recover(args.input, args.output, overwrite=args.force)
             state = "truncated input" if report.truncated else "intact input"
             print(
                 f"recovered {report.messages} messages on {report.channels} channels, "

@@ -12,9 +12,9 @@ from bionav.errors import UserError
 
 
 def _open(path: str | Path):
-    path = Path(path)
-    if not path.is_file():
-        raise UserError(f"the log file {path} does not exist; pass the path of a run.mcap written by a bionav run.")
+    from bionav.logs.recover import check_mcap
+
+    check_mcap(path)
     return open(path, "rb")
 
 

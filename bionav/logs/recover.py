@@ -24,7 +24,28 @@ class RecoveryReport:
     error: str | None
 
 
-def recover(src: str | Path, dst: str | Path) -> RecoveryReport:
+MAGIC = b"\x89MCAP0\r\n"
+
+
+def check_mcap(path: str | Path) -> None:
+    """Raise :class:`UserError` unless ``path`` is a file starting with the MCAP magic bytes."""
+    path = Path(path)
+    if path.is_dir():
+        raise UserError(f"{path} is a directory, not a log file; pass the run.mcap inside it, "
+                        f"e.g. {path / 'run.mcap'}.")
+    if not path.is_file():
+        raise UserError(f"the log file {path} does not exist; pass the path of a run.mcap written by a bionav run.")
+    try:
+        with open(path, "rb") as f:
+            head = f.read(len(MAGIC))
+    except OSError as exc:
+        raise UserError(f"cannot read {path}: {exc.strerror or exc}.") from None
+    if head != MAGIC:
+        what = "it is empty" if not head else "it does not start with the MCAP magic bytes"
+        raise UserError(f"{path} is not an MCAP file ({what}); pass a run.mcap written by a bionav run.")
+
+
+def recover(src: str | Path, dst: str | Path, *, overwrite: bool = False) -> RecoveryReport:
     """Copy every complete record of a (possibly truncated) MCAP file into a valid, indexed one.
 
     Records are read sequentially until the file ends or a record is cut
@@ -38,12 +59,28 @@ def recover(src: str | Path, dst: str | Path) -> RecoveryReport:
         Damaged (or intact) input file.
     dst : path-like
         Output file; must differ from ``src``.
+    overwrite : bool
+        Replace an existing ``dst`` (refused otherwise: it may be a good log).
+
+    Raises
+    ------
+    UserError
+        When ``src`` is missing, a directory or not an MCAP file, or ``dst``
+        cannot be written.
     """
     src, dst = Path(src), Path(dst)
-    if not src.is_file():
-        raise UserError(f"the log file {src} does not exist; pass the path of the damaged run.mcap.")
+    check_mcap(src)
     if src.resolve() == dst.resolve():
         raise UserError("recover writes a new file: give an output path different from the input.")
+    if dst.is_dir():
+        raise UserError(f"the output {dst} is a directory; give a file name, e.g. {dst / 'fixed.mcap'}.")
+    if dst.exists() and not overwrite:
+        raise UserError(f"the output {dst} exists; recover does not overwrite files (it could be a good log): "
+                        f"choose another name, or pass --force.")
+    try:
+        fout = open(dst, "wb")
+    except OSError as exc:
+        raise UserError(f"cannot write the output {dst}: {exc.strerror or exc}; choose a writable place.") from None
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
     out_schema: dict[int, int] = {}
@@ -51,7 +88,7 @@ def recover(src: str | Path, dst: str | Path) -> RecoveryReport:
     n_msg = n_att = n_meta = 0
     truncated = False
     error = None
-    with open(src, "rb") as fin, open(dst, "wb") as fout:
+    with open(src, "rb") as fin, fout:
         writer = Writer(fout, compression=CompressionType.ZSTD)
         writer.start(profile="bionav", library="bionav recover")
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+import threading
 import time
 from pathlib import Path
 from typing import Any, Mapping
@@ -70,10 +71,13 @@ def to_json_bytes(message: Mapping[str, Any], *, non_finite: str = "null") -> by
 class McapLog:
     """An MCAP log of JSON messages that survives crashes.
 
-    Every ``flush_interval_s`` seconds (checked on each write) the chunk in
-    progress is finished and written, so a crash loses at most the messages of
-    the last interval; :func:`bionav.logs.recover.recover` turns a truncated
-    file into a valid, indexed one.
+    The header, attachments and metadata reach the file (the operating
+    system's cache) at once; messages are collected in a chunk that a
+    background thread writes out every ``flush_interval_s`` seconds, also
+    while the experiment is busy computing and writes nothing. A crash (even
+    SIGKILL) therefore loses at most the messages of the last interval;
+    :func:`bionav.logs.recover.recover` turns the truncated file into a
+    valid, indexed one. All methods are thread-safe.
 
     Parameters
     ----------
@@ -98,6 +102,24 @@ class McapLog:
         self._closed = False
         #: wall-clock time the log was opened (ns since the Unix epoch): simulated time starts here
         self.start_ns = time.time_ns()
+        self._lock = threading.RLock()
+        self._dirty = False
+        self._file.flush()
+        self._stop = threading.Event()
+        self._flusher = threading.Thread(target=self._flush_loop, name=f"mcap-flush {self.path.name}", daemon=True)
+        self._flusher.start()
+
+    def _flush_loop(self) -> None:
+        """Background thread: flush pending messages every interval until closed."""
+        while not self._stop.wait(self._flush_interval / 2):
+            with self._lock:
+                if self._closed:
+                    return
+                if self._dirty and time.monotonic() - self._last_flush >= self._flush_interval:
+                    try:
+                        self.flush()
+                    except OSError:  # reported by the next write or close in the main thread
+                        return
 
     # -- channels -------------------------------------------------------------
     def _channel(self, topic: str, schema_name: str, schema: Mapping[str, Any] | None) -> int:
@@ -151,21 +173,24 @@ class McapLog:
             Log time in nanoseconds since the Unix epoch; now if omitted. Replayed
             and simulated sessions pass their own clock (``start_ns`` plus simulated time).
         """
-        if self._closed:
-            raise RuntimeError(f"the log {self.path} is already closed")
-        channel = self._channel(topic, schema_name, schema)
-        now = time.time_ns()
-        t = now if log_time_ns is None else int(log_time_ns)
-        self._writer.add_message(
-            channel_id=channel,
-            log_time=t,
-            publish_time=t,
-            data=self._encode(topic, schema_name, message),
-            sequence=self._sequence[topic],
-        )
-        self._sequence[topic] += 1
-        if time.monotonic() - self._last_flush >= self._flush_interval:
-            self.flush()
+        data = self._encode(topic, schema_name, message)
+        with self._lock:
+            if self._closed:
+                raise RuntimeError(f"the log {self.path} is already closed")
+            channel = self._channel(topic, schema_name, schema)
+            now = time.time_ns()
+            t = now if log_time_ns is None else int(log_time_ns)
+            self._writer.add_message(
+                channel_id=channel,
+                log_time=t,
+                publish_time=t,
+                data=data,
+                sequence=self._sequence[topic],
+            )
+            self._sequence[topic] += 1
+            self._dirty = True
+            if time.monotonic() - self._last_flush >= self._flush_interval:
+                self.flush()
 
     @staticmethod
     def _encode(topic: str, schema_name: str, message: Mapping[str, Any]) -> bytes:
@@ -182,26 +207,34 @@ class McapLog:
     def attach(self, name: str, data: bytes, *, media_type: str) -> None:
         """Attach a file (e.g. the resolved config as YAML)."""
         t = time.time_ns()
-        self._writer.add_attachment(create_time=t, log_time=t, name=name, media_type=media_type, data=data)
+        with self._lock:
+            self._writer.add_attachment(create_time=t, log_time=t, name=name, media_type=media_type, data=data)
+            self.flush()
 
     def metadata(self, name: str, values: Mapping[str, Any]) -> None:
         """Add a metadata record (string keys and values)."""
-        self._writer.add_metadata(name=name, data={str(k): str(v) for k, v in values.items()})
+        with self._lock:
+            self._writer.add_metadata(name=name, data={str(k): str(v) for k, v in values.items()})
+            self.flush()
 
     def flush(self) -> None:
-        """Write the chunk in progress to disk now."""
-        self._writer.flush()
-        self._last_flush = time.monotonic()
+        """Write the chunk in progress to the file now (not fsync'ed: survives a crash, not a power cut)."""
+        with self._lock:
+            self._writer.flush()
+            self._last_flush = time.monotonic()
+            self._dirty = False
 
     def close(self) -> None:
         """Finish the file: write the summary and index. Safe to call twice."""
-        if self._closed:
-            return
-        self._closed = True
-        try:
-            self._writer.finish()
-        finally:
-            self._file.close()
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            self._stop.set()
+            try:
+                self._writer.finish()
+            finally:
+                self._file.close()
 
     def __enter__(self) -> "McapLog":
         return self

@@ -166,7 +166,8 @@ def sky_table(array: PolArray, sun_elevation: float, *, n_grid: int = 720, max_d
 def sun_directions(azimuths, elevation):
     """Unit sun vectors in the sensor frame for solar azimuths (sensor frame) at one elevation, shape ``(G, 3)``."""
     az = np.asarray(azimuths, float)
-    return np.stack([np.cos(elevation) * np.cos(az), np.cos(elevation) * np.sin(az), np.full(az.shape, np.sin(elevation))], axis=-1)
+    ce = np.cos(elevation)
+    return np.stack([ce * np.cos(az), ce * np.sin(az), np.full(az.shape, np.sin(elevation))], axis=-1)
 
 
 def _pick_pair(score, azimuths, total, margin):
@@ -402,7 +403,7 @@ def _ring_fit(values, valid, azimuths, grid, n_harmonics):
     return coef @ basis(grid).T  # (N, G)
 
 
-def sun_from_four_zeros(ev: UnitEvectors, valid, *, array: PolArray, n_harmonics: int = 3, n_grid: int = 720) -> SunEstimate:
+def sun_from_four_zeros(ev: UnitEvectors, valid, *, array: PolArray, n_harmonics: int = 3, n_grid: int = 360) -> SunEstimate:
     """Four-zeros method (see the module docstring).
 
     ``cos 2 chi`` (``chi`` = e-vector angle from the unit's meridian, the unit

@@ -34,11 +34,16 @@ def flatten(metrics: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
+def _cell(text: str) -> str:
+    """Markdown table cell text: ``|`` escaped, line breaks as ``<br>`` (an error message stays in its cell)."""
+    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\r\n", "\n").replace("\n", "<br>")
+
+
 def markdown_table(rows: Sequence[Mapping[str, Any]], columns: Sequence[str]) -> str:
-    """A GitHub-flavoured Markdown table."""
-    head = "| " + " | ".join(columns) + " |"
+    """A GitHub-flavoured Markdown table (cells with ``|`` or line breaks escaped)."""
+    head = "| " + " | ".join(_cell(str(c)) for c in columns) + " |"
     sep = "|" + "|".join("---" for _ in columns) + "|"
-    body = ["| " + " | ".join(fmt(r.get(c)) for c in columns) + " |" for r in rows]
+    body = ["| " + " | ".join(_cell(fmt(r.get(c))) for c in columns) + " |" for r in rows]
     return "\n".join([head, sep, *body])
 
 

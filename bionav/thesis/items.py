@@ -481,6 +481,10 @@ class _Fig55:
                 res = ctx.result(specs[e * len(sizes) + i])
                 if not res.ok:
                     out.missing.append(f"{s[0]}x{s[1]} {eq}: {why_missing(res)}")
+                    for r in range(2):
+                        axes[2 * e + r, i].text(0.5, 0.5, f"{s[0]}x{s[1]}, {eq}:\nno completed run", ha="center",
+                                                va="center", transform=axes[2 * e + r, i].transAxes)
+                        axes[2 * e + r, i].set_axis_off()
                     continue
                 aae[e, i], rr[e, i] = res.metrics["aae"], res.metrics["rr"]
                 out.rows.append(Row(f"AAE* {s[0]}x{s[1]} {eq}", None, aae[e, i]))
@@ -494,6 +498,8 @@ class _Fig55:
                     ax = axes[2 * e + r, i]
                     im = ax.imshow(grid, origin="lower", cmap="viridis", vmin=0, vmax=1 if col == 3 else None)
                     ax.set_title(f"{lab}, {s[0]}x{s[1]}, {eq}", fontsize=8)
+                    ax.set_xlabel("x (grid)", fontsize=7)
+                    ax.set_ylabel("y (grid)", fontsize=7)
                     fig.colorbar(im, ax=ax, shrink=0.7)
         fig.suptitle("SIFT homing on sim_original: per-snapshot AAE_s and RR_s (thesis fig. 5.5)", fontsize=9)
         save_figure(fig, ctx.figure("fig5_5.png"), dpi=90)

@@ -340,6 +340,12 @@ class Runner:
                 self.echo(f"python {cmd}")
                 results[spec.key] = RunResult(spec, None, None, "dry run")
                 continue
+            done = index_runs(self.out / "runs" / spec.group).get(spec.key)  # finished meanwhile by another invocation
+            if done is not None:
+                metrics = _sweep_metrics(done) if spec.multirun else read_json(done / "metrics.json")
+                results[spec.key] = RunResult(spec, done, metrics, reused=True)
+                self.echo(f"[{i}/{len(todo)}] completed meanwhile: {done}")
+                continue
             self.echo(f"[{i}/{len(todo)}] python {cmd}")
             res = execute_local(spec, self.out, env=self.env)
             self.echo(f"    {'done' if res.ok else 'FAILED: ' + str(res.error)} in {res.seconds:.0f} s "

@@ -1,7 +1,7 @@
 """The contract of ``bionav.decoders`` plugins.
 
-A decoder plugin is a class with a typed ``Config`` dataclass (validated where
-values enter, with ranges), constructed as ``Plugin(config)``, whose
+A decoder plugin is a class with a typed ``Config`` dataclass (ranges declared
+with :func:`bionav.validation.bounded`, checked where values enter), constructed as ``Plugin(config)``, whose
 :meth:`Decoder.decode` turns the e-vectors the units of an array read at each
 sample into the solar azimuth in the sensor frame
 (:class:`bionav.polcompass.decoders.SunEstimate`). A decoder sees one sample
@@ -11,16 +11,6 @@ at a time (vectorised over samples): no information from other samples.
 from __future__ import annotations
 
 from typing import ClassVar
-
-from bionav.errors import UserError
-
-
-def check_range(name: str, value, lo=None, hi=None, *, prefix: str = "decoder") -> None:
-    """Raise a :class:`UserError` naming ``prefix.name`` and its allowed range when ``value`` is outside."""
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        lo_s = "-inf" if lo is None else f"{lo:g}"
-        hi_s = "inf" if hi is None else f"{hi:g}"
-        raise UserError(f"{prefix}.{name}={value!r} is out of range; allowed: [{lo_s}, {hi_s}].")
 
 
 class Decoder:

@@ -9,24 +9,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.errors import UserError
-from bionav.plugins.decoders.base import Decoder, check_range
+from bionav.plugins.decoders.base import Decoder
 from bionav.polcompass.decoders import sun_from_eigenvector, sun_from_four_zeros, sun_from_mean_vector, sun_from_sol
+from bionav.validation import bounded
 
 
 @dataclass
 class SolConfig:
-    """Parameters of ``decoder=sol`` (Gkanias et al. 2019 / 2023)."""
+    """Parameters of ``decoder=sol`` (Gkanias et al. 2019 / 2023).
 
-    n_sol: int = 8  # SOL neurons, [3, 360]
-    response: str = "c"  # per-unit response: p (polarization), i (intensity), c = i - p
-    analyser_deg: float = 90.0  # analyser of the POL response in the unit frame (90: horizontal), [-180, 180]
+    n_sol : SOL neurons. response : per-unit response ``p`` (polarization), ``i`` (intensity) or
+    ``c = i - p``. analyser_deg : analyser of the POL response in the unit frame (90: horizontal).
+    """
 
-    def __post_init__(self):
-        check_range("n_sol", self.n_sol, 3, 360)
-        check_range("analyser_deg", self.analyser_deg, -180.0, 180.0)
-        if self.response not in ("p", "i", "c"):
-            raise UserError(f"decoder.response={self.response!r} is unknown; choose p, i or c.")
+    n_sol: int = bounded(8, ge=3, le=360)
+    response: str = bounded("c", choices=("p", "i", "c"))
+    analyser_deg: float = bounded(90.0, ge=-180.0, le=180.0)
 
 
 class Sol(Decoder):
@@ -41,7 +39,10 @@ class Sol(Decoder):
 
 @dataclass
 class FourZerosConfig:
-    """``decoder=four_zeros`` has no parameters."""
+    """Parameters of ``decoder=four_zeros``: harmonics of the ring interpolation, azimuth grid."""
+
+    n_harmonics: int = bounded(3, ge=1, le=3)
+    n_grid: int = bounded(360, ge=36, le=7200)
 
 
 class FourZeros(Decoder):
@@ -50,17 +51,15 @@ class FourZeros(Decoder):
     Config = FourZerosConfig
 
     def decode(self, evectors, valid, *, array, sun_elevation: float):
-        return sun_from_four_zeros(evectors, valid, array=array)
+        return sun_from_four_zeros(evectors, valid, array=array, n_harmonics=self.config.n_harmonics,
+                                   n_grid=self.config.n_grid)
 
 
 @dataclass
 class VectorConfig:
-    """Parameters of ``decoder=eigenvector`` / ``mean_vector``."""
+    """Parameters of ``decoder=eigenvector`` / ``mean_vector``: sun elevation (deg) for a resolved sign."""
 
-    margin_deg: float = 2.0  # sun elevation needed for a resolved sign (above the horizon), degrees, [0, 90]
-
-    def __post_init__(self):
-        check_range("margin_deg", self.margin_deg, 0.0, 90.0)
+    margin_deg: float = bounded(2.0, ge=0.0, le=90.0)
 
 
 class Eigenvector(Decoder):

@@ -6,34 +6,32 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.errors import UserError
-from bionav.plugins.decoders.base import Decoder, check_range
+from bionav.plugins.decoders.base import Decoder
 from bionav.polcompass.decoders import sky_table, sun_from_sky_fit, sun_from_two_units
+from bionav.validation import bounded
 
 
 @dataclass
 class SkyFitConfig:
-    """Parameters of ``decoder=sky_fit``."""
+    """Parameters of ``decoder=sky_fit``.
 
-    residual: str = "perpendicular"  # perpendicular (e-vectors perpendicular to the sun) | angle (model e-vector angles)
-    n_grid: int = 720  # solar azimuths tried (then refined), [36, 7200]
-    weight_power: float = 1.0  # unit weight = measured degree ** weight_power, [0, 4]
-    robust_iterations: int = 2  # Cauchy re-weighting rounds, [0, 10]
-    robust_scale_deg: float = 10.0  # residual scale of the re-weighting, degrees, (0, 90]
-    margin: float = 0.01  # normalised error gap for a resolved eq. 4.6 pair, [0, 1]
-    max_degree: float = 0.76  # sky model's maximum degree (only the pattern's angles matter), (0, 1]
-    neutral_point_separation_deg: float = 0.0  # 0: Rayleigh; >0: Berry et al. 2004, [0, 60]
+    residual : ``perpendicular`` (every e-vector perpendicular to the sun, elevation from time and
+        place) or ``angle`` (the tabulated model e-vector angles of any sky model).
+    n_grid : solar azimuths tried, then refined by a parabola.
+    weight_power : unit weight = measured degree ** weight_power.
+    robust_iterations, robust_scale_deg : Cauchy re-weighting rounds and their residual scale.
+    margin : normalised error gap for a resolved eq. 4.6 pair (else the brighter side decides).
+    max_degree, neutral_point_separation_deg : the sky model of ``residual=angle`` (0: Rayleigh).
+    """
 
-    def __post_init__(self):
-        if self.residual not in ("perpendicular", "angle"):
-            raise UserError(f"decoder.residual={self.residual!r} is unknown; choose perpendicular or angle.")
-        check_range("n_grid", self.n_grid, 36, 7200)
-        check_range("robust_iterations", self.robust_iterations, 0, 10)
-        check_range("robust_scale_deg", self.robust_scale_deg, 1e-6, 90.0)
-        check_range("weight_power", self.weight_power, 0.0, 4.0)
-        check_range("margin", self.margin, 0.0, 1.0)
-        check_range("max_degree", self.max_degree, 1e-6, 1.0)
-        check_range("neutral_point_separation_deg", self.neutral_point_separation_deg, 0.0, 60.0)
+    residual: str = bounded("perpendicular", choices=("perpendicular", "angle"))
+    n_grid: int = bounded(720, ge=36, le=7200)
+    weight_power: float = bounded(1.0, ge=0.0, le=4.0)
+    robust_iterations: int = bounded(2, ge=0, le=10)
+    robust_scale_deg: float = bounded(10.0, gt=0.0, le=90.0)
+    margin: float = bounded(0.01, ge=0.0, le=1.0)
+    max_degree: float = bounded(0.76, gt=0.0, le=1.0)
+    neutral_point_separation_deg: float = bounded(0.0, ge=0.0, le=60.0)
 
 
 class SkyFit(Decoder):
@@ -75,12 +73,9 @@ class SkyFit(Decoder):
 
 @dataclass
 class TwoUnitConfig:
-    """Parameters of ``decoder=two_unit``."""
+    """Parameters of ``decoder=two_unit``: elevation-error gap (degrees) for a resolved eq. 4.6 pair."""
 
-    margin_deg: float = 2.0  # elevation-error gap for a resolved eq. 4.6 pair, degrees, [0, 90]
-
-    def __post_init__(self):
-        check_range("margin_deg", self.margin_deg, 0.0, 90.0)
+    margin_deg: float = bounded(2.0, ge=0.0, le=90.0)
 
 
 class TwoUnit(Decoder):

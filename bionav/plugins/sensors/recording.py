@@ -10,12 +10,13 @@ unit by unit in file order). Experiments record these readings to
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from bionav.errors import UserError
 from bionav.plugins.sensors.base import SensorPlugin
+from bionav.validation import Range, bounded
 
 READING_SCHEMA = {
     "type": "object",
@@ -34,29 +35,26 @@ READING_SCHEMA = {
 
 @dataclass
 class RecordingConfig:
-    """Parameters of ``sensor=recording``."""
+    """Parameters of ``sensor=recording``.
 
-    path: str = ""  # a rotation file <n>.json or a session folder
-    photodiodes: int = 4  # photodiodes per unit in the files, [1, 16]
-    loop: bool = False  # start again at the end instead of stopping
-    # how the array reads (used by experiment=pol_compass mode=rotation on recorded counts)
-    tilt_deg: float = 45.0  # zenith angle of the units, [0, 90]
-    azimuth_sign: float = -1.0  # file azimuths clockwise (-1) or counter-clockwise (+1)
-    photodiode_angles_deg: list = field(default_factory=lambda: [-45.0, 45.0, 0.0, 90.0])
-    pairs: list = field(default_factory=lambda: [[2, 3], [1, 0]])
-    saturation_counts: float = 11000.0  # (0, inf)
-    dark_counts: float = 5.0  # [0, inf)
-    imbalance_decades: float = 0.15  # (0, 3]
+    path : a rotation file ``<n>.json`` or a session folder. photodiodes : per unit in the files.
+    loop : start again at the end instead of stopping.
+    How the array reads (used by ``experiment=pol_compass mode=rotation`` on recorded counts; the
+    same keys as ``recordings.*`` of ``experiment=pol_recordings``): tilt_deg, azimuth_sign (-1:
+    file azimuths clockwise), photodiode_angles_deg (unit frame, file order), pairs (POL-OPs),
+    saturation_counts, dark_counts, imbalance_decades.
+    """
 
-    def __post_init__(self):
-        if not 1 <= self.photodiodes <= 16:
-            raise UserError(f"sensor.photodiodes={self.photodiodes} is out of range; allowed: [1, 16].")
-        if not 0.0 <= self.tilt_deg <= 90.0:
-            raise UserError(f"sensor.tilt_deg={self.tilt_deg} is out of range; allowed: [0, 90].")
-        if self.azimuth_sign not in (-1.0, 1.0):
-            raise UserError(f"sensor.azimuth_sign={self.azimuth_sign} must be -1 (clockwise) or 1 (counter-clockwise).")
-        if self.saturation_counts <= 0 or self.dark_counts < 0 or not 0 < self.imbalance_decades <= 3:
-            raise UserError("sensor.saturation_counts must be > 0, sensor.dark_counts >= 0 and sensor.imbalance_decades in (0, 3].")
+    path: str = ""
+    photodiodes: int = bounded(4, ge=1, le=16)
+    loop: bool = False
+    tilt_deg: float = bounded(45.0, ge=0.0, le=90.0)
+    azimuth_sign: float = bounded(-1.0, choices=(-1.0, 1.0))
+    photodiode_angles_deg: list[float] = bounded([-45.0, 45.0, 0.0, 90.0], length=(1, 16), item=Range(ge=-360.0, le=360.0))
+    pairs: list[list[int]] = bounded([[2, 3], [1, 0]], length=(1, 8), item=Range(length=2, item=Range(ge=0, le=15)))
+    saturation_counts: float = bounded(11000.0, gt=0.0, le=1e12)
+    dark_counts: float = bounded(5.0, ge=0.0, le=1e12)
+    imbalance_decades: float = bounded(0.15, gt=0.0, le=3.0)
 
 
 class Recording(SensorPlugin):

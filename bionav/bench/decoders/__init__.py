@@ -1,0 +1,1 @@
+"""Decoding speed of the POL-OP decoders: ``python -m bionav.bench.decoders``."""

@@ -1,0 +1,394 @@
+"""``experiment=route_homing``: following real ant routes in a mesh world (Seville 2009 by default).
+
+For every route (``experiment.routes``, default the ``db.route``) the
+snapshots are the views along the route every ``db.step_m`` metres at the
+ant's recorded heading (:func:`bionav.db.mesh.route_database`). Methods
+(``experiment.methods``):
+
+* ``perfect_memory`` -- RIDF against every snapshot, head where the best
+  rotation points (Baddeley et al. 2012, doi:10.1371/journal.pcbi.1002336);
+* ``windowed`` -- the same against the snapshots in a window ahead of the last
+  best match (sequential perfect memory; open loop: around the true index);
+* ``zernike`` -- perfect memory on Zernike-moment amplitudes (rotation
+  invariant: one comparison per snapshot), heading from the phases of the best
+  snapshot's moments (Sun, Yue & Mangan 2020, doi:10.7554/eLife.54026;
+  :mod:`bionav.homing.signatures.zernike`);
+* ``homing`` -- the configured ``homing=`` method as a route follower: home
+  to the snapshot ``lookahead`` views after the current best match (progress
+  tracked by windowed RIDF); the agent's view is aligned with that snapshot
+  (a perfect compass), test-step methods get views at ``+-test_step_m``.
+
+Measures (all angles radians, distances metres):
+
+* open loop, at every ``test_stride``-th route view and each lateral offset of
+  ``offsets_m`` (left positive): heading error -- RIDF methods against the
+  recorded route heading at that route point (as BoB/navbench), homing
+  against the true direction to its target snapshot; ``catchment_width_m``:
+  mean over route points of the lateral extent with errors below
+  ``error_threshold_deg`` (:func:`bionav.evaluation.route.catchment_width`);
+* closed loop, from the route start displaced ``start_offset_m`` to the left:
+  steps of ``agent_step_m``; ``completed`` when within ``success_radius_m`` of
+  the route's end, given up beyond ``give_up_m`` from the route or after
+  ``max_steps_factor`` x route length / step; ``route_distance_m`` = mean
+  distance of the path from the route.
+
+Writes metrics.json (``<measure>_<method>``: ``heading_error``,
+``catchment_width_m``, ``completed``, ``route_distance_m``, each the mean over
+routes), ``route_homing.csv`` (one row per route and method), run.mcap
+(agent paths) and plots/ (world from above with routes and paths, headings
+along each route, heading-error maps).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import zlib
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from bionav.errors import UserError
+from bionav.geometry import angular_difference, wrap_angle
+
+METHODS = ("perfect_memory", "windowed", "zernike", "homing")
+PATH_TOPIC = "/route_homing/agent_path"
+PATH_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "route": {"type": "string"},
+        "method": {"type": "string"},
+        "xy": {"type": "array", "description": "agent positions (x, y) in metres, world frame"},
+        "completed": {"type": "boolean"},
+    },
+}
+
+
+@dataclass
+class RouteHomingConfig:
+    """Typed ``experiment.*`` of ``route_homing`` (ranges checked by :meth:`validate`).
+
+    routes : route names (``Ant<a>_Route<r>``); empty = ``db.route``.
+    methods : subset of ``perfect_memory``, ``windowed``, ``zernike``, ``homing``.
+    offsets_m : lateral offsets of the open-loop test points, metres in [-5, 5]; must include 0.
+    test_stride : every k-th route view is a test point, k >= 1.
+    error_threshold_deg : catchment threshold, (0, 180].
+    window : snapshots ahead of the last match searched by ``windowed``, >= 1.
+    lookahead : ``homing`` targets the snapshot this many views ahead, >= 1.
+    test_step_m : test-step length of ``uses_test_steps`` methods, (0, 1] m.
+    closed_loop : run the simulated agent.
+    start_offset_m : lateral displacement of the agent's start, [-5, 5] m.
+    agent_step_m : agent step, (0, 1] m.
+    success_radius_m : route completed within this distance of its end, (0, 5] m.
+    give_up_m : agent lost beyond this distance from the route, (0, 20] m.
+    max_steps_factor : step budget = factor x route length / step, [1, 20].
+    zernike_order : highest moment order of the ``zernike`` method, 1..40.
+    plots : write plots/.
+    """
+
+    name: str = "route_homing"
+    routes: list[str] = field(default_factory=list)
+    methods: list[str] = field(default_factory=lambda: list(METHODS))
+    offsets_m: list[float] = field(default_factory=lambda: [-0.4, -0.2, -0.1, 0.0, 0.1, 0.2, 0.4])
+    test_stride: int = 5
+    error_threshold_deg: float = 45.0
+    window: int = 10
+    lookahead: int = 2
+    test_step_m: float = 0.05
+    closed_loop: bool = True
+    start_offset_m: float = 0.2
+    agent_step_m: float = 0.05
+    success_radius_m: float = 0.2
+    give_up_m: float = 1.0
+    max_steps_factor: float = 2.0
+    zernike_order: int = 16
+    plots: bool = True
+
+    def validate(self) -> "RouteHomingConfig":
+        def bad(key, value, rng):
+            raise UserError(f"experiment.{key}={value} is out of range: it must lie in {rng}.")
+
+        unknown = [m for m in self.methods if m not in METHODS]
+        if unknown or not self.methods:
+            raise UserError(f"experiment.methods={list(self.methods)}: choose one or more of {', '.join(METHODS)}.")
+        if not self.offsets_m or 0.0 not in [float(v) for v in self.offsets_m]:
+            raise UserError(f"experiment.offsets_m={list(self.offsets_m)} must include 0 (the route itself).")
+        if any(abs(float(v)) > 5 for v in self.offsets_m):
+            bad("offsets_m", list(self.offsets_m), "[-5, 5] metres")
+        checks = [("test_stride", self.test_stride, 1, 10_000, "1..10000"),
+                  ("error_threshold_deg", self.error_threshold_deg, 1e-9, 180, "(0, 180]"),
+                  ("window", self.window, 1, 10_000, "1..10000"),
+                  ("lookahead", self.lookahead, 1, 1000, "1..1000"),
+                  ("test_step_m", self.test_step_m, 1e-9, 1, "(0, 1] metres"),
+                  ("start_offset_m", self.start_offset_m, -5, 5, "[-5, 5] metres"),
+                  ("agent_step_m", self.agent_step_m, 1e-9, 1, "(0, 1] metres"),
+                  ("success_radius_m", self.success_radius_m, 1e-9, 5, "(0, 5] metres"),
+                  ("give_up_m", self.give_up_m, 1e-9, 20, "(0, 20] metres"),
+                  ("max_steps_factor", self.max_steps_factor, 1, 20, "[1, 20]"),
+                  ("zernike_order", self.zernike_order, 1, 40, "1..40")]
+        for key, value, lo, hi, text in checks:
+            if not lo <= float(value) <= hi:
+                bad(key, value, text)
+        return self
+
+
+def route_homing_config(node) -> RouteHomingConfig:
+    """:class:`RouteHomingConfig` from the ``experiment`` node (unknown keys and bad types named)."""
+    from omegaconf.errors import OmegaConfBaseException
+
+    try:
+        data = OmegaConf.to_container(node, resolve=True) if OmegaConf.is_config(node) else dict(node)
+        merged = OmegaConf.merge(OmegaConf.structured(RouteHomingConfig), data)
+        cfg = OmegaConf.to_object(merged)
+    except OmegaConfBaseException as exc:
+        key = getattr(exc, "full_key", None) or "a value"
+        raise UserError(f"invalid experiment.{key} for route_homing: {str(exc).splitlines()[0]} "
+                        "(see RouteHomingConfig in bionav/experiments/route_homing.py).") from None
+    return cfg.validate()
+
+
+@dataclass
+class _RouteSetup:
+    name: str
+    world: Any
+    db: Any  # ImageDatabase of the snapshots
+    xy: np.ndarray  # (K, 2) snapshot positions
+    heading: np.ndarray  # (K,)
+    dense_xy: np.ndarray  # the full recorded route, metres
+    height: float
+    geometry: Any
+    noise: float
+
+
+class _Follower:
+    """Per-route state of one method: snapshots prepared once."""
+
+    def __init__(self, method: str, setup: _RouteSetup, exp: RouteHomingConfig, homing=None):
+        self.method = method
+        self.s = setup
+        self.exp = exp
+        self.homing = homing
+        self.snaps = setup.db.images
+        self.prepared = None
+        if method == "homing":
+            self.prepared = [homing.prepare(img) for img in setup.db.images]
+        if method == "zernike":
+            from bionav.plugins.signatures.zernike import Zernike
+
+            self.zernike = Zernike({"order": exp.zernike_order})
+            self.moments = np.array([self.zernike.moments(img)[0] for img in setup.db.images])
+            self.zindex = self.zernike.moments(setup.db.images[0])[1]
+
+    def zernike_heading(self, view0, lo: int = 0, hi: int | None = None):
+        """Best snapshot by moment amplitudes; heading from the phases (view0 looks along heading 0)."""
+        from bionav.homing.signatures.zernike import rotation_from_moments
+
+        hi = len(self.moments) if hi is None else hi
+        zc = self.zernike.moments(view0)[0]
+        d = ((np.abs(self.moments[lo:hi]) - np.abs(zc)[None]) ** 2).sum(axis=1)
+        k = lo + int(np.argmin(d))
+        delta = rotation_from_moments(zc, self.moments[k], self.zindex)  # heading(view0) - heading(snapshot k)
+        return float(wrap_angle(-delta)), k
+
+    def ridf_heading(self, view0, lo: int = 0, hi: int | None = None):
+        from bionav.evaluation.route import best_match
+
+        hi = len(self.snaps) if hi is None else hi
+        h, k, d = best_match(view0, self.snaps[lo:hi], snapshot_headings=self.s.heading[lo:hi])
+        return h, lo + k
+
+    def window_of(self, k_last: int, centred: bool):
+        w = self.exp.window
+        if centred:
+            return max(0, k_last - w // 2), min(len(self.snaps), k_last + w // 2 + 1)
+        return max(0, k_last - 1), min(len(self.snaps), k_last + w + 1)
+
+    def home_direction(self, render, pos, target: int):
+        """World direction from ``pos`` to snapshot ``target`` by the homing method (NaN if none)."""
+        h_t = float(self.s.heading[target])
+        cur = render(pos, h_t)
+        neighbours = None
+        if getattr(self.homing, "uses_test_steps", False):
+            neighbours = {}
+            c, s = math.cos(h_t), math.sin(h_t)
+            for d in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+                step = self.exp.test_step_m
+                p = (pos[0] + step * (c * d[0] - s * d[1]), pos[1] + step * (s * d[0] + c * d[1]))
+                neighbours[d] = self.homing.prepare(render(p, h_t))
+        hv = self.homing.home_vector(self.prepared[target], self.homing.prepare(cur), neighbours=neighbours)
+        return float(wrap_angle(hv.angle + h_t)) if hv.valid else float("nan")
+
+
+def _make_renderer(setup: _RouteSetup, rng: np.random.Generator):
+    from bionav.db.synthetic import quantise
+    from bionav.world.mesh_render import render_mesh_panorama
+
+    def render(xy, heading):
+        z = float(setup.world.terrain_height(np.array([xy]))[0])
+        z = (setup.world.ground_z if not np.isfinite(z) else z) + setup.height
+        img = render_mesh_panorama(setup.world, position=(xy[0], xy[1], z), heading=heading, geometry=setup.geometry)
+        img = quantise(img, noise=setup.noise, rng=rng).astype(np.float32) / np.float32(255.0)
+        return img[..., 0] if img.shape[-1] == 1 else img
+
+    return render
+
+
+def open_loop(f: _Follower, render, exp: RouteHomingConfig, progress=None):
+    """Heading errors at test points offset from the route: ``(stations (N,), errors (N, M), estimates (N, M))``."""
+    from bionav.evaluation.route import lateral_normals
+
+    s = f.s
+    stations = np.arange(0, len(s.xy), exp.test_stride)
+    offsets = np.asarray(exp.offsets_m, np.float64)
+    normals = lateral_normals(s.heading)
+    err = np.full((len(stations), len(offsets)), np.nan)
+    est = np.full_like(err, np.nan)
+    it = range(len(stations)) if progress is None else progress(range(len(stations)))
+    for a in it:
+        i = int(stations[a])
+        for b, off in enumerate(offsets):
+            p = s.xy[i] + off * normals[i]
+            if f.method == "homing":
+                target = min(i + exp.lookahead, len(s.xy) - 1)
+                truth = math.atan2(s.xy[target, 1] - p[1], s.xy[target, 0] - p[0])
+                h = f.home_direction(render, p, target)
+            else:
+                truth = float(s.heading[i])
+                view0 = render(p, 0.0)
+                if f.method == "zernike":
+                    h, _k = f.zernike_heading(view0)
+                else:
+                    lo, hi = (0, None) if f.method == "perfect_memory" else f.window_of(i, centred=True)
+                    h, _k = f.ridf_heading(view0, lo, hi)
+            est[a, b] = h
+            err[a, b] = angular_difference(h, truth) if np.isfinite(h) else np.nan
+    return stations, err, est
+
+
+def closed_loop(f: _Follower, render, exp: RouteHomingConfig):
+    """Simulated agent from the displaced start; returns ``(path (T, 2), completed, mean distance)``."""
+    from bionav.evaluation.route import distance_to_route, lateral_normals
+
+    s = f.s
+    pos = s.xy[0] + exp.start_offset_m * lateral_normals(s.heading[:1])[0]
+    end = s.dense_xy[-1]
+    length = float(np.linalg.norm(np.diff(s.dense_xy, axis=0), axis=1).sum())
+    max_steps = int(math.ceil(exp.max_steps_factor * length / exp.agent_step_m))
+    path = [pos.copy()]
+    k_last = 0
+    heading = float(s.heading[0])
+    completed = False
+    for _ in range(max_steps):
+        if f.method == "perfect_memory":
+            heading, k_last = f.ridf_heading(render(pos, 0.0))
+        elif f.method == "zernike":
+            heading, k_last = f.zernike_heading(render(pos, 0.0))
+        elif f.method == "windowed":
+            lo, hi = f.window_of(k_last, centred=False)
+            heading, k_last = f.ridf_heading(render(pos, 0.0), lo, hi)
+        else:
+            lo, hi = f.window_of(k_last, centred=False)
+            _h, k_last = f.ridf_heading(render(pos, 0.0), lo, hi)
+            h = f.home_direction(render, pos, min(k_last + exp.lookahead, len(s.xy) - 1))
+            if np.isfinite(h):
+                heading = h
+        pos = pos + exp.agent_step_m * np.array([math.cos(heading), math.sin(heading)])
+        path.append(pos.copy())
+        if np.linalg.norm(pos - end) <= exp.success_radius_m:
+            completed = True
+            break
+        if distance_to_route(pos[None], s.dense_xy)[0][0] > exp.give_up_m:
+            break
+    path = np.array(path)
+    dist = distance_to_route(path, s.dense_xy)[0]
+    return path, completed, float(dist.mean())
+
+
+def _setup_route(cfg: DictConfig, name: str) -> _RouteSetup:
+    from bionav.db.loading import as_database_config
+    from bionav.db.mesh import MeshDatabaseSpec, load_route, route_database, world_from_spec
+
+    node = OmegaConf.to_container(cfg.db, resolve=True)
+    if node.get("source") != "route":
+        raise UserError(f"experiment=route_homing needs a route database (db=seville_route), not db={node.get('name')}.")
+    node["route"] = name
+    dbc = as_database_config(node)
+    spec = MeshDatabaseSpec.from_config(dbc, grid=False)
+    db = route_database(dbc, cache_dir=str(cfg.cache_dir))
+    world = world_from_spec(spec)
+    dense = load_route(name, dbc.routes_path).xy
+    return _RouteSetup(name, world, db, np.asarray(db.meta["world_xy"]), np.asarray(db.headings), dense,
+                       spec.camera_height_m, db.geometry, spec.noise)
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    from bionav.experiments.common import make_homing
+
+    exp = route_homing_config(cfg.experiment)
+    routes = list(exp.routes) or [str(cfg.db.route)]
+    rows = []
+    per_route = {}
+    for name in routes:
+        setup = _setup_route(cfg, name)
+        homing = make_homing(cfg, ctx, setup.geometry) if "homing" in exp.methods else None
+        per_route[name] = {"setup": setup, "results": {}}
+        for method in exp.methods:
+            key = zlib.crc32(f"{name}/{method}".encode())  # camera noise per route and method, whatever the order
+            rng = np.random.default_rng(np.random.SeedSequence([int(cfg.get("seed", 0)), key]))
+            render = _make_renderer(setup, rng)
+            f = _Follower(method, setup, exp, homing)
+            stations, err, est = open_loop(f, render, exp, progress=lambda it, n=name, m=method: ctx.progress(
+                it, desc=f"{n} {m} open loop"))
+            from bionav.evaluation.route import catchment_width
+
+            width = catchment_width(np.asarray(exp.offsets_m), err, threshold=np.deg2rad(exp.error_threshold_deg))
+            row = {"route": name, "method": method, "n_snapshots": len(setup.xy),
+                   "heading_error": float(np.nanmean(err)) if np.isfinite(err).any() else float("nan"),
+                   "heading_error_on_route": float(np.nanmean(err[:, list(exp.offsets_m).index(0.0)])),
+                   "catchment_width_m": float(width.mean()), "invalid": int(np.isnan(err).sum())}
+            res = {"stations": stations, "err": err, "est": est}
+            if exp.closed_loop:
+                path, completed, dist = closed_loop(f, render, exp)
+                row.update({"completed": bool(completed), "route_distance_m": dist, "steps": len(path) - 1})
+                res["path"] = path
+                ctx.log.write(PATH_TOPIC, {"route": name, "method": method, "xy": path.tolist(),
+                                           "completed": bool(completed)},
+                              schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
+            per_route[name]["results"][method] = res
+            rows.append(row)
+    _write_csv(ctx.dir / "route_homing.csv", rows)
+    if exp.plots:
+        from bionav.experiments.route_plots import plot_error_maps, plot_headings, plot_world_routes
+
+        setups = [v["setup"] for v in per_route.values()]
+        paths = {(r, m): v["results"][m].get("path") for r, v in per_route.items() for m in v["results"]}
+        plot_world_routes(ctx.plots / "world_routes.png", setups[0].world, setups, paths)
+        for r, v in per_route.items():
+            plot_headings(ctx.plots / f"headings_{r}.png", v["setup"], v["results"], exp.offsets_m)
+            plot_error_maps(ctx.plots / f"error_map_{r}.png", v["setup"], v["results"], exp.offsets_m)
+    metrics: dict[str, Any] = {"db": str(cfg.db.name), "routes": routes, "n_routes": len(routes),
+                               "homing": str(cfg.homing.name) if "homing" in exp.methods else None}
+    for method in exp.methods:
+        mine = [r for r in rows if r["method"] == method]
+        for key in ("heading_error", "heading_error_on_route", "catchment_width_m"):
+            vals = [r[key] for r in mine if np.isfinite(r[key])]
+            metrics[f"{key}_{method}"] = float(np.mean(vals)) if vals else None
+        if exp.closed_loop:
+            metrics[f"completed_{method}"] = float(np.mean([r["completed"] for r in mine]))
+            metrics[f"route_distance_m_{method}"] = float(np.mean([r["route_distance_m"] for r in mine]))
+    return metrics
+
+
+def _write_csv(path, rows):
+    keys = ["route", "method", "n_snapshots", "heading_error", "heading_error_on_route", "catchment_width_m",
+            "invalid", "completed", "route_distance_m", "steps"]
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6f}" if isinstance(v, float) else v) for k, v in r.items()})
+
+
+__all__ = ["RouteHomingConfig", "closed_loop", "open_loop", "route_homing_config", "run"]

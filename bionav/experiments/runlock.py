@@ -1,0 +1,137 @@
+"""One run per run directory: a lock file holding the owner's pid, host and start time.
+
+A second run into a directory whose lock is held by a live process is refused
+(:class:`bionav.errors.UserError`); a lock left behind by a crashed run
+(SIGKILL, power cut) is recognised as stale -- its process is gone, or its
+pid now belongs to another process -- and taken over.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import time
+from pathlib import Path
+
+from bionav.errors import UserError
+
+LOCK_FILE = ".bionav.lock"
+
+
+def _process_start(pid: int) -> str | None:
+    """Start time of a process in clock ticks since boot (Linux), to tell reused pids apart."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    return stat.rsplit(")", 1)[-1].split()[19]
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def _read(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def lock_owner(run_dir: str | Path) -> dict | None:
+    """The live owner of ``run_dir``'s lock (``pid``, ``host``, ``started``), or ``None`` if free or stale.
+
+    A lock written on another host is reported as live (its process cannot
+    be checked from here).
+    """
+    info = _read(Path(run_dir) / LOCK_FILE)
+    if info is None:
+        return None
+    if info.get("host") != socket.gethostname():
+        return info
+    pid = int(info.get("pid", -1))
+    if pid <= 0 or not _alive(pid):
+        return None
+    start = info.get("start_ticks")
+    if start is not None and _process_start(pid) not in (None, start):
+        return None  # the pid was reused by another process
+    return info
+
+
+def _refusal(run_dir: Path, info: dict) -> UserError:
+    where = info.get("host", "?")
+    return UserError(
+        f"the run directory {run_dir} is in use by another bionav run (pid {info.get('pid')} on {where}, "
+        f"started {info.get('started', '?')}); two runs in one directory would overwrite each other's "
+        f"metrics.json and run.mcap. Choose another directory with hydra.run.dir=..., or wait for that run to "
+        f"finish. If that run is dead (on another host), delete {run_dir / LOCK_FILE}."
+    )
+
+
+def check_free(run_dir: str | Path) -> None:
+    """Raise :class:`UserError` if a live run holds ``run_dir`` (checked before Hydra writes there)."""
+    info = lock_owner(run_dir)
+    if info is not None and not (info.get("host") == socket.gethostname() and info.get("pid") == os.getpid()):
+        raise _refusal(Path(run_dir), info)
+
+
+class RunLock:
+    """Hold ``run_dir/.bionav.lock`` for the lifetime of a run (a context manager).
+
+    Raises
+    ------
+    UserError
+        When another live run holds the directory.
+    """
+
+    def __init__(self, run_dir: str | Path) -> None:
+        self.path = Path(run_dir) / LOCK_FILE
+        self._held = False
+
+    def acquire(self) -> "RunLock":
+        me = {
+            "pid": os.getpid(),
+            "host": socket.gethostname(),
+            "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+            "start_ticks": _process_start(os.getpid()),
+        }
+        tmp = self.path.with_name(f"{LOCK_FILE}.{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(me))
+        try:
+            for _ in range(2):
+                try:
+                    os.link(tmp, self.path)  # atomic: fails if the lock exists; never an empty lock file
+                    self._held = True
+                    return self
+                except FileExistsError:
+                    owner = lock_owner(self.path.parent)
+                    if owner is not None:
+                        raise _refusal(self.path.parent, owner) from None
+                    try:  # stale: the owner crashed
+                        self.path.unlink()
+                    except FileNotFoundError:
+                        pass
+            raise _refusal(self.path.parent, _read(self.path) or {})
+        finally:
+            tmp.unlink(missing_ok=True)
+
+    def release(self) -> None:
+        if not self._held:
+            return
+        self._held = False
+        info = _read(self.path)
+        if info and info.get("pid") == os.getpid() and info.get("host") == socket.gethostname():
+            self.path.unlink(missing_ok=True)
+
+    def __enter__(self) -> "RunLock":
+        return self.acquire()
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
