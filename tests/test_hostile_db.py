@@ -148,3 +148,10 @@ def test_metrics_never_hold_nan():
                       "arr": np.array([np.nan, 1.0])})
     assert safe == {"aae": None, "per": [1.0, None], "x": 2.5, "n": 3, "arr": [None, 1.0]}
     json.dumps(safe, allow_nan=False)
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads files whatever their mode")
+def test_unreadable_file_mode_is_an_error(tmp_path):
+    folder = make_folder(tmp_path / "db", grid(2, 2))
+    (folder / "1_0.png").chmod(0)
+    clean_error(run_folder(tmp_path, folder), "1_0.png", "cannot be read", "db.on_bad_image=skip")

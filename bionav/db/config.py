@@ -38,7 +38,7 @@ class DatabaseConfig:
     """
 
     name: str = "sim_original"
-    source: str = bounded("synthetic", choices=("synthetic", "folder"))
+    source: str = bounded("synthetic", choices=("synthetic", "folder", "mesh", "route"))
     path: Optional[str] = None  # folder databases: the directory
     image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=2, le=MAX_IMAGE_SIDE))  # [W, H]; None: native
     seed: int = bounded(0, ge=0, le=2**32 - 1)  # synthetic worlds: which world of this kind
@@ -58,12 +58,14 @@ class DatabaseConfig:
     unfold: UnfoldConfig = field(default_factory=UnfoldConfig)
     extra: dict[str, Any] = field(default_factory=dict)
     # mesh worlds (source: mesh | route; see bionav/db/mesh.py and docs/worlds.md)
-    world: Optional[str] = None  # a packaged world (seville2009) when no path is given
-    origin_m: Optional[list[float]] = None  # world (x, y) in metres of grid cell (0, 0); None = centred
-    camera_height_m: float = 0.01  # camera height over the local terrain, metres
-    ground: str = "auto"  # plane | mesh | auto (.mat: plane at z = 0, .obj/.ply: the mesh)
-    channels: str = "grey"  # grey | spectral (UV B G R IR)
-    clearance_m: Optional[float] = None  # a cell is missing if a triangle lies this close above it; None = any
+    world: Optional[str] = bounded(None, choices=("seville2009",))  # a packaged world when no path is given
+    # world (x, y) in metres of grid cell (0, 0); None = centred on the world
+    origin_m: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-1e6, le=1e6))
+    camera_height_m: float = bounded(0.01, gt=0.0, le=100.0)  # camera height over the local terrain, metres
+    ground: str = bounded("auto", choices=("auto", "plane", "mesh"))  # auto: .mat plane at z = 0, .obj/.ply the mesh
+    channels: str = bounded("grey", choices=("grey", "spectral"))  # spectral: UV B G R IR
+    # a cell is missing if a triangle lies this close above its terrain point; None = at any height
+    clearance_m: Optional[float] = bounded(None, gt=0.0, le=1000.0)
     route: Optional[str] = None  # route databases: Ant<a>_Route<r>
     routes_path: Optional[str] = None  # .mat of routes; None = the packaged Seville routes
-    step_m: float = 0.1  # route databases: distance between views along the route, metres
+    step_m: float = bounded(0.1, gt=0.0, le=10.0)  # route databases: path length between views, metres

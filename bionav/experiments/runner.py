@@ -199,7 +199,8 @@ def _finish(run_dir: Path, mcap: McapLog | None, metrics: dict[str, Any], starte
         raise
 
 
-def _mount_point(path: Path) -> Path:
+def mount_point(path: Path) -> Path:
+    """The mount point of the file system holding ``path`` (what `df` calls the device's mount)."""
     path = path.resolve()
     try:
         dev = path.stat().st_dev
@@ -216,7 +217,8 @@ def disk_full_error(exc: BaseException, run_dir: Path) -> UserError | None:
         return None
     what = "no space left" if exc.errno == errno.ENOSPC else "disk quota exceeded"
     return UserError(
-        f"{what} on {_mount_point(run_dir)} (writing {exc.filename or 'the run directory'}); free space or choose "
-        f"hydra.run.dir=... on another disk. What was written before is kept in {run_dir}: metrics.json says failed, "
-        f"and a run.mcap cut short is repaired with `python -m bionav.logs recover {run_dir / LOG_FILE} fixed.mcap`."
+        f"{what} on {mount_point(run_dir)} (writing {exc.filename or 'the run directory'}); free space or choose "
+        f"hydra.run.dir=... on another disk. What was written before is kept in {run_dir} (metrics.json says failed, "
+        f"or still running if there was no room to update it; a run.mcap cut short is repaired with "
+        f"`python -m bionav.logs recover {run_dir / LOG_FILE} fixed.mcap` once there is space)."
     )

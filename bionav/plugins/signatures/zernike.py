@@ -15,6 +15,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.homing.signatures.base import Signature
+from bionav.validation import bounded
 
 MODES = ("intensity", "skyline")
 
@@ -30,9 +31,9 @@ class ZernikeConfig:
     threshold : sky threshold in [0, 1] for ``mode=skyline``.
     """
 
-    order: int = 16
-    mode: str = "intensity"
-    threshold: float = 0.7
+    order: int = bounded(16, ge=1, le=40)
+    mode: str = bounded("intensity", choices=MODES)
+    threshold: float = bounded(0.7, ge=0.0, le=1.0)
 
 
 class Zernike(Signature):
