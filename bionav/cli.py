@@ -19,6 +19,8 @@ from bionav.errors import UserError
 
 EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
+#: a run directory with less free space is refused before Hydra writes its files there
+MIN_FREE_BYTES = 2**20
 
 log = logging.getLogger("bionav")
 
@@ -31,14 +33,15 @@ def _fail(message: str, code: int = EXIT_USER_ERROR) -> None:
     sys.exit(code)
 
 
-def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
-    """Catch unknown plugin names and unwritable output dirs before Hydra starts."""
+def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, bool]]:
+    """Catch unknown plugin names before Hydra starts; return the output dirs given (path, is_sweep)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
     try:
         overrides = OverridesParser.create().parse_overrides([a for a in argv if not a.startswith("-")])
     except Exception:
-        return  # Hydra reports syntax errors itself
+        return []  # Hydra reports syntax errors itself
+    dirs: list[tuple[Path, bool]] = []
     groups = {g: list(v) for g, v in names.items()}
     for group in YAML_GROUPS:
         if _yaml_options(group):  # only groups that exist; otherwise `key=value` is a plain value
@@ -58,7 +61,8 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> None:
                         f"Run `python -m bionav.plugins` to see every installed plugin."
                     )
         if key in ("hydra.run.dir", "hydra.sweep.dir"):
-            _check_writable(Path(str(override.value())), sweep=key == "hydra.sweep.dir")
+            dirs.append((Path(str(override.value())), key == "hydra.sweep.dir"))
+    return dirs
 
 
 def _concrete_overrides(argv: list[str]) -> list[str] | None:
@@ -181,6 +185,15 @@ def _check_writable(path: Path, *, sweep: bool = False) -> None:
             pass
     except OSError as exc:
         raise UserError(f"cannot write the output directory {path}: {exc.strerror or exc}. {fix}") from None
+    free = os.statvfs(path)
+    if free.f_bavail * free.f_frsize < MIN_FREE_BYTES:
+        from bionav.experiments.runner import mount_point
+
+        raise UserError(
+            f"no space left on {mount_point(path)} (only {free.f_bavail * free.f_frsize // 1024} kB free, a run "
+            f"needs at least {MIN_FREE_BYTES // 2**20} MB for its config, log and metrics); free space or choose "
+            f"hydra.run.dir=... on another disk."
+        )
     check_free(path)
     if sweep:
         for job in sorted(p.parent for p in path.glob("*/.bionav.lock")):
@@ -303,12 +316,18 @@ def main(argv: list[str] | None = None) -> None:
         from bionav.config import register_configs
 
         names = register_configs()
-        if not any(a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv):
-            _precheck(argv, names)
-        if not any(a in ("--help", "-h", "--hydra-help", "-sc", "--shell-completion", "-cp", "-cn", "-cd",
-                         "--config-path", "--config-name", "--config-dir") or a.startswith(("--info", "--shell"))
-                   for a in argv):
+        output_dirs: list[tuple[Path, bool]] = []
+        completion = any(a in ("-sc", "--shell-completion") for a in argv)  # `query=...` is not an override
+        if not completion and not any(
+            a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
+        ):
+            output_dirs = _precheck(argv, names)
+        if not completion and not any(a in ("--help", "-h", "--hydra-help", "-cp", "-cn", "-cd", "--config-path",
+                                            "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
+        # only after every value passed: a refused run leaves no directory behind
+        for path, sweep in output_dirs:
+            _check_writable(path, sweep=sweep)
     except UserError as exc:
         _fail(str(exc))
 

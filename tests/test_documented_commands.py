@@ -179,9 +179,15 @@ def _expand_sweeps(args: list[str]) -> list[list[str]]:
     overrides = OverridesParser.create().parse_overrides([a for a in args if not a.startswith("-")])
     choices = []
     for o in overrides:
-        if o.is_sweep_override():
+        if o.is_sweep_override() and o.is_discrete_sweep():
             prefix = o.get_key_element()
-            choices.append([f"{prefix}={v}" for v in o.sweep_string_iterator()])
+            values = list(o.sweep_string_iterator())
+            if o.value_type.name == "RANGE_SWEEP":  # range(4,40,step=2): its ends are enough
+                values = values[:1] + values[-1:]
+            choices.append([f"{prefix}={v}" for v in values])
+        elif o.is_sweep_override():  # interval(a,b) of a tuning sweeper: both ends
+            prefix, value = o.get_key_element(), o.value()
+            choices.append([f"{prefix}={value.start}", f"{prefix}={value.end}"])
         else:
             choices.append([o.input_line])
     return [[*[x for x in opts if x not in ("-m", "--multirun")], *combo] for combo in itertools.product(*choices)]
@@ -228,6 +234,19 @@ class Job:
     compose_only: bool  # composed by the driver, not its own subprocess
 
 
+def _missing_hydra_plugin(argv) -> str | None:
+    """The Hydra plugin (``hydra/sweeper=optuna``, ``hydra/launcher=joblib``) a command needs and lacks."""
+    import importlib.util
+
+    for arg in argv:
+        key, _, value = arg.partition("=")
+        if key in ("hydra/sweeper", "hydra/launcher") and value not in ("basic", ""):
+            module = f"hydra_plugins.hydra_{value.split('_')[0]}_{key.split('/')[1]}"
+            if importlib.util.find_spec(module) is None:
+                return module
+    return None
+
+
 def _jobs() -> list[Job]:
     jobs: list[Job] = []
     seen: set[tuple[str, ...]] = set()
@@ -244,8 +263,8 @@ def _jobs() -> list[Job]:
         module = _module(cmd)
         args = _substitute(cmd)
         if module == "bionav":
-            if any(a in ("--help", "-h", "--hydra-help") for a in args):
-                add(cmd, ["bionav", *args])
+            if any(a.startswith("-") and a not in ("-m", "--multirun") for a in args):
+                add(cmd, ["bionav", *args])  # --help, --cfg job, -sc install=bash, ...: run as documented
                 continue
             for combo in _expand_sweeps(args):
                 add(cmd, combo, compose_only=True)
@@ -297,7 +316,9 @@ def test_sweeps_expand_into_jobs():
 
 def test_every_documented_command_composes(sandbox, plugin_site):
     """Every documented command composes (``--cfg job``, or ``--help`` / a tiny real run) without error."""
-    jobs = _jobs()
+    all_jobs = _jobs()
+    jobs = [j for j in all_jobs if not _missing_hydra_plugin(j.argv)]
+    unchecked = sorted({f"{j.cmd.where()} (needs {_missing_hydra_plugin(j.argv)})" for j in all_jobs if j not in jobs})
     failures = []
     # 1. all `python -m bionav` commands (each sweep job) composed by the driver, one process per plugin set
     for requires in sorted({j.cmd.requires or "" for j in jobs if j.compose_only}):
@@ -325,3 +346,5 @@ def test_every_documented_command_composes(sandbox, plugin_site):
     failures += [f for f in map(check, real) if f]  # in document order: `recover A B` before `info B`
     assert len(jobs) >= 40
     assert not failures, f"{len(failures)} documented commands fail:\n\n" + "\n\n".join(failures)
+    if unchecked:  # everything else passed; say what could not be checked here
+        pytest.skip("Hydra plugins missing (pip install -e '.[test]'), not checked: " + "; ".join(unchecked))

@@ -210,13 +210,15 @@ def test_ctrl_c_during_a_sweep_writes_the_summary(tmp_path, render_cache):
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=60)
     done = subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
+    summary = (sweep / "summary.md").read_text() if (sweep / "summary.md").exists() else "(no summary.md)"
+    assert proc.returncode == 130, (summary, err[-3000:])
     _clean_failure(done, "interrupted", "summary", "bionav.resume=true", code=130)
     import csv
 
     with open(sweep / "summary.csv") as f:
         rows = {r["job"]: r for r in csv.DictReader(f)}
-    assert rows["0"]["status"] == "completed" and float(rows["0"]["aae"]) > 0
-    assert rows["1"]["status"] == "failed" and "KeyboardInterrupt" in rows["1"]["error"]
+    assert rows["0"]["status"] == "completed" and float(rows["0"]["aae"]) > 0, (rows, err)
+    assert rows["1"]["status"] == "failed" and "KeyboardInterrupt" in rows["1"]["error"], (rows, err)
     assert "2 runs, 1 failed" in (sweep / "summary.md").read_text()
 
 
@@ -261,23 +263,61 @@ def _disk_full_checks(proc, run_dir: Path):
     assert not (run_dir / "error.log").exists() or (run_dir / "error.log").read_text().strip()
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="mounting a tmpfs needs root")
-def test_disk_full_on_a_tiny_tmpfs(tmp_path, tiny_folder):
+@pytest.fixture
+def small_tmpfs(tmp_path):
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root")
     mount = tmp_path / "small"
     mount.mkdir()
-    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(mount)]).returncode != 0:
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(mount)]).returncode != 0:
         pytest.skip("cannot mount a tmpfs here")
+    yield mount
+    subprocess.run(["umount", str(mount)])
+
+
+def _fill(mount: Path) -> None:
+    """Fill a file system completely."""
+    with open(mount / "filler", "ab") as f:
+        try:
+            while True:
+                f.write(b"\0" * 65536)
+                f.flush()
+        except OSError:
+            pass
+
+
+def test_disk_already_full_is_refused_before_hydra_writes(tmp_path, small_tmpfs, tiny_folder):
+    _fill(small_tmpfs)
+    proc = run_bionav("homing=mfdid", "db=folder", f"db.path={tiny_folder}", f"hydra.run.dir={small_tmpfs / 'run'}",
+                      cwd=tmp_path)
+    _disk_full_checks(proc, small_tmpfs / "run")
+    assert f"no space left on {small_tmpfs}" in proc.stderr
+
+
+def test_disk_fills_up_during_the_run(tmp_path, small_tmpfs, render_cache):
+    """The disk fills while the run computes: one clean message naming the mount point; what was written
+    before (metrics.json, the start of run.mcap) is kept and the log is recoverable."""
+    run_dir = small_tmpfs / "run"
+    proc = _start([*SLOW_RUN, f"hydra.run.dir={run_dir}"], tmp_path, render_cache)
     try:
-        run_dir = mount / "run"
-        # log images: run.mcap outgrows 64 kB
-        proc = run_bionav("homing=mfdid", "db=folder", f"db.path={tiny_folder}", f"hydra.run.dir={run_dir}",
-                          "experiment.n_quiver_plots=9", cwd=tmp_path)
-        _disk_full_checks(proc, run_dir)
-        assert f"no space left on {mount}" in proc.stderr
-        if (run_dir / "metrics.json").exists():
-            assert json.loads((run_dir / "metrics.json").read_text())["status"] in ("failed", "running")
+        _wait_for(lambda: (run_dir / "run.mcap").exists() and _rows_since(run_dir / "run.mcap") >= 1, 120, proc,
+                  "the first rows are flushed")
+        rows_before = _rows_since(run_dir / "run.mcap")
+        _fill(small_tmpfs)
+        out, err = proc.communicate(timeout=300)
     finally:
-        subprocess.run(["umount", str(mount)])
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    done = subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
+    _disk_full_checks(done, run_dir)
+    assert f"no space left on {small_tmpfs}" in err
+    assert _status(run_dir) in ("failed", "running")
+    (small_tmpfs / "filler").unlink()  # make room, then repair the log: the rows before are all there
+    rec = run_bionav("recover", str(run_dir / "run.mcap"), str(tmp_path / "fixed.mcap"), cwd=tmp_path,
+                     module="bionav.logs")
+    assert rec.returncode == 0, rec.stderr
+    assert sum(1 for topic, _, _ in read_messages(tmp_path / "fixed.mcap") if topic == ROW_TOPIC) >= rows_before
 
 
 def test_disk_full_simulated_with_dev_full(tmp_path, tiny_folder):
@@ -340,3 +380,31 @@ def test_interrupt_or_terminate_a_run_keeps_its_results(tmp_path, render_cache, 
         summary = make_reader(f).get_summary()
     assert summary.statistics.message_count >= 1
     assert not (run_dir / ".bionav.lock").exists()
+
+
+def test_ctrl_c_inside_compiled_code_counts_as_an_interrupt(tmp_path, monkeypatch):
+    """numba turns a KeyboardInterrupt inside a jitted function into SystemError (caused by the interrupt);
+    the runner records it as an interrupt and re-raises KeyboardInterrupt (so a sweep stops, not goes on)."""
+    import types
+
+    from omegaconf import OmegaConf
+
+    from bionav.experiments.runner import run_experiment
+
+    def run(cfg, ctx):
+        ctx.log.write("/t", {"before": 1}, schema_name="bionav.Test")
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise SystemError("CPUDispatcher(<function f>) returned a result with an exception set") from exc
+
+    module = types.ModuleType("bionav.experiments.interrupted_inside_numba")
+    module.run = run
+    monkeypatch.setitem(sys.modules, module.__name__, module)
+    cfg = OmegaConf.create({"experiment": {"name": "interrupted_inside_numba"}, "seed": 0})
+    monkeypatch.setattr("bionav.experiments.runner.validate_run_config", lambda cfg: None)
+    with pytest.raises(KeyboardInterrupt):
+        run_experiment(cfg, tmp_path / "run")
+    metrics = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    assert metrics["status"] == "failed" and metrics["error"].startswith("KeyboardInterrupt")
+    assert [m for _, _, m in read_messages(tmp_path / "run" / "run.mcap")] == [{"before": 1}]

@@ -165,3 +165,15 @@ def test_bad_mesh_files_give_one_clear_message(tmp_path, case, needle):
         path.write_text("solid nothing\n")
     with pytest.raises(UserError, match=needle):
         load_mesh(path)
+
+
+def test_mesh_bench_cli_reports_cpu_and_wall(capsys):
+    import json
+
+    from bionav.bench.mesh import main
+
+    assert main(["--json", "--grid", "2", "--repeat", "1", "--threads", "1"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [r["benchmark"] for r in rows] == ["panorama", "grid_2x2", "panorama_50k"]
+    assert rows[0]["triangles"] == 5000 and rows[2]["triangles"] == 50_000
+    assert all(r["cpu_ms"] > 0 and r["wall_ms"] > 0 for r in rows)

@@ -164,7 +164,7 @@ def test_db_mesh_on_an_unseen_obj_runs_grid_homing_from_the_cli(tmp_path):
     parts.append(floor)
     path = tmp_path / "pillars.ply"
     trimesh.util.concatenate(parts).export(path)
-    proc = run_bionav(f"db=mesh", f"db.path={path}", "db.grid_shape=[4,4]", "db.spacing_m=0.5", "db.origin_m=[2,2]",
+    proc = run_bionav("db=mesh", f"db.path={path}", "db.grid_shape=[4,4]", "db.spacing_m=0.5", "db.origin_m=[2,2]",
                       "db.camera_height_m=0.3", "db.image_size=[120,20]", "homing=mfdid", "workers=1",
                       f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr[-2000:]

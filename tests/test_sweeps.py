@@ -105,7 +105,8 @@ def test_parallel_and_cluster_launchers(tmp_path, tiny_folder, launcher):
     sweep = tmp_path / "sweep"
     proc = run_bionav("-m", "homing=mfdid,sift", "db=folder", f"db.path={tiny_folder},{tmp_path / 'missing'}",
                       f"hydra/launcher={launcher}", f"hydra.sweep.dir={sweep}", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
+    assert proc.returncode == 1, proc.stderr  # the two jobs on the missing folder fail the sweep
+    assert "2 of 4 jobs failed" in proc.stderr.strip().splitlines()[-1]
     rows = _rows(sweep / "summary.csv")
     assert len(rows) == 4
     assert sorted(r["status"] for r in rows) == ["completed", "completed", "failed", "failed"]

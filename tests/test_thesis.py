@@ -265,3 +265,19 @@ def test_fig4_5_shows_the_raw_first_candidate():
     assert np.allclose(np.abs((raw - wrapped_truth + 180.0) % 360.0 - 180.0)[jump], 180.0)
     assert np.allclose(raw[~jump], wrapped_truth[~jump])
     assert np.allclose(near, np.degrees(truth))
+
+
+def test_a_multirun_is_complete_only_when_hydra_finished_it(tmp_path):
+    from bionav.thesis.runs import _sweep_metrics
+
+    for k in range(2):
+        d = tmp_path / str(k)
+        (d / ".hydra").mkdir(parents=True)
+        (d / ".hydra" / "overrides.yaml").write_text(yaml.safe_dump([f"signature=s{k}"]))
+        (d / "metrics.json").write_text(json.dumps({"status": "completed"}))
+    assert _sweep_metrics(tmp_path)["status"] == "failed"  # killed before the sweep's end: no summary.csv
+    (tmp_path / "summary.csv").write_text("job,status\n")
+    assert _sweep_metrics(tmp_path)["status"] == "completed"
+    (tmp_path / "1" / "metrics.json").write_text(json.dumps({"status": "failed"}))
+    assert _sweep_metrics(tmp_path) == {"status": "failed", "n_jobs": 2, "n_completed": 1,
+                                        "error": "1 of 2 jobs completed"}

@@ -207,11 +207,11 @@ def test_reference_threshold_rule_gives_arithmetic_midpoints_and_a_largest_ratio
 
     s = default_scales()
     g = PanoramaGeometry.square_pixels(288, 50)
-    _, tau = MinWarping(MinWarping.Config(threshold_rule="reference"), geometry=g)._scales()
+    _, tau = MinWarping(MinWarping.Config(), geometry=g)._scales()  # the default rule
     # by hand: (2**((k-4)/4) + 2**((k-3)/4)) / 2, then the largest ratio 2.5
     assert tau[:-1] == pytest.approx([(s[k] + s[k + 1]) / 2 for k in range(8)])
     assert tau[3] == pytest.approx((2 ** -0.25 + 1.0) / 2) and tau[-1] == 2.5
-    _, tau_g = MinWarping(MinWarping.Config(), geometry=g)._scales()
+    _, tau_g = MinWarping(MinWarping.Config(threshold_rule="geometric"), geometry=g)._scales()
     assert tau_g[3] == pytest.approx(2 ** -0.125) and np.isinf(tau_g[-1])
     # explicit thresholds win over the rule
     explicit = [float(x) for x in tau_g[:-1]] + [3.0]

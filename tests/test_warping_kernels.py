@@ -249,3 +249,54 @@ def test_quantised_search_agrees_with_float_on_random_panoramas(seed, options):
         ip = int(np.flatnonzero(p_cols == round(q.psi * w / (2 * np.pi)) % w)[0])
         quantum, _ = distance_quantum(w)
         assert table[ip, ia] <= table.min() + 2 * w * (0.5 + 0.02 * quantum) / quantum
+
+
+@pytest.mark.parametrize("step", [1, 3])
+def test_single_hypothesis_scores_equal_the_reference(step):
+    # the fine search's kernel: any (alpha, psi) in columns, also off the alpha grid
+    from bionav.homing.warping.kernels import minwarp_scores_at
+    from bionav.homing.warping.search import _window_minima
+
+    snap, cur = _pair(41)
+    tau = default_thresholds(SCALES)
+    windows = minwarp_windows(minwarp_template(W, SCALES, tau))
+    levels = _window_minima(snap, cur, step, windows, False).copy()
+    rng = np.random.default_rng(2)
+    a_cols, p_cols = rng.integers(0, W, 12), rng.integers(0, W, 12)
+    fast = minwarp_scores_at(levels, a_cols, p_cols, *windows)
+    for t in range(12):
+        ref = minwarping_scores_reference(snap, cur, a_cols=[a_cols[t]], p_cols=[p_cols[t]], thresholds=tau)
+        assert fast[t] == pytest.approx(ref[0, 0], rel=1e-5)
+
+
+def _asm(kernel, *args):
+    # a fresh, uncached compilation with the kernel's options (cached code cannot be inspected)
+    from numba import njit
+
+    fresh = njit(nogil=True, fastmath=True)(kernel.py_func)
+    fresh(*args)
+    return fresh.inspect_asm(fresh.signatures[0])
+
+
+@pytest.mark.skipif(__import__("platform").machine() not in ("x86_64", "AMD64"), reason="x86 mnemonics")
+def test_quantised_kernels_compile_to_packed_byte_and_word_instructions():
+    import re
+
+    from bionav.homing.warping.distance import _diagonal_distances_q
+    from bionav.homing.warping.kernels import minwarp_scores
+
+    w, step = 48, 3
+    n = w // step
+    levels = np.zeros((2, 3, w, step, 2 * n), np.uint8)
+    windows = minwarp_windows(minwarp_template(w, default_scales(3), default_thresholds(default_scales(3))), max_level=1)
+    asm = _asm(minwarp_scores, levels, n, np.arange(4, dtype=np.int64), *windows, np.uint8(255),
+               np.zeros((4, n), np.uint16))
+    # minima of 8-bit distances (pminub, or AVX-512 byte compares and masked moves) and 16-bit sums
+    assert re.search(r"\b(v?pminub|vpcmp\w*ub)\b", asm)
+    assert re.search(r"\bv?paddw\b", asm)
+    sq = np.zeros((3, 9, w), np.int16)
+    asm = _asm(_diagonal_distances_q, sq, np.zeros((3, 9, 2 * w), np.int16), np.zeros((3, w), np.int32),
+               np.zeros((3, 2 * w), np.int32), step, 227, np.zeros((3, w, step, 2 * n), np.uint8))
+    # |a - b| of 16-bit values as packed max - min, summed in packed 16-bit adds
+    assert re.search(r"\bv?pmaxsw\b", asm) and re.search(r"\bv?pminsw\b", asm)
+    assert re.search(r"\bv?paddw\b", asm)

@@ -58,15 +58,14 @@ class DatabaseConfig:
     unfold: UnfoldConfig = field(default_factory=UnfoldConfig)
     extra: dict[str, Any] = field(default_factory=dict)
     # mesh worlds (source: mesh | route; see bionav/db/mesh.py and docs/worlds.md)
-    world: Optional[str] = None  # a packaged world (seville2009) when no path is given
-    # world (x, y) in metres of grid cell (0, 0); None = centred
-    origin_m: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-1e7, le=1e7))
-    camera_height_m: float = bounded(0.01, gt=0.0, le=1000.0)  # camera height over the local terrain, metres
-    # plane | mesh | auto (.mat: plane at z = 0, .obj/.ply: the mesh)
-    ground: str = bounded("auto", choices=("auto", "plane", "mesh"))
+    world: Optional[str] = bounded(None, choices=("seville2009",))  # a packaged world when no path is given
+    # world (x, y) in metres of grid cell (0, 0); None = centred on the world
+    origin_m: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-1e6, le=1e6))
+    camera_height_m: float = bounded(0.01, gt=0.0, le=100.0)  # camera height over the local terrain, metres
+    ground: str = bounded("auto", choices=("auto", "plane", "mesh"))  # auto: .mat plane at z = 0, .obj/.ply the mesh
     channels: str = bounded("grey", choices=("grey", "spectral"))  # spectral: UV B G R IR
-    # a cell is missing if a triangle lies this close above it; None = any
-    clearance_m: Optional[float] = bounded(None, ge=0.0, le=1000.0)
+    # a cell is missing if a triangle lies this close above its terrain point; None = at any height
+    clearance_m: Optional[float] = bounded(None, gt=0.0, le=1000.0)
     route: Optional[str] = None  # route databases: Ant<a>_Route<r>
     routes_path: Optional[str] = None  # .mat of routes; None = the packaged Seville routes
-    step_m: float = bounded(0.1, gt=0.0, le=100.0)  # route databases: distance between views along the route, metres
+    step_m: float = bounded(0.1, gt=0.0, le=10.0)  # route databases: path length between views, metres

@@ -514,6 +514,49 @@ def check_group_nodes(cfg: DictConfig) -> None:
 
 
 # --------------------------------------------------------------------------- top-level run settings
+# --------------------------------------------------------------------------- routes in mesh worlds
+ROUTE_METHODS = ("perfect_memory", "windowed", "zernike", "homing")
+
+
+@dataclass
+class RouteHomingConfig:
+    """``experiment=route_homing``: following real ant routes (docs/worlds.md).
+
+    routes : route names (``Ant<a>_Route<r>``); empty = ``db.route``.
+    methods : subset of ``perfect_memory``, ``windowed``, ``zernike``, ``homing``.
+    offsets_m : lateral offsets of the open-loop test points, metres (left positive); must include 0.
+    test_stride : every k-th route view is a test point.
+    error_threshold_deg : heading error below which a test point is inside the route's catchment.
+    window : snapshots ahead of the last match searched by ``windowed`` (and by ``homing`` to track progress).
+    lookahead : ``homing`` targets the snapshot this many views ahead of the best match.
+    test_step_m : test-step length of methods with test steps, metres.
+    closed_loop : run the simulated agent from a displaced start.
+    start_offset_m, agent_step_m, success_radius_m, give_up_m : the agent's start displacement (left
+        positive), step, success radius around the route's end and give-up distance from the route, metres.
+    max_steps_factor : step budget = factor x route length / agent step.
+    zernike_order : highest Zernike-moment order of the ``zernike`` method.
+    """
+
+    name: str = "route_homing"
+    routes: list[str] = bounded([], length=(0, 1000))
+    methods: list[str] = bounded(list(ROUTE_METHODS), length=(1, 4), item=Range(choices=ROUTE_METHODS))
+    offsets_m: list[float] = bounded([-0.4, -0.2, -0.1, 0.0, 0.1, 0.2, 0.4], length=(1, 100),
+                                     item=Range(ge=-5.0, le=5.0))
+    test_stride: int = bounded(5, ge=1, le=10_000)
+    error_threshold_deg: float = bounded(45.0, gt=0.0, le=180.0)
+    window: int = bounded(10, ge=1, le=10_000)
+    lookahead: int = bounded(2, ge=1, le=1000)
+    test_step_m: float = bounded(0.05, gt=0.0, le=1.0)
+    closed_loop: bool = True
+    start_offset_m: float = bounded(0.2, ge=-5.0, le=5.0)
+    agent_step_m: float = bounded(0.05, gt=0.0, le=1.0)
+    success_radius_m: float = bounded(0.2, gt=0.0, le=5.0)
+    give_up_m: float = bounded(1.0, gt=0.0, le=20.0)
+    max_steps_factor: float = bounded(2.0, ge=1.0, le=20.0)
+    zernike_order: int = bounded(16, ge=1, le=40)
+    plots: bool = True
+
+
 @dataclass
 class RunSettings:
     """Top-level keys of every run (``conf/config.yaml``): ``seed=``, ``workers=``."""
@@ -549,6 +592,7 @@ EXPERIMENT_CONFIGS: dict[str, type] = {
     "pol_compass": PolCompassConfig,
     "cleaning": CleaningConfig,
     "pol_recordings": PolRecordingsConfig,
+    "route_homing": RouteHomingConfig,
 }
 
 

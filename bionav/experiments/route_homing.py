@@ -44,16 +44,16 @@ from __future__ import annotations
 import csv
 import math
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
+from bionav.experiments.configs import RouteHomingConfig, experiment_config
 from bionav.geometry import angular_difference, wrap_angle
 
-METHODS = ("perfect_memory", "windowed", "zernike", "homing")
 PATH_TOPIC = "/route_homing/agent_path"
 PATH_SCHEMA = {
     "type": "object",
@@ -66,87 +66,13 @@ PATH_SCHEMA = {
 }
 
 
-@dataclass
-class RouteHomingConfig:
-    """Typed ``experiment.*`` of ``route_homing`` (ranges checked by :meth:`validate`).
-
-    routes : route names (``Ant<a>_Route<r>``); empty = ``db.route``.
-    methods : subset of ``perfect_memory``, ``windowed``, ``zernike``, ``homing``.
-    offsets_m : lateral offsets of the open-loop test points, metres in [-5, 5]; must include 0.
-    test_stride : every k-th route view is a test point, k >= 1.
-    error_threshold_deg : catchment threshold, (0, 180].
-    window : snapshots ahead of the last match searched by ``windowed``, >= 1.
-    lookahead : ``homing`` targets the snapshot this many views ahead, >= 1.
-    test_step_m : test-step length of ``uses_test_steps`` methods, (0, 1] m.
-    closed_loop : run the simulated agent.
-    start_offset_m : lateral displacement of the agent's start, [-5, 5] m.
-    agent_step_m : agent step, (0, 1] m.
-    success_radius_m : route completed within this distance of its end, (0, 5] m.
-    give_up_m : agent lost beyond this distance from the route, (0, 20] m.
-    max_steps_factor : step budget = factor x route length / step, [1, 20].
-    zernike_order : highest moment order of the ``zernike`` method, 1..40.
-    plots : write plots/.
-    """
-
-    name: str = "route_homing"
-    routes: list[str] = field(default_factory=list)
-    methods: list[str] = field(default_factory=lambda: list(METHODS))
-    offsets_m: list[float] = field(default_factory=lambda: [-0.4, -0.2, -0.1, 0.0, 0.1, 0.2, 0.4])
-    test_stride: int = 5
-    error_threshold_deg: float = 45.0
-    window: int = 10
-    lookahead: int = 2
-    test_step_m: float = 0.05
-    closed_loop: bool = True
-    start_offset_m: float = 0.2
-    agent_step_m: float = 0.05
-    success_radius_m: float = 0.2
-    give_up_m: float = 1.0
-    max_steps_factor: float = 2.0
-    zernike_order: int = 16
-    plots: bool = True
-
-    def validate(self) -> "RouteHomingConfig":
-        def bad(key, value, rng):
-            raise UserError(f"experiment.{key}={value} is out of range: it must lie in {rng}.")
-
-        unknown = [m for m in self.methods if m not in METHODS]
-        if unknown or not self.methods:
-            raise UserError(f"experiment.methods={list(self.methods)}: choose one or more of {', '.join(METHODS)}.")
-        if not self.offsets_m or 0.0 not in [float(v) for v in self.offsets_m]:
-            raise UserError(f"experiment.offsets_m={list(self.offsets_m)} must include 0 (the route itself).")
-        if any(abs(float(v)) > 5 for v in self.offsets_m):
-            bad("offsets_m", list(self.offsets_m), "[-5, 5] metres")
-        checks = [("test_stride", self.test_stride, 1, 10_000, "1..10000"),
-                  ("error_threshold_deg", self.error_threshold_deg, 1e-9, 180, "(0, 180]"),
-                  ("window", self.window, 1, 10_000, "1..10000"),
-                  ("lookahead", self.lookahead, 1, 1000, "1..1000"),
-                  ("test_step_m", self.test_step_m, 1e-9, 1, "(0, 1] metres"),
-                  ("start_offset_m", self.start_offset_m, -5, 5, "[-5, 5] metres"),
-                  ("agent_step_m", self.agent_step_m, 1e-9, 1, "(0, 1] metres"),
-                  ("success_radius_m", self.success_radius_m, 1e-9, 5, "(0, 5] metres"),
-                  ("give_up_m", self.give_up_m, 1e-9, 20, "(0, 20] metres"),
-                  ("max_steps_factor", self.max_steps_factor, 1, 20, "[1, 20]"),
-                  ("zernike_order", self.zernike_order, 1, 40, "1..40")]
-        for key, value, lo, hi, text in checks:
-            if not lo <= float(value) <= hi:
-                bad(key, value, text)
-        return self
-
-
-def route_homing_config(node) -> RouteHomingConfig:
-    """:class:`RouteHomingConfig` from the ``experiment`` node (unknown keys and bad types named)."""
-    from omegaconf.errors import OmegaConfBaseException
-
-    try:
-        data = OmegaConf.to_container(node, resolve=True) if OmegaConf.is_config(node) else dict(node)
-        merged = OmegaConf.merge(OmegaConf.structured(RouteHomingConfig), data)
-        cfg = OmegaConf.to_object(merged)
-    except OmegaConfBaseException as exc:
-        key = getattr(exc, "full_key", None) or "a value"
-        raise UserError(f"invalid experiment.{key} for route_homing: {str(exc).splitlines()[0]} "
-                        "(see RouteHomingConfig in bionav/experiments/route_homing.py).") from None
-    return cfg.validate()
+def route_homing_config(cfg: DictConfig) -> RouteHomingConfig:
+    """The typed, range-checked ``experiment`` node (:class:`~bionav.experiments.configs.RouteHomingConfig`)."""
+    exp = OmegaConf.to_object(experiment_config(cfg, "route_homing"))
+    if not any(float(v) == 0.0 for v in exp.offsets_m):
+        raise UserError(f"experiment.offsets_m={list(exp.offsets_m)} must include 0 (the route itself), "
+                        "e.g. experiment.offsets_m=[-0.2,0.0,0.2].")
+    return exp
 
 
 @dataclass
@@ -326,7 +252,7 @@ def _setup_route(cfg: DictConfig, name: str) -> _RouteSetup:
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.common import make_homing
 
-    exp = route_homing_config(cfg.experiment)
+    exp = route_homing_config(cfg)
     routes = list(exp.routes) or [str(cfg.db.route)]
     rows = []
     per_route = {}

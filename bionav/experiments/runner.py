@@ -165,6 +165,11 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
         metrics.update(result or {})
         metrics["status"] = "completed"
     except BaseException as exc:
+        if not isinstance(exc, KeyboardInterrupt) and _caused_by_interrupt(exc):
+            # Ctrl-C inside compiled code (numba) surfaces as SystemError caused by KeyboardInterrupt
+            metrics.update(status="failed", error=f"KeyboardInterrupt: (inside {type(exc).__name__}: {exc})")
+            _finish(run_dir, mcap, metrics, started, failing=True)
+            raise KeyboardInterrupt from None
         full = disk_full_error(exc, run_dir)
         metrics["status"] = "failed"
         metrics["error"] = str(full or exc) if isinstance(full or exc, UserError) else f"{type(exc).__name__}: {exc}"
@@ -199,7 +204,19 @@ def _finish(run_dir: Path, mcap: McapLog | None, metrics: dict[str, Any], starte
         raise
 
 
-def _mount_point(path: Path) -> Path:
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """True if a KeyboardInterrupt is among the causes/contexts of ``exc``."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+def mount_point(path: Path) -> Path:
+    """The mount point of the file system holding ``path`` (what `df` calls the device's mount)."""
     path = path.resolve()
     try:
         dev = path.stat().st_dev
@@ -216,7 +233,8 @@ def disk_full_error(exc: BaseException, run_dir: Path) -> UserError | None:
         return None
     what = "no space left" if exc.errno == errno.ENOSPC else "disk quota exceeded"
     return UserError(
-        f"{what} on {_mount_point(run_dir)} (writing {exc.filename or 'the run directory'}); free space or choose "
-        f"hydra.run.dir=... on another disk. What was written before is kept in {run_dir}: metrics.json says failed, "
-        f"and a run.mcap cut short is repaired with `python -m bionav.logs recover {run_dir / LOG_FILE} fixed.mcap`."
+        f"{what} on {mount_point(run_dir)} (writing {exc.filename or 'the run directory'}); free space or choose "
+        f"hydra.run.dir=... on another disk. What was written before is kept in {run_dir} (metrics.json says failed, "
+        f"or still running if there was no room to update it; a run.mcap cut short is repaired with "
+        f"`python -m bionav.logs recover {run_dir / LOG_FILE} fixed.mcap` once there is space)."
     )

@@ -77,6 +77,11 @@ def _run_lines(section: Section, out: Path) -> list[str]:
     return lines
 
 
+def _cell(text: str) -> str:
+    """Text for a Markdown table cell (pipes escaped, one line)."""
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
 def section_markdown(s: Section, out: Path) -> str:
     o = s.outcome
     passed, total = o.score
@@ -88,12 +93,12 @@ def section_markdown(s: Section, out: Path) -> str:
         md += ["**Not produced / incomplete:**", *[f"- {m}" for m in o.missing], ""]
     if o.rows:
         md += ["| quantity | thesis | bionav | difference | tolerance | verdict |", "|---|---|---|---|---|---|"]
-        md += [f"| {r.quantity} | {fmt(r.thesis)} | {fmt(r.bionav)} | {fmt(r.difference)} | "
+        md += [f"| {_cell(r.quantity)} | {_cell(fmt(r.thesis))} | {_cell(fmt(r.bionav))} | {fmt(r.difference)} | "
                f"{'' if r.tolerance is None else fmt(r.tolerance)} | {r.verdict} |" for r in o.rows]
         md.append("")
     if o.checks:
         md += ["| check | result | detail |", "|---|---|---|"]
-        md += [f"| {c.rule} | {'n/a' if c.passed is None else ('pass' if c.passed else 'fail')} | {c.detail} |"
+        md += [f"| {_cell(c.rule)} | {'n/a' if c.passed is None else ('pass' if c.passed else 'fail')} | {_cell(c.detail)} |"
                for c in o.checks]
         md.append("")
     for n in o.notes:
@@ -157,7 +162,7 @@ def markdown_to_html(md: str, out: Path) -> str:
     def flush_table():
         if table:
             rows = [r for r in table if not re.match(r"^\|[-| ]+\|$", r)]
-            cells = [[c.strip() for c in r.strip("|").split("|")] for r in rows]
+            cells = [[c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", r.strip()[1:-1])] for r in rows]
             h = "".join(f"<th>{inline(c)}</th>" for c in cells[0])
             b = "".join("<tr>" + "".join(f"<td>{inline(c)}</td>" for c in row) + "</tr>" for row in cells[1:])
             body.append(f"<table><tr>{h}</tr>{b}</table>")

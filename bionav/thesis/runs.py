@@ -183,9 +183,16 @@ def sweep_jobs(sweep_dir: Path) -> list[tuple[Path, dict | None]]:
 
 
 def _sweep_metrics(sweep_dir: Path) -> dict:
+    """A multirun is complete when Hydra finished it (``summary.csv`` written) and every job completed."""
     jobs = sweep_jobs(sweep_dir)
     done = sum(1 for _, m in jobs if m and m.get("status") == "completed")
-    return {"status": "completed" if jobs and done == len(jobs) else "failed", "n_jobs": len(jobs), "n_completed": done}
+    finished = (Path(sweep_dir) / "summary.csv").is_file()
+    ok = finished and jobs and done == len(jobs)
+    out = {"status": "completed" if ok else "failed", "n_jobs": len(jobs), "n_completed": done}
+    if not ok:
+        out["error"] = (f"{done} of {len(jobs)} jobs completed" if finished else
+                        f"the multirun did not finish ({done} jobs completed; see its log)")
+    return out
 
 
 def _move_aside(path: Path) -> None:

@@ -170,26 +170,32 @@ def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
         In the units of ``levels``.
     """
     _, n_planes, width, step, _ = levels.shape
-    out = np.zeros(a_cols.shape[0])
-    for t in range(a_cols.shape[0]):
-        ac = a_cols[t] % width
-        pc = p_cols[t]
-        total = 0.0
-        for u in range(width):
-            i = u + ac
-            if i >= width:
-                i -= width
-            m = i // step
-            rr = i - m * step
-            best = np.inf
-            for e in range(start[u], start[u + 1]):
-                d = _wrap(w_v[e] - u - pc, width)
-                x = np.float64(levels[w_level[e], w_plane[e], d, rr, m])
-                if x < best:
-                    best = x
-            total += best
-        out[t] = total
-    return out
+    n_t = a_cols.shape[0]
+    total = np.zeros(n_t)
+    best = np.empty(n_t)
+    rr_t = np.empty(n_t, np.int64)
+    m_t = np.empty(n_t, np.int64)
+    p_t = np.empty(n_t, np.int64)
+    for t in range(n_t):
+        p_t[t] = p_cols[t] % width
+    # column by column, all hypotheses at once: neighbouring hypotheses read
+    # neighbouring entries of the same rows
+    for u in range(width):
+        for t in range(n_t):
+            i = (u + a_cols[t]) % width
+            m_t[t] = i // step
+            rr_t[t] = i - m_t[t] * step
+            best[t] = np.inf
+        for e in range(start[u], start[u + 1]):
+            plane = levels[w_level[e], w_plane[e]]
+            v0 = w_v[e] - u
+            for t in range(n_t):
+                x = np.float64(plane[_wrap(v0 - p_t[t], width), rr_t[t], m_t[t]])
+                if x < best[t]:
+                    best[t] = x
+        for t in range(n_t):
+            total[t] += best[t]
+    return total
 
 
 @njit(nogil=True, fastmath=True, cache=True)

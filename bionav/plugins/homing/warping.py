@@ -164,9 +164,9 @@ class MinWarping(_PlaneWarping):
         n_alpha, n_psi: search steps over 360 degrees for movement direction and rotation.
         scales: scale factors of the planes; null = 2 ** ((k - 4) / 4), k = 0..8.
         thresholds: upper scale thresholds per plane; null = by threshold_rule.
-        threshold_rule: thresholds when none are given: geometric (geometric means of
-            neighbouring scales, no largest ratio) or reference (arithmetic means, largest
-            scale ratio max_scale_ratio, as the SIMD reference implementation WarpingSIMD).
+        threshold_rule: thresholds when none are given: reference (default: arithmetic means
+            of neighbouring scales and a largest scale ratio max_scale_ratio, as WarpingSIMD and
+            the thesis' table 5.2) or geometric (geometric means, no largest ratio).
         max_scale_ratio: largest allowed scale ratio of the reference rule.
         compass_acceleration: search only compass_fraction of the rotations, those the
             visual compass measure ranks best.
@@ -174,7 +174,7 @@ class MinWarping(_PlaneWarping):
         fine_search: refine alpha and psi at one-column resolution.
         double_search: also search with snapshot and current view exchanged.
         quantised: 8-bit column distances summed in 16 bits, as the SIMD reference
-            implementation (fast); false searches float32 distances (about 2x slower,
+            implementation (fast); false searches float32 distances (about 3x slower,
             home directions agree within one search step).
         """
 
@@ -185,7 +185,7 @@ class MinWarping(_PlaneWarping):
         n_psi: int = bounded(96, ge=4, le=4096)
         scales: list[float] | None = bounded(None, gt=0.0, le=100.0)
         thresholds: list[float] | None = bounded(None, gt=0.0, le=100.0)
-        threshold_rule: str = bounded("geometric", choices=THRESHOLD_RULES)
+        threshold_rule: str = bounded("reference", choices=THRESHOLD_RULES)
         max_scale_ratio: float = bounded(2.5, gt=1.0, le=100.0)
         compass_acceleration: bool = False
         compass_fraction: float = bounded(0.25, gt=0.0, le=1.0)
