@@ -80,9 +80,10 @@ def _concrete_overrides(argv: list[str]) -> list[str] | None:
         if key == "hydra" or key.startswith(("hydra.", "hydra/")):
             continue
         if override.is_sweep_override():
-            if not override.is_discrete_sweep():
-                continue  # range/interval sweeps: Hydra checks them per job
-            values = list(override.sweep_string_iterator())
+            try:
+                values = list(override.sweep_string_iterator())
+            except Exception:  # interval sweeps (optimisers): each job checks its own value
+                continue
             if not values:
                 continue
             out.append(f"{override.get_key_element()}={values[0]}")
@@ -321,7 +322,8 @@ def main(argv: list[str] | None = None) -> None:
             a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
         ):
             output_dirs = _precheck(argv, names)
-        if not completion and not any(a in ("--help", "-h", "--hydra-help") or a.startswith("--info") for a in argv):
+        if not completion and not any(a in ("--help", "-h", "--hydra-help", "-cp", "-cn", "-cd", "--config-path",
+                                            "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
         # only after every value passed: a refused run leaves no directory behind
         for path, sweep in output_dirs:

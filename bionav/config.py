@@ -101,20 +101,19 @@ def register_configs() -> dict[str, list[str]]:
     """
     Plugins.instance().register(BionavSearchPathPlugin)
     store = ConfigStore.instance()
-    from bionav.db.config import DatabaseConfig
+    # typed schemas of config nodes, registered by the rooms that own them (entry points
+    # ``bionav.schemas``); e.g. every db preset is merged onto ``db_schema``
+    schemas = registry.config_schemas()
+    if "db_schema" not in schemas:
+        from bionav.errors import UserError
 
-    # every db preset is merged onto this schema: all db.* keys exist and are typed
-    store.store(name="db_schema", node=DatabaseConfig, provider="bionav")
-    from bionav.experiments.configs import register as register_experiment_configs
-
-    # every experiment preset is merged onto its typed schema (experiment_schema/<name>)
-    register_experiment_configs(store)
-    try:  # hydra/launcher=submitit_slurm records cancelled/killed jobs as failed (bionav/launcher.py)
-        from bionav.launcher import register as register_launcher
-    except ImportError:  # the slurm extra is not installed
-        pass
-    else:
-        register_launcher()
+        raise UserError("bionav's entry points are out of date (no 'db_schema' in bionav.schemas); "
+                        "re-install it: pip install -e . (or pip install .) in the bionav checkout.")
+    for name, schema in schemas.items():
+        if isinstance(schema, type):
+            store.store(name=name, node=schema, provider="bionav")
+        else:  # a registration function: experiment_schema/<name>, hydra/launcher=submitit_slurm, ...
+            schema(store)
     names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
     for kind in registry.GROUPS:
         with warnings.catch_warnings():

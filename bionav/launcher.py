@@ -222,8 +222,11 @@ def _plain_launcher(state: dict) -> SlurmLauncher:
     return launcher
 
 
-def register() -> None:
-    """Store this launcher as ``hydra/launcher=submitit_slurm`` (after Hydra's own plugin registered it)."""
+def register(store=None) -> None:
+    """Store this launcher as ``hydra/launcher=submitit_slurm`` (after Hydra's own plugin registered it).
+
+    Called through the ``bionav.schemas`` entry point ``submitit_slurm`` with Hydra's ConfigStore.
+    """
     from hydra.core.config_store import ConfigStore
     from hydra.core.plugins import Plugins
 

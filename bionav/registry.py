@@ -35,6 +35,8 @@ GROUPS: dict[str, str] = {
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"
+#: entry-point group of structured config schemas (``name = "module:Dataclass"``) stored in Hydra's ConfigStore
+SCHEMA_GROUP = "bionav.schemas"
 
 
 class PluginWarning(UserWarning):
@@ -111,7 +113,7 @@ def _distribution_of(ep: importlib_metadata.EntryPoint) -> tuple[str, str]:
 @functools.cache
 def _all_entry_points() -> dict[str, tuple[importlib_metadata.EntryPoint, ...]]:
     eps = importlib_metadata.entry_points()
-    return {group: tuple(eps.select(group=group)) for group in (*GROUPS.values(), CONFIG_GROUP)}
+    return {group: tuple(eps.select(group=group)) for group in (*GROUPS.values(), CONFIG_GROUP, SCHEMA_GROUP)}
 
 
 def clear_cache() -> None:
@@ -256,4 +258,34 @@ def config_packages() -> list[tuple[str, str, str]]:
         dist, _ = _distribution_of(ep)
         out.append((ep.name, ep.value, dist))
     out.sort(key=lambda item: (item[0] != "bionav", item[0]))
+    return out
+
+
+def config_schemas() -> dict[str, Any]:
+    """Structured config schemas declared in ``bionav.schemas``: name -> dataclass or registration function.
+
+    A room that owns a config node registers its schema here (bionav's
+    ``db_schema`` is :class:`bionav.db.config.DatabaseConfig`; the experiment
+    schemas come from :func:`bionav.experiments.configs.register`), so the
+    Hydra wiring stores them without importing that room. An entry whose
+    optional dependency is not installed (e.g. the SLURM launcher without the
+    ``slurm`` extra) is skipped.
+    """
+    out: dict[str, Any] = {}
+    for ep in _all_entry_points()[SCHEMA_GROUP]:
+        if ep.name in out:
+            dist, _ = _distribution_of(ep)
+            raise PluginError(f"the config schema {ep.name!r} is declared twice (again by {dist}); uninstall one.")
+        try:
+            out[ep.name] = ep.load()
+        except ModuleNotFoundError as exc:
+            if exc.name and exc.name.split(".")[0] != "bionav":
+                continue  # it needs an optional dependency (an extra) that is not installed
+            dist, _ = _distribution_of(ep)
+            raise PluginError(f"the config schema {ep.name!r} of {dist} cannot be loaded ({exc}); "
+                              f"reinstall {dist}.") from None
+        except Exception as exc:  # a broken third-party schema
+            dist, _ = _distribution_of(ep)
+            raise PluginError(f"the config schema {ep.name!r} of {dist} cannot be loaded ({exc}); "
+                              f"reinstall {dist}.") from None
     return out

@@ -27,7 +27,7 @@ def test_fake_server_prints_one_override_per_device_and_stops_on_ctrl_c(scene, o
 
 
 def test_replay_of_a_missing_log_is_one_clear_error(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "bionav.robot.replay", str(tmp_path / "nowhere")],
+    proc = subprocess.run([sys.executable, "-m", "bionav.experiments.cleaning_replay", str(tmp_path / "nowhere")],
                           capture_output=True, text=True)
     assert proc.returncode == 2
     assert proc.stderr.startswith("error:") and "Traceback" not in proc.stderr

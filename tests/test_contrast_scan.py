@@ -7,8 +7,8 @@ from spectral_ctx import FakeContext
 
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import SkyState
+from bionav.plugins.sensors.fakes.spectral5 import FakeSpectral5
 from bionav.plugins.sensors.spectral5 import Spectral5Serial, Spectral5Sim
-from bionav.spectral.fake_device import FakeSpectral5
 from bionav.spectral.scan import DirectPanTilt, ScanGrid, feature_images, run_scan, stability_series
 from bionav.spectral.scene import backyard_scene
 from bionav.spectral.sensor_model import LogSensorModel

@@ -9,9 +9,9 @@ from bionav.db.compose import compose_database
 from bionav.db.database import ImageDatabase
 from bionav.db.export import export_database
 from bionav.db.loading import load_database
+from bionav.evaluation.agent import evaluate_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix
-from bionav.experiments.grid_homing import evaluate_agents
 from bionav.geometry import PanoramaGeometry
 
 

@@ -137,5 +137,5 @@ def test_oracle_cleaning_log_is_foxglove_valid(tmp_path):
     counts = check_foxglove_messages(run_dir / "run.mcap")
     assert counts.get("foxglove.PoseInFrame", 0) > 0
     assert "foxglove.RawImage" not in counts  # the oracle's pose vectors are no images
-    replay = run_bionav(str(run_dir), cwd=tmp_path, module="bionav.robot.replay")
+    replay = run_bionav(str(run_dir), cwd=tmp_path, module="bionav.experiments.cleaning_replay")
     assert replay.returncode == 0, replay.stderr

@@ -11,7 +11,7 @@ from omegaconf import OmegaConf
 from parameter_scene import render, ring_of_landmarks
 
 from bionav.db.database import ImageDatabase
-from bionav.evaluation.pairs import home_vector_matrix
+from bionav.evaluation.pairs import home_vector_matrix, neighbour_table
 from bionav.experiments import param_sweep
 from bionav.geometry import PanoramaGeometry
 from bionav.plugins.homing.parameter import Config, ParameterHoming
@@ -43,8 +43,8 @@ def test_vectorised_matrix_equals_per_pair_runner(small_db, name, gradient):
     homing = ParameterHoming(Config(signature=name, gradient=gradient, rings=3, bins=8), geometry=GEOM) if name in (
         "hist", "mean") else ParameterHoming(Config(signature=name, gradient=gradient), geometry=GEOM)
     prepared = [homing.prepare(img) for img in small_db.images]
-    fast = param_sweep.parameter_home_vector_matrix(homing, small_db, prepared)
-    slow = home_vector_matrix(homing, small_db, prepared=(prepared, prepared))
+    fast = home_vector_matrix(homing, small_db, prepared=(prepared, prepared))  # the batch path
+    slow = home_vector_matrix(homing, small_db, prepared=(prepared, prepared), batch=False)
     assert fast.n_pairs == slow.n_pairs == len(small_db) * (len(small_db) - 1)
     np.testing.assert_array_equal(np.isnan(fast.angles), np.isnan(slow.angles))
     ok = np.isfinite(slow.angles)
@@ -52,7 +52,7 @@ def test_vectorised_matrix_equals_per_pair_runner(small_db, name, gradient):
 
 
 def test_neighbour_table_with_missing_cell(small_db):
-    nb = param_sweep.neighbour_table(small_db)
+    nb = neighbour_table(small_db)
     i = small_db.index_of(2, 2)
     # (+1,0) -> (3,2); (-1,0) -> (1,2); (0,+1) -> (2,3) is missing; (0,-1) -> (2,1)
     assert list(nb[i]) == [small_db.index_of(3, 2), small_db.index_of(1, 2), -1, small_db.index_of(2, 1)]
@@ -178,15 +178,16 @@ def test_rotated_current_views_give_grid_frame_angles(small_db):
     )  # fmt: skip
     for name, gradient in (("mffc_abs", "matched_filter"), ("fc_abs", "test_steps"), ("hist", "test_steps")):
         homing = ParameterHoming(Config(signature=name, gradient=gradient, rings=3, bins=8), geometry=GEOM)
-        aligned = param_sweep.parameter_home_vector_matrix(homing, small_db, [homing.prepare(i) for i in small_db.images])
+        p0 = [homing.prepare(i) for i in small_db.images]
+        aligned = home_vector_matrix(homing, small_db, prepared=(p0, p0))
         prep = [homing.prepare(i) for i in rotated.images]
-        turned = param_sweep.parameter_home_vector_matrix(homing, rotated, prep)
+        turned = home_vector_matrix(homing, rotated, prepared=(prep, prep))
         ok = np.isfinite(aligned.angles)
         np.testing.assert_array_equal(ok, np.isfinite(turned.angles))
         diff = np.abs(np.angle(np.exp(1j * (aligned.angles[ok] - turned.angles[ok]))))
         assert diff.max() < 1e-6, (name, diff.max())
         if gradient == "test_steps":
-            nb = param_sweep.neighbour_table(rotated)
+            nb = neighbour_table(rotated)
             s, c = 0, rotated.index_of(2, 2)
             offsets = {}
             for (dx, dy), j in zip(((1, 0), (-1, 0), (0, 1), (0, -1)), nb[c]):

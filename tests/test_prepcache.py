@@ -9,7 +9,7 @@ import numpy as np
 from bionav.evaluation.prepcache import PreparedCache
 from bionav.evaluation.prepcache import prepared_key as cache_key
 from bionav.geometry import PanoramaGeometry
-from bionav.homing.sift_homing import SiftFeatures
+from bionav.homing.features import SiftFeatures
 
 
 @dataclass

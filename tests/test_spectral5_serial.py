@@ -4,14 +4,10 @@ import numpy as np
 import pytest
 
 from bionav.errors import DeviceError
-from bionav.plugins.sensors.spectral5 import (
-    Spectral5Serial,
-    Spectral5Sim,
-    reading_counts,
-    reading_message,
-)
+from bionav.plugins.sensors.fakes.spectral5 import FakeSpectral5
+from bionav.plugins.sensors.spectral5 import Spectral5Serial, Spectral5Sim
 from bionav.spectral import protocol
-from bionav.spectral.fake_device import FakeSpectral5
+from bionav.spectral.protocol import reading_counts, reading_message
 
 
 def _driver(port, **kw):

@@ -68,14 +68,16 @@ def test_hiss_points_home_without_a_compass(views):
 
 def test_hiss_signs_on_hand_made_features():
     # one landmark straight ahead (column 0) that shrank: home is ahead
-    feats = lambda size: {  # noqa: E731
-        "x": np.array([0.0, 30.0], np.float32),
-        "y": np.zeros(2, np.float32),
-        "size": np.array([size, 5.0], np.float32),
-        "desc": np.eye(2, 128, dtype=np.float32) * 100,
-        "width": np.int64(120),
-    }
+    from bionav.homing.features import SiftFeatures
     from bionav.homing.hiss import hiss
+
+    feats = lambda size: SiftFeatures(  # noqa: E731
+        xy=np.array([[0.0, 0.0], [30.0, 0.0]], np.float32),
+        descriptors=np.eye(2, 128, dtype=np.float32) * 100,
+        sq_norms=np.full(2, 1e4, np.float32),
+        size=np.array([size, 5.0], np.float32),
+        width=np.array(120, np.int64),
+    )
 
     r = hiss(feats(8.0), feats(4.0), scale_threshold=0.1)  # second keypoint unchanged: ignored
     assert (r.n_contracted, r.n_expanded) == (1, 0) and abs(r.home_angle) < 1e-9

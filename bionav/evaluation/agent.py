@@ -106,3 +106,37 @@ def run_agents(
                 paths[i].append(p[i].copy())
     result = AgentResult(success=success, steps=steps)
     return result, None if paths is None else [np.array(path) for path in paths]
+
+
+def evaluate_agents(db, hv, *, step_length: float, success_radius: float, record=frozenset()):
+    """Agent trials from every existing cell towards every evaluated snapshot of an all-pairs run.
+
+    Parameters
+    ----------
+    db : ImageDatabase
+        The database of the current views (positions and grid shape).
+    hv : HomeVectorMatrix
+        Result of :func:`bionav.evaluation.pairs.home_vector_matrix` (grid-frame angles).
+    step_length, success_radius : float
+        Grid units (thesis 3.2.3: 0.5 and 1).
+    record : set of int
+        Rows of ``hv`` whose agent paths are returned.
+
+    Returns
+    -------
+    success : ndarray of bool, shape (S, C)
+    paths : dict
+        Row -> agent paths (see :func:`run_agents`) for the recorded rows.
+    """
+    success = np.zeros(hv.angles.shape, dtype=bool)
+    paths = {}
+    for row, si in enumerate(hv.snapshot_index):
+        result, p = run_agents(
+            hv.angles[row], db.positions, db.positions[si], db.positions,
+            grid_shape=db.grid_shape, step_length=step_length, success_radius=success_radius,
+            record_paths=row in record,
+        )
+        success[row] = result.success
+        if p is not None:
+            paths[row] = p
+    return success, paths

@@ -1,4 +1,4 @@
-"""All-pairs home-vector computation: per-image work once, pairs on all cores."""
+"""The one all-pairs runner: per-image work once, then a method's batch path or pairs on all cores."""
 
 from __future__ import annotations
 
@@ -59,6 +59,25 @@ class HomeVectorMatrix:
         return 1e3 * (self.prepare_s + self.pairs_s) / max(self.n_pairs, 1)
 
 
+def neighbour_table(db: ImageDatabase) -> np.ndarray:
+    """Index of each cell's grid neighbours at :data:`NEIGHBOUR_OFFSETS`; -1 where missing.
+
+    Returns
+    -------
+    ndarray of int, shape (N, 4)
+        Columns: offsets ``(+1, 0), (-1, 0), (0, +1), (0, -1)`` in the grid frame.
+    """
+    lut = db.cell_index_map()
+    nx, ny = db.grid_shape
+    out = np.full((len(db), len(NEIGHBOUR_OFFSETS)), -1, dtype=np.int64)
+    for k, (dx, dy) in enumerate(NEIGHBOUR_OFFSETS):
+        x = db.positions[:, 0] + dx
+        y = db.positions[:, 1] + dy
+        ok = (x >= 0) & (x < nx) & (y >= 0) & (y < ny)
+        out[ok, k] = lut[x[ok], y[ok]]
+    return out
+
+
 def prepare_images(
     method: HomingMethod,
     images: Sequence[np.ndarray],
@@ -89,6 +108,7 @@ def home_vector_matrix(
     prepared: tuple[list[Any], list[Any]] | None = None,
     cache: Any = None,
     on_row: Callable[[int, np.ndarray, np.ndarray], None] | None = None,
+    batch: bool = True,
 ) -> HomeVectorMatrix:
     """Home vectors from every current view to every (selected) snapshot.
 
@@ -117,6 +137,10 @@ def home_vector_matrix(
         ``snapshot`` is its index into ``snapshots``, ``angles`` and
         ``compass`` have shape (C,), radians in the grid frame (NaN: none).
         Experiments log rows here, so a crash loses no finished row.
+    batch : bool
+        Use the method's batch path (:meth:`HomingMethod.all_pairs_angles`)
+        when it has one and snapshots and current views are one database;
+        ``False`` forces the per-pair calls.
 
     Returns
     -------
@@ -137,6 +161,21 @@ def home_vector_matrix(
     else:
         snap_prep, cur_prep = prepared
     t1 = time.perf_counter()
+
+    n_pairs = int(np.sum(~np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)))
+    all_pairs = None
+    if batch and same:
+        all_pairs = method.all_pairs_angles(cur_prep, headings=currents.headings, neighbours=neighbour_table(currents))
+    if all_pairs is not None:
+        angles = np.array(all_pairs, dtype=np.float64)[s_idx]
+        angles[np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)] = np.nan
+        t2 = time.perf_counter()
+        if on_row is not None:
+            no_compass = np.full(len(currents), np.nan)
+            for row_angles, si in zip(angles, s_idx):
+                on_row(int(si), row_angles, no_compass)
+        return HomeVectorMatrix(snapshot_index=s_idx, angles=angles, compass_error=None, prepare_s=t1 - t0,
+                                pairs_s=t2 - t1, n_pairs=n_pairs, prepared_stats=_prepared_stats(method, cur_prep))
 
     lut = currents.cell_index_map()
     nx, ny = currents.grid_shape
@@ -176,10 +215,7 @@ def home_vector_matrix(
 
     angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))
     compass = np.array([r[1] for r in rows]).reshape(len(s_idx), len(currents))
-    n_pairs = int(np.sum(~np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)))
     has_compass = bool(np.any(np.isfinite(compass)))
-    described = [method.describe_prepared(p) for p in cur_prep]
-    stats = {k: float(np.mean([d[k] for d in described])) for k in (described[0] if described else {})}
     return HomeVectorMatrix(
         snapshot_index=s_idx,
         angles=angles,
@@ -187,5 +223,11 @@ def home_vector_matrix(
         prepare_s=t1 - t0,
         pairs_s=t2 - t1,
         n_pairs=n_pairs,
-        prepared_stats=stats,
+        prepared_stats=_prepared_stats(method, cur_prep),
     )
+
+
+def _prepared_stats(method: HomingMethod, prepared: Sequence[Any]) -> dict[str, float]:
+    """Means over the images of :meth:`HomingMethod.describe_prepared` (e.g. keypoints per image)."""
+    described = [method.describe_prepared(p) for p in prepared]
+    return {k: float(np.mean([d[k] for d in described])) for k in (described[0] if described else {})}

@@ -17,61 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from bionav.errors import UserError
+from bionav.experiments.common import _get, load_samples
 from bionav.experiments.configs import experiment_config
 
 #: Names ``data=`` accepts.
 DATASETS = ("sim_natural", "sim_artificial", "csv")
-
-
-def _get(node, key, default=None):
-    try:
-        value = node.get(key, default) if hasattr(node, "get") else getattr(node, key, default)
-    except Exception:  # omegaconf missing value
-        return default
-    return default if value is None else value
-
-
-def load_samples(data):
-    """The sample set a ``data`` config node names.
-
-    Parameters
-    ----------
-    data : mapping
-        ``name`` (``sim_natural``, ``sim_artificial`` or ``csv``) and its
-        options: ``seed``, ``n_objects``, ``n_sky``, ``n_average``,
-        ``noise_counts`` for the simulated sets; ``path`` for ``csv``.
-
-    Returns
-    -------
-    SampleSet
-    """
-    from bionav.spectral.sensor_model import LogSensorModel
-
-    name = str(_get(data, "name", ""))
-    if name == "csv":
-        path = _get(data, "path")
-        if not path or str(path) == "???":
-            raise UserError("data=csv needs the file: add data.path=/path/to/samples.csv (columns class,UV,B,G,R,IR, "
-                            "optional kind,time).")
-        from bionav.spectral.csv_io import read_samples_csv
-
-        try:
-            from hydra.utils import to_absolute_path
-
-            path = to_absolute_path(str(path))
-        except Exception:
-            pass
-        return read_samples_csv(path)
-    if name in ("sim_natural", "sim_artificial"):
-        from bionav.spectral import samples as sim
-
-        sensor = LogSensorModel(noise_counts=float(_get(data, "noise_counts", 4.0)))
-        default_objects = 239 if name == "sim_natural" else 124
-        fn = sim.sim_natural if name == "sim_natural" else sim.sim_artificial
-        return fn(seed=int(_get(data, "seed", 0)), n_objects=int(_get(data, "n_objects", default_objects)),
-                  n_sky=int(_get(data, "n_sky", 233)), sensor=sensor, n_average=int(_get(data, "n_average", 10)))
-    raise UserError(f"Unknown data set {name!r} for experiment=contrast_lda. Choose data=sim_natural, "
-                    f"data=sim_artificial, or data=csv data.path=FILE.")
 
 
 def analyse(samples, *, sigma: float, n_resamples: int, rng: np.random.Generator, out_dir, plots_dir,

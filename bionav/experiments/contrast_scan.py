@@ -27,8 +27,8 @@ import datetime as _dt
 import numpy as np
 
 from bionav.errors import UserError
+from bionav.experiments.common import _get, load_samples
 from bionav.experiments.configs import experiment_config
-from bionav.experiments.contrast_lda import _get, load_samples
 from bionav.light.sun import parse_time
 
 SCAN_TOPIC = "/contrast_scan/scan"
@@ -55,14 +55,6 @@ def _per_scan(value, k, n, what):
         raise UserError(f"experiment.{what} has {len(v)} entries but experiment.times has {n}; give one value or "
                         f"one per scan.")
     return float(v[k])
-
-
-def learn_discriminants(node, *, sigma: float) -> dict:
-    """``J_sigma`` discriminants per feature learned on the labelled samples a ``data`` node names."""
-    from bionav.spectral.lda_analysis import analyse_features
-
-    samples = load_samples(node)
-    return {n: r.lda_sigma for n, r in analyse_features(samples, sigma=sigma).items()}
 
 
 def run(cfg, ctx) -> dict:
@@ -160,13 +152,13 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     import csv
 
     from bionav.light.bands import CHANNELS, dual_contrasts
+    from bionav.spectral.lda_analysis import learn_discriminants
     from bionav.spectral.scan import separation_images, stability_series
     from bionav.spectral.stability import MEASURES
 
     exp = experiment_config(cfg, "contrast_scan")
     sigma = float(exp.sigma)
-    learn = exp.learn
-    disc = learn_discriminants(learn, sigma=sigma)
+    disc = learn_discriminants(load_samples(exp.learn), sigma=sigma)
     names = list(CHANNELS) + list(dual_contrasts())
     np.savez_compressed(ctx.dir / "scans.npz", counts=scans, times=np.array([t.isoformat() for t in times]),
                         pans=grid.pans, tilts=grid.tilts)

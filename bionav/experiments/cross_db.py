@@ -15,11 +15,11 @@ import yaml
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
+from bionav.evaluation.agent import evaluate_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix, prepare_images
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
 from bionav.experiments.configs import experiment_config
-from bionav.experiments.grid_homing import evaluate_agents
 from bionav.report.figures import pyplot, save_figure
 
 #: settings of cfg.db that apply to every member of the family

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from omegaconf import DictConfig
 
-from bionav.evaluation.agent import run_agents
+from bionav.evaluation.agent import evaluate_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
@@ -45,22 +45,6 @@ HOME_VECTOR_ROW_SCHEMA = {
 
 def _finite_or_none(values) -> list[float | None]:
     return [float(a) if np.isfinite(a) else None for a in np.asarray(values, dtype=float)]
-
-
-def evaluate_agents(db, hv, *, step_length: float, success_radius: float, record: set[int] = frozenset()):
-    """Agent trials from every existing cell towards every evaluated snapshot."""
-    success = np.zeros(hv.angles.shape, dtype=bool)
-    paths = {}
-    for row, si in enumerate(hv.snapshot_index):
-        result, p = run_agents(
-            hv.angles[row], db.positions, db.positions[si], db.positions,
-            grid_shape=db.grid_shape, step_length=step_length, success_radius=success_radius,
-            record_paths=row in record,
-        )
-        success[row] = result.success
-        if p is not None:
-            paths[row] = p
-    return success, paths
 
 
 def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:

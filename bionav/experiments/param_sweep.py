@@ -9,8 +9,9 @@ size x preprocessing (x database) is declared in ``bionav/conf/experiment/param_
 
 For every configuration the signatures are computed once per image
 (:meth:`ParameterHoming.prepare`), the home vectors of all pairs come from
-matrix operations on them (:func:`parameter_home_vector_matrix`, identical to
-the per-pair :meth:`ParameterHoming.home_vector`), and AAE*, MAE*, RR* follow
+matrix operations on them (:meth:`ParameterHoming.all_pairs_angles`, the
+batch path of the all-pairs runner, identical to the per-pair
+:meth:`ParameterHoming.home_vector`), and AAE*, MAE*, RR* follow
 thesis 3.2 (:mod:`bionav.evaluation`).
 
 Files in the run directory
@@ -40,9 +41,8 @@ from omegaconf import DictConfig, OmegaConf
 
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
-from bionav.evaluation.pairs import NEIGHBOUR_OFFSETS, HomeVectorMatrix
+from bionav.evaluation.pairs import home_vector_matrix
 from bionav.experiments.configs import experiment_config
-from bionav.geometry import wrap_angle
 from bionav.report.figures import pyplot, save_figure
 
 ROWS_FILE = "param_sweep.jsonl"
@@ -77,87 +77,12 @@ def sweep_levels(signature_cls: type, *, rings: Sequence[int], n_coeffs: Sequenc
     return [{}]
 
 
-def neighbour_table(db: ImageDatabase) -> np.ndarray:
-    """Index of each cell's grid neighbours at offsets ``(+1,0), (-1,0), (0,+1), (0,-1)``; -1 where missing.
-
-    Returns
-    -------
-    ndarray of int, shape (N, 4)
-    """
-    lut = db.cell_index_map()
-    nx, ny = db.grid_shape
-    out = np.full((len(db), len(NEIGHBOUR_OFFSETS)), -1, dtype=np.int64)
-    for k, (dx, dy) in enumerate(NEIGHBOUR_OFFSETS):
-        x = db.positions[:, 0] + dx
-        y = db.positions[:, 1] + dy
-        ok = (x >= 0) & (x < nx) & (y >= 0) & (y < ny)
-        out[ok, k] = lut[x[ok], y[ok]]
-    return out
-
-
-def parameter_home_vector_matrix(homing, db: ImageDatabase, prepared: Sequence[dict]) -> HomeVectorMatrix:
-    """Home vectors of all pairs of a database for a :class:`ParameterHoming` (vectorised).
-
-    The same angles as calling ``homing.home_vector`` pair by pair (as
-    :func:`bionav.evaluation.pairs.home_vector_matrix` does) -- grid-frame
-    angles, NaN on the snapshot's own cell and where the gradient vanishes --
-    computed with matrix operations on the prepared signatures. The test steps
-    are the four grid neighbours, so their gradient is in the grid frame; the
-    matched filter's gradient is in the current view's frame and is turned by
-    the current view's heading. (For rotated current views this equals the
-    per-pair call with the neighbour offsets expressed in the current view's
-    frame, as :meth:`HomingMethod.home_vector` specifies.)
-
-    Parameters
-    ----------
-    homing : ParameterHoming
-    db : ImageDatabase
-        Snapshots and current views.
-    prepared : sequence of dict
-        ``homing.prepare(image)`` of every image of ``db``.
-
-    Returns
-    -------
-    HomeVectorMatrix
-        ``prepare_s`` is 0 (the caller times the per-image work).
-    """
-    from bionav.homing import parameter as ph
-
-    t0 = time.perf_counter()
-    f = np.stack([p["f"] for p in prepared])
-    if homing.gradient == "test_steps":
-        grad = ph.gradient_matrix_from_test_steps(ph.potential_matrix(f, f), neighbour_table(db))
-    else:
-        dfx = np.stack([p["df_dx"] for p in prepared])
-        dfy = np.stack([p["df_dy"] for p in prepared])
-        grad = ph.matched_filter_gradient_matrix(f, f, dfx, dfy)
-    hx, hy = -grad[..., 0], -grad[..., 1]
-    with np.errstate(invalid="ignore"):
-        angles = np.arctan2(hy, hx)
-    angles[(hx == 0) & (hy == 0)] = np.nan
-    angles[~(np.isfinite(hx) & np.isfinite(hy))] = np.nan
-    if homing.gradient != "test_steps":
-        # flow templates live in the current view's own frame; test steps are taken along the
-        # grid axes, so their gradient is already in the grid frame
-        angles = angles + db.headings[None, :]
-    angles = wrap_angle(angles)
-    same = np.all(db.positions[:, None, :] == db.positions[None, :, :], axis=2)
-    angles[same] = np.nan
-    return HomeVectorMatrix(
-        snapshot_index=np.arange(len(db)),
-        angles=angles,
-        compass_error=None,
-        prepare_s=0.0,
-        pairs_s=time.perf_counter() - t0,
-        n_pairs=int(np.sum(~same)),
-    )
-
-
 def evaluate_configuration(homing, db: ImageDatabase, *, step_length: float = 0.5, success_radius: float = 1.0):
     """AAE*/MAE*/RR* of one parameter-homing configuration on one database.
 
-    Signatures are computed once per image; home vectors of all pairs by
-    :func:`parameter_home_vector_matrix`; agents and measures as thesis 3.2.
+    Signatures are computed once per image; home vectors of all pairs by the
+    all-pairs runner through the method's batch path
+    (:meth:`ParameterHoming.all_pairs_angles`); agents and measures as thesis 3.2.
 
     Returns
     -------
@@ -165,14 +90,14 @@ def evaluate_configuration(homing, db: ImageDatabase, *, step_length: float = 0.
     hv : HomeVectorMatrix
         With ``prepare_s`` set to the per-image time.
     """
+    from bionav.evaluation.agent import evaluate_agents
     from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
-    from bionav.experiments.grid_homing import evaluate_agents
 
     t0 = time.perf_counter()
     use_raw = db.raw is not None and getattr(homing.signature, "uses_raw", False)
     prepared = [homing.prepare(img, raw=db.raw(i) if use_raw else None) for i, img in enumerate(db.images)]
     prepare_s = time.perf_counter() - t0
-    hv = parameter_home_vector_matrix(homing, db, prepared)
+    hv = home_vector_matrix(homing, db, prepared=(prepared, prepared))
     hv = dataclasses.replace(hv, prepare_s=prepare_s)
     ae = angular_errors(hv.angles, ideal_home_angles(db.positions, db.positions))
     success, _ = evaluate_agents(db, hv, step_length=step_length, success_radius=success_radius)

@@ -51,6 +51,8 @@ from bionav.experiments.pol_compass_session import (
     sky_model,
     start_fakes,
 )
+from bionav.polcompass.compass import evectors_from_counts
+from bionav.polcompass.headings import pose_headings
 
 MODES = ("filter_test", "rotation", "vs_em_compass", "evector_scan", "partial_sky")
 
@@ -61,63 +63,6 @@ MODES = ("filter_test", "rotation", "vs_em_compass", "evector_scan", "partial_sk
 def counts_of(readings: list[dict]) -> np.ndarray:
     """ADC counts of recorded compass readings, shape ``(N, K)``."""
     return np.asarray([r["counts"] for r in readings], dtype=float)
-
-
-def evectors_from_counts(counts, calibration, *, solver: str = "least_squares"):
-    """E-vector angle, degree and delogarithmised unit outputs from ADC counts.
-
-    Parameters
-    ----------
-    counts : ndarray, shape ``(N, K)``
-        10-bit counts (``V = count * 5 / 1023``).
-    calibration : UnitCalibration
-    solver : {'least_squares', 'two_unit'}
-        Three-unit least squares, or eqs. 4.4-4.5 on the first two units.
-
-    Returns
-    -------
-    angle : ndarray, shape ``(N,)``
-        E-vector angle in the sensor frame, radians ``[-pi/2, pi/2)``.
-    degree : ndarray, shape ``(N,)``
-    x : ndarray, shape ``(N, K)``
-    """
-    from bionav.polcompass import (
-        counts_to_volts,
-        delogarithmise,
-        least_squares_evector,
-        two_unit_evector,
-        volts_to_decades,
-    )
-
-    volts = counts_to_volts(counts)
-    x = delogarithmise(volts_to_decades(volts, center_v=calibration.center_v, volts_per_decade=calibration.volts_per_decade))
-    if solver == "least_squares":
-        angle, degree = least_squares_evector(x, calibration.unit_angles)
-    elif solver == "two_unit":
-        angle, degree = two_unit_evector(x[:, 0], x[:, 1], calibration.unit_angles[0], calibration.unit_angles[1])
-    else:
-        raise UserError(f"experiment.solver={solver!r} is unknown; choose least_squares or two_unit.")
-    return angle, degree, x
-
-
-def pose_headings(angle, x, tilts, *, sun, predictor, unit_angles, margin):
-    """Sensor heading of every reading; tilted readings resolved by the error function.
-
-    Returns
-    -------
-    heading : ndarray, shape ``(N,)``
-        Radians CCW from east (for zenith readings: the candidate in
-        ``[-pi, pi)`` of eq. 4.6's pair).
-    resolved : ndarray of bool, shape ``(N,)``
-    """
-    from bionav.polcompass import solve_pose, zenith_heading
-
-    heading = np.asarray(zenith_heading(angle, sun_azimuth=sun.azimuth), float)
-    resolved = np.zeros(heading.shape, dtype=bool)
-    for i in np.flatnonzero(np.abs(tilts) > 1e-12):
-        sol = solve_pose(x[i], float(angle[i]), float(tilts[i]), predictor=predictor, unit_angles=unit_angles, margin=margin)
-        heading[i], resolved[i] = sol.heading, sol.resolved
-    return heading, resolved
 
 
 def summarize(errors, *, axial: bool, n: int) -> dict[str, Any]:

@@ -24,9 +24,8 @@ import csv
 import numpy as np
 
 from bionav.errors import UserError
+from bionav.experiments.common import _get, load_samples
 from bionav.experiments.configs import experiment_config
-from bionav.experiments.contrast_lda import _get
-from bionav.experiments.contrast_scan import learn_discriminants
 from bionav.light.sun import parse_time
 from bionav.report.figures import pyplot, save_figure
 
@@ -112,13 +111,14 @@ def render_campus_counts(world, geometry, cells, *, sensor_model, rng, progress=
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
     from bionav.db.database import ImageDatabase
+    from bionav.evaluation.agent import evaluate_agents
     from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
     from bionav.evaluation.pairs import home_vector_matrix, prepare_images
     from bionav.experiments.common import make_homing
-    from bionav.experiments.grid_homing import evaluate_agents
     from bionav.geometry import PanoramaGeometry
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
+    from bionav.spectral.lda_analysis import learn_discriminants
     from bionav.spectral.representations import check_representation, representation_image
     from bionav.spectral.scene import garden_scene
     from bionav.spectral.sensor_model import LogSensorModel
@@ -147,8 +147,7 @@ def run(cfg, ctx) -> dict:
     seed = int(exp.world_seed)
     extent = max(nx - 1, ny - 1) * spacing
     sensor_model = LogSensorModel(noise_counts=float(exp.noise_counts))
-    disc = learn_discriminants(exp.learn,
-                               sigma=float(exp.sigma))
+    disc = learn_discriminants(load_samples(exp.learn), sigma=float(exp.sigma))
 
     gx, gy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     positions = np.c_[gx.ravel(), gy.ravel()]

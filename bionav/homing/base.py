@@ -117,3 +117,30 @@ class HomingMethod:
         HomeVector
         """
         raise NotImplementedError
+
+    def all_pairs_angles(self, prepared, *, headings: np.ndarray, neighbours: np.ndarray) -> np.ndarray | None:
+        """Optional batch path: home angles of every pair of one database at once.
+
+        The all-pairs runner (:func:`bionav.evaluation.pairs.home_vector_matrix`)
+        uses it when snapshots and current views come from one database; it
+        must give the same angles as :meth:`home_vector` pair by pair.
+
+        Parameters
+        ----------
+        prepared : sequence
+            :meth:`prepare` of every image of the database, length ``N``.
+        headings : ndarray, shape (N,)
+            Heading of every view in the grid frame (radians CCW).
+        neighbours : ndarray of int, shape (N, 4)
+            Index of each cell's grid neighbours at offsets ``(+1, 0), (-1, 0),
+            (0, +1), (0, -1)`` (-1 where missing), see
+            :func:`bionav.evaluation.pairs.neighbour_table`.
+
+        Returns
+        -------
+        ndarray, shape (N, N), or None
+            ``[s, c]``: home direction from current view ``c`` to snapshot ``s``
+            in the *grid frame* (radians CCW; NaN where the method gives none);
+            ``None`` (the default) when the method has no batch path.
+        """
+        return None

@@ -16,70 +16,13 @@ keypoints. IJCV 60(2), 91-110. doi:10.1023/B:VISI.0000029664.99615.94
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from bionav.geometry import TWO_PI, PanoramaGeometry, wrap_angle
+from bionav.homing.features import SiftFeatures
 
 #: keypoints whose snapshot elevation is at most this (radians) are ignored (thesis 5.1.2)
 MIN_ELEVATION = 0.01
-
-
-@dataclass(frozen=True)
-class SiftFeatures:
-    """Keypoints of one panorama.
-
-    Attributes
-    ----------
-    xy : ndarray, shape (N, 2), float32
-        Pixel coordinates (column, row) of the keypoints.
-    descriptors : ndarray, shape (N, 128), float32
-        SIFT descriptors.
-    sq_norms : ndarray, shape (N,), float32
-        Squared descriptor norms (for fast distance matrices).
-    """
-
-    xy: np.ndarray
-    descriptors: np.ndarray
-    sq_norms: np.ndarray
-
-
-def sift_features(
-    image: np.ndarray,
-    *,
-    n_features: int = 0,
-    contrast_threshold: float = 0.04,
-    edge_threshold: float = 10.0,
-    sigma: float = 1.6,
-    n_octave_layers: int = 3,
-) -> SiftFeatures:
-    """Detect OpenCV SIFT keypoints and descriptors in a panorama.
-
-    Parameters
-    ----------
-    image : ndarray, shape (H, W), float in [0, 1] or uint8
-        Canonical panorama.
-    n_features, contrast_threshold, edge_threshold, sigma, n_octave_layers
-        Passed to ``cv2.SIFT_create``.
-    """
-    import cv2
-
-    img = image if image.dtype == np.uint8 else np.clip(np.rint(image * 255.0), 0, 255).astype(np.uint8)
-    sift = cv2.SIFT_create(
-        nfeatures=n_features,
-        nOctaveLayers=n_octave_layers,
-        contrastThreshold=contrast_threshold,
-        edgeThreshold=edge_threshold,
-        sigma=sigma,
-    )
-    keypoints, descriptors = sift.detectAndCompute(img, None)
-    if descriptors is None or len(keypoints) == 0:
-        empty = np.zeros((0, 2), np.float32)
-        return SiftFeatures(empty, np.zeros((0, 128), np.float32), np.zeros(0, np.float32))
-    xy = np.array([kp.pt for kp in keypoints], dtype=np.float32)
-    descriptors = descriptors.astype(np.float32)
-    return SiftFeatures(xy, descriptors, np.einsum("ij,ij->i", descriptors, descriptors))
 
 
 def match_in_neighbourhood(

@@ -6,6 +6,7 @@ from bionav.polcompass.compass import (
     candidate_pair,
     choose_candidate,
     delogarithmise,
+    evectors_from_counts,
     heading_errors,
     least_squares_evector,
     two_unit_evector,
@@ -20,7 +21,7 @@ from bionav.polcompass.electronics import (
     log_ratio_voltage,
     sample_mismatch,
 )
-from bionav.polcompass.headings import EvectorPredictor, fit_scan_heading, solve_pose
+from bionav.polcompass.headings import EvectorPredictor, fit_scan_heading, pose_headings, solve_pose
 from bionav.polcompass.optics import CompassOptics, cone_samples, sensor_frame
 from bionav.polcompass.simulation import CompassScene, SimulatedCompassHardware
 
@@ -40,10 +41,12 @@ __all__ = [
     "cone_samples",
     "counts_to_volts",
     "delogarithmise",
+    "evectors_from_counts",
     "fit_scan_heading",
     "heading_errors",
     "least_squares_evector",
     "log_ratio_voltage",
+    "pose_headings",
     "sample_mismatch",
     "sensor_frame",
     "solve_pose",

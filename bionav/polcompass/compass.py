@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bionav.errors import UserError
 from bionav.geometry import wrap_angle, wrap_axial
 
 
@@ -232,3 +233,34 @@ def heading_errors(estimated, reference, *, axial: bool, remove_offset: bool = T
     offset = float(np.angle(np.mean(np.exp(1j * k * diff))) / k) if remove_offset and diff.size else 0.0
     errors = wrap_axial(diff - offset) if axial else wrap_angle(diff - offset)
     return HeadingErrors(np.asarray(errors, float), offset, axial)
+
+
+def evectors_from_counts(counts, calibration, *, solver: str = "least_squares"):
+    """E-vector angle, degree and delogarithmised unit outputs from ADC counts (thesis 4.1).
+
+    Parameters
+    ----------
+    counts : ndarray, shape ``(N, K)``
+        10-bit counts (``V = count * 5 / 1023``).
+    calibration : UnitCalibration
+    solver : {'least_squares', 'two_unit'}
+        Three-unit least squares, or eqs. 4.4-4.5 on the first two units.
+
+    Returns
+    -------
+    angle : ndarray, shape ``(N,)``
+        E-vector angle in the sensor frame, radians ``[-pi/2, pi/2)``.
+    degree : ndarray, shape ``(N,)``
+    x : ndarray, shape ``(N, K)``
+    """
+    from bionav.polcompass.electronics import counts_to_volts
+
+    volts = counts_to_volts(counts)
+    x = delogarithmise(volts_to_decades(volts, center_v=calibration.center_v, volts_per_decade=calibration.volts_per_decade))
+    if solver == "least_squares":
+        angle, degree = least_squares_evector(x, calibration.unit_angles)
+    elif solver == "two_unit":
+        angle, degree = two_unit_evector(x[:, 0], x[:, 1], calibration.unit_angles[0], calibration.unit_angles[1])
+    else:
+        raise UserError(f"experiment.solver={solver!r} is unknown; choose least_squares or two_unit.")
+    return angle, degree, x

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bionav.geometry import wrap_angle, wrap_axial
-from bionav.polcompass.compass import choose_candidate
+from bionav.polcompass.compass import choose_candidate, zenith_heading
 from bionav.polcompass.optics import CompassOptics
 
 
@@ -274,3 +274,35 @@ def fit_scan_heading(
     if e_alt < e_best:
         h_best, e_best, h_alt, e_alt = h_alt, e_alt, h_best, e_best
     return ScanFit(h_best, h_alt, e_best, e_alt, bool(e_alt - e_best > margin), int(use.sum()))
+
+
+def pose_headings(angle, x, tilts, *, sun, predictor, unit_angles, margin):
+    """Sensor heading of every reading; tilted readings resolved by the error function (thesis 4.2.3).
+
+    Parameters
+    ----------
+    angle : ndarray, shape ``(N,)``
+        E-vector angles in the sensor frame (radians).
+    x : ndarray, shape ``(N, K)``
+        Delogarithmised unit outputs.
+    tilts : ndarray, shape ``(N,)``
+        Sensor tilt of every reading (radians; 0 at the zenith).
+    sun : SunPosition
+    predictor : EvectorPredictor
+    unit_angles : ndarray, shape ``(K,)``
+    margin : float
+        See :func:`solve_pose`.
+
+    Returns
+    -------
+    heading : ndarray, shape ``(N,)``
+        Radians CCW from east (for zenith readings: the candidate in
+        ``[-pi, pi)`` of eq. 4.6's pair).
+    resolved : ndarray of bool, shape ``(N,)``
+    """
+    heading = np.asarray(zenith_heading(angle, sun_azimuth=sun.azimuth), float)
+    resolved = np.zeros(heading.shape, dtype=bool)
+    for i in np.flatnonzero(np.abs(tilts) > 1e-12):
+        sol = solve_pose(x[i], float(angle[i]), float(tilts[i]), predictor=predictor, unit_angles=unit_angles, margin=margin)
+        heading[i], resolved[i] = sol.heading, sol.resolved
+    return heading, resolved

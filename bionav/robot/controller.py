@@ -3,7 +3,7 @@
 A controller is a ``bionav.controllers`` plugin. It sees only what a real
 robot's computer sees and emits wheel commands, so the same object can drive
 the simulator (:mod:`bionav.robot.simulator`), a replayed log
-(:mod:`bionav.robot.replay`) or real hardware:
+(:mod:`bionav.experiments.cleaning_replay`) or real hardware:
 
 * :class:`Observation` (one per control tick): the time, the odometry pose
   (dead reckoning from the wheel encoders, frame fixed at the start of the

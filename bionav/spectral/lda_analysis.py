@@ -127,6 +127,25 @@ class Significance:
         return rows
 
 
+def learn_discriminants(samples: SampleSet, *, sigma: float = 30.0) -> dict:
+    """The ``J_sigma`` discriminant of every feature, learned on a labelled sample set.
+
+    Parameters
+    ----------
+    samples : SampleSet
+        Labelled sky and object samples.
+    sigma : float
+        Receptor noise (counts) of the noise-aware Fisher criterion.
+
+    Returns
+    -------
+    dict
+        Feature name (:func:`~bionav.light.bands.feature_subsets`) -> its
+        ``lda_sigma`` discriminant (:class:`FeatureResult`).
+    """
+    return {n: r.lda_sigma for n, r in analyse_features(samples, sigma=sigma).items()}
+
+
 def bootstrap_significance(samples: SampleSet, results: dict[str, FeatureResult], *, sigma: float = 30.0,
                            n_resamples: int = 10_000, rng: np.random.Generator) -> dict[str, Significance]:
     """Pairwise bootstrap significance of J, J_sigma and n_f between all features.

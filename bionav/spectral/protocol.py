@@ -45,6 +45,8 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
+
 #: Default serial settings: baud rate, data bits, parity, stop bits.
 BAUDRATE = 9600
 BYTESIZE = 8
@@ -99,3 +101,30 @@ def parse_reading(line: bytes) -> tuple[int, int, int, int, int, int]:
 def format_reading(values) -> bytes:
     """Encode ``(uv, b, g, r, ir, ref)`` as one reply line with ``\\r\\n``."""
     return (",".join(str(int(v)) for v in values) + "\r\n").encode("ascii")
+
+
+#: MCAP topic of raw readings (the convention of ``sensor=replay``: one message per ``read()``).
+RAW_TOPIC = "/sensor/raw"
+#: Schema name and JSON schema of one raw reading message.
+RAW_SCHEMA_NAME = "bionav.Spectral5Reading"
+RAW_SCHEMA = {
+    "type": "object",
+    "title": RAW_SCHEMA_NAME,
+    "description": "The reply to one measure command of the five-channel log sensor: n readings of "
+                   "uv, b, g, r, ir, ref 12-bit ADC counts.",
+    "properties": {
+        "counts": {"type": "array", "items": {"type": "array", "items": {"type": "integer"},
+                                               "minItems": 6, "maxItems": 6}},
+    },
+    "required": ["counts"],
+}
+
+
+def reading_message(readings) -> dict:
+    """A raw reply ``(n, 6)`` as the dict ``read()`` returns and ``/sensor/raw`` records."""
+    return {"counts": np.asarray(readings, dtype=np.int64).reshape(-1, 6).tolist()}
+
+
+def reading_counts(message) -> np.ndarray:
+    """Inverse of :func:`reading_message`: the ``(n, 6)`` int array of a raw reading dict."""
+    return np.asarray(message["counts"], dtype=np.int64).reshape(-1, 6)

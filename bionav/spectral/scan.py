@@ -124,7 +124,7 @@ def run_scan(sensor, pantilt, grid: ScanGrid, *, before_column: Callable[[int], 
         Mean counts (over the readings of one measure command) per pixel:
         ``uv, b, g, r, ir, ref``.
     """
-    from bionav.plugins.sensors.spectral5 import reading_counts
+    from bionav.spectral.protocol import reading_counts
 
     h, w = grid.shape
     out = np.empty((h, w, 6))

@@ -22,6 +22,8 @@ class HissHoming(HomingMethod):
     aligned.
     """
 
+    cache_version = "2"  # prepare() returns bionav.homing.features.SiftFeatures (was a dict)
+
     name = "hiss"
     requires_alignment = False
 
@@ -58,8 +60,8 @@ class HissHoming(HomingMethod):
             raise UserError(f"homing.scale_threshold={cfg.scale_threshold} must be >= 0")
 
     def prepare(self, image):
-        """SIFT features of the (resized) panorama: dict of arrays (see :func:`bionav.homing.hiss.sift_features`)."""
-        from bionav.homing.hiss import sift_features
+        """SIFT features of the (resized) panorama, seamless across the border (:func:`bionav.homing.features.sift_features`)."""
+        from bionav.homing.features import sift_features
         from bionav.homing.imageops import resize_panorama
 
         img = np.asarray(image, dtype=np.float32)

@@ -200,3 +200,34 @@ class ParameterHoming(HomingMethod):
         if not (np.isfinite(hx) and np.isfinite(hy)) or (hx == 0.0 and hy == 0.0):
             return HomeVector(angle=math.nan, extras={"potential": p0})
         return HomeVector(angle=float(math.atan2(hy, hx)), extras={"potential": p0})
+
+    def all_pairs_angles(self, prepared, *, headings: np.ndarray, neighbours: np.ndarray) -> np.ndarray:
+        """Grid-frame home angles of all pairs from matrix operations on the prepared signatures.
+
+        The same angles as :meth:`home_vector` pair by pair (see
+        :meth:`bionav.homing.base.HomingMethod.all_pairs_angles`). The test
+        steps are the four grid neighbours, so their gradient is in the grid
+        frame; the matched filter's gradient is in the current view's frame and
+        is turned by the current view's heading. (For rotated current views this
+        equals the per-pair call with the neighbour offsets expressed in the
+        current view's frame.)
+        """
+        from bionav.geometry import wrap_angle
+        from bionav.homing import parameter as ph
+
+        f = np.stack([p["f"] for p in prepared])
+        if self.gradient == "test_steps":
+            grad = ph.gradient_matrix_from_test_steps(ph.potential_matrix(f, f), neighbours)
+        else:
+            dfx = np.stack([p["df_dx"] for p in prepared])
+            dfy = np.stack([p["df_dy"] for p in prepared])
+            grad = ph.matched_filter_gradient_matrix(f, f, dfx, dfy)
+        hx, hy = -grad[..., 0], -grad[..., 1]
+        with np.errstate(invalid="ignore"):
+            angles = np.arctan2(hy, hx)
+        angles[(hx == 0) & (hy == 0)] = np.nan
+        angles[~(np.isfinite(hx) & np.isfinite(hy))] = np.nan
+        if self.gradient != "test_steps":
+            # flow templates live in the current view's own frame
+            angles = angles + np.asarray(headings)[None, :]
+        return wrap_angle(angles)

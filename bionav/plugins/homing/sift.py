@@ -49,6 +49,7 @@ class SiftHoming(HomingMethod):
 
     Config = SiftConfig
     requires_alignment = True
+    cache_version = "2"  # prepare() returns bionav.homing.features.SiftFeatures with size and width
 
     def __init__(self, config: SiftConfig, *, geometry) -> None:
         if config.combine not in ("average", "max"):
@@ -64,8 +65,8 @@ class SiftHoming(HomingMethod):
         )
 
     def prepare(self, image: np.ndarray):
+        from bionav.homing.features import sift_features
         from bionav.homing.imageops import resize_panorama
-        from bionav.homing.sift_homing import sift_features
 
         image, _ = resize_panorama(image, geometry=self.geometry, size=self.config.image_size)
         c = self.config

@@ -10,7 +10,7 @@ Both are ``bionav.sensors`` plugins with the life cycle of bionav's sensor
 contract (``open``/``close``/context manager, ``attach_simulation(scene, rng)``)
 and ``read() -> dict``: one raw reading ``{"counts": [[uv, b, g, r, ir, ref],
 ...]}`` (the reply to one ``M<n>``). Experiments record every raw reading to
-``run.mcap`` under :data:`RAW_TOPIC` (``/sensor/raw``, schema
+``run.mcap`` under :data:`bionav.spectral.protocol.RAW_TOPIC` (``/sensor/raw``, schema
 ``bionav.Spectral5Reading``) as it is taken, and pan-tilt states under
 ``/pantilt/state``, so that ``sensor=replay`` re-runs a session from its log.
 
@@ -26,33 +26,8 @@ import numpy as np
 
 from bionav.errors import DeviceError
 from bionav.plugins.sensors.base import SensorPlugin
+from bionav.spectral.protocol import RAW_SCHEMA, RAW_SCHEMA_NAME, reading_message
 from bionav.validation import bounded
-
-#: MCAP topic of raw readings (the convention of ``sensor=replay``: one message per ``read()``).
-RAW_TOPIC = "/sensor/raw"
-#: Schema name and JSON schema of one raw reading message.
-RAW_SCHEMA_NAME = "bionav.Spectral5Reading"
-RAW_SCHEMA = {
-    "type": "object",
-    "title": RAW_SCHEMA_NAME,
-    "description": "The reply to one measure command of the five-channel log sensor: n readings of "
-                   "uv, b, g, r, ir, ref 12-bit ADC counts.",
-    "properties": {
-        "counts": {"type": "array", "items": {"type": "array", "items": {"type": "integer"},
-                                               "minItems": 6, "maxItems": 6}},
-    },
-    "required": ["counts"],
-}
-
-
-def reading_message(readings) -> dict:
-    """A raw reply ``(n, 6)`` as the dict ``read()`` returns and ``/sensor/raw`` records."""
-    return {"counts": np.asarray(readings, dtype=np.int64).reshape(-1, 6).tolist()}
-
-
-def reading_counts(message) -> np.ndarray:
-    """Inverse of :func:`reading_message`: the ``(n, 6)`` int array of a raw reading dict."""
-    return np.asarray(message["counts"], dtype=np.int64).reshape(-1, 6)
 
 
 class BadReply(DeviceError):

@@ -44,8 +44,8 @@ def _spectral_fakes(args) -> dict:
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
     from bionav.plugins.sensors.fakes.ptu46 import FakePTU46
+    from bionav.plugins.sensors.fakes.spectral5 import FakeSpectral5
     from bionav.plugins.sensors.spectral5 import Spectral5Sim
-    from bionav.spectral.fake_device import FakeSpectral5
     from bionav.spectral.scene import backyard_scene
 
     clouds = CloudLayer(cover=args.cloud_cover, optical_depth=args.cloud_optical_depth, seed=args.seed)

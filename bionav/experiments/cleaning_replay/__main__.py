@@ -1,4 +1,4 @@
-"""Command line of :mod:`bionav.robot.replay`."""
+"""Command line of :mod:`bionav.experiments.cleaning_replay`."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ def main(argv: list[str] | None = None) -> int:
     from bionav.errors import UserError
     from bionav.experiments.cleaning import replay_log
 
-    parser = argparse.ArgumentParser(prog="python -m bionav.robot.replay", description=_DESCRIPTION)
+    parser = argparse.ArgumentParser(prog="python -m bionav.experiments.cleaning_replay", description=_DESCRIPTION)
     parser.add_argument("log", help="run.mcap of an experiment=cleaning run, or its run directory")
     parser.add_argument("--run", type=int, action="append", help="only this run (repeatable)")
     args = parser.parse_args(argv)

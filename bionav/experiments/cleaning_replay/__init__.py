@@ -1,4 +1,4 @@
-"""``python -m bionav.robot.replay RUN_DIR_OR_MCAP [--run K ...]``: replay logged cleaning runs.
+"""``python -m bionav.experiments.cleaning_replay RUN_DIR_OR_MCAP [--run K ...]``: replay logged cleaning runs.
 
 Rebuilds controller, homing method, layout and (for images that were not
 logged) the camera from the config attached to ``run.mcap``, feeds every

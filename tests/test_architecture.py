@@ -1,0 +1,148 @@
+"""Import direction: every room imports only the rooms docs/architecture.md allows; one home per concept."""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "architecture.md"
+
+
+def allowed_imports(doc: str) -> dict[str, set[str]]:
+    """Room -> rooms it may import, from the "Rooms" table (rooms sharing a row may import each other)."""
+    table: dict[str, set[str]] = {}
+    header = None
+    for line in doc.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")] if line.startswith("|") else None
+        if cells is None:
+            header = None
+            continue
+        if cells[:3] == ["room", "holds", "imports"]:
+            header = cells
+            continue
+        if header is None or set(line) <= set("|- "):
+            continue
+        rooms = {_room_name(n) for n in re.findall(r"`([^`]+)`", cells[0])}
+        allowed = {_room_name(n) for n in re.findall(r"`([^`]+)`", cells[2])}
+        for room in rooms:
+            table[room] = allowed | rooms
+    return table
+
+
+def _room_name(text: str) -> str:
+    return text.strip().rstrip("/").removesuffix(".py")
+
+
+def room_of(module: str) -> str | None:
+    """``bionav.light.sun`` -> ``light``; ``bionav.cli`` -> ``cli``; ``bionav`` -> None."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 and parts[0] == "bionav" else None
+
+
+def module_name(path: Path, package_root: Path) -> str:
+    parts = list(path.relative_to(package_root.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imported_modules(path: Path, module: str) -> list[tuple[int, str]]:
+    """Absolute names of the bionav modules a file imports (``from bionav import x`` counts as ``bionav.x``)."""
+    out = []
+    is_package = path.name == "__init__.py"
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out += [(node.lineno, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                pkg = module.split(".")
+                pkg = pkg if is_package else pkg[:-1]
+                pkg = pkg[: len(pkg) - (node.level - 1)]
+                base = ".".join(pkg + ([base] if base else []))
+            if base == "bionav":
+                out += [(node.lineno, f"bionav.{a.name}") for a in node.names]
+            else:
+                out.append((node.lineno, base))
+    return [(line, name) for line, name in out if name == "bionav" or name.startswith("bionav.")]
+
+
+def violations(package_root: Path, table: dict[str, set[str]], experiments: set[str]) -> list[str]:
+    """Imports that run against the table, modules outside it, and experiments importing experiments."""
+    found = []
+    for path in sorted(package_root.rglob("*.py")):
+        module = module_name(path, package_root)
+        src = room_of(module)
+        if src is None:
+            continue
+        if src not in table:
+            found.append(f"{path}: room {src!r} is not in docs/architecture.md")
+            continue
+        for line, name in imported_modules(path, module):
+            dst = room_of(name)
+            if dst is None or dst == src or dst == "__version__":
+                continue
+            if dst not in table[src]:
+                found.append(f"{path}:{line}: {src} imports {dst} ({name}), not allowed by docs/architecture.md")
+        if src == "experiments":
+            own = module.split(".")[2] if len(module.split(".")) > 2 else ""
+            for line, name in imported_modules(path, module):
+                parts = name.split(".")
+                if len(parts) > 2 and parts[1] == "experiments" and parts[2] in experiments:
+                    target = parts[2]
+                    if target != own and not own.startswith(f"{target}_"):
+                        found.append(f"{path}:{line}: experiment module {own} imports the experiment {target}")
+    return found
+
+
+def experiment_names(conf: Path) -> set[str]:
+    return {p.stem for p in (conf / "experiment").glob("*.yaml")}
+
+
+def test_no_import_runs_against_the_table():
+    table = allowed_imports(DOC.read_text(encoding="utf-8"))
+    assert {"errors", "geometry", "light", "homing", "db", "experiments", "cli"} <= set(table)
+    found = violations(ROOT / "bionav", table, experiment_names(ROOT / "bionav" / "conf"))
+    assert found == [], "\n".join(found)
+
+
+def test_the_check_catches_an_arrow_back_up(tmp_path):
+    pkg = tmp_path / "bionav"
+    for rel, text in {
+        "__init__.py": "",
+        "geometry.py": "import numpy\n",
+        "light/__init__.py": "from bionav.geometry import x\n",
+        "light/sun.py": "from bionav.experiments import cleaning\nfrom . import clouds\n",
+        "light/clouds.py": "",
+        "experiments/__init__.py": "",
+        "experiments/cleaning.py": "from bionav.light import sun\n",
+        "experiments/cleaning_replay.py": "from bionav.experiments.cleaning import run\n",
+        "experiments/param_sweep.py": "from bionav.experiments.grid_homing import evaluate_agents\n",
+        "experiments/grid_homing.py": "from bionav.experiments.common import x\n",
+        "experiments/common.py": "",
+        "newroom/__init__.py": "",
+    }.items():
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text(text)
+    table = {"geometry": {"geometry"}, "light": {"geometry", "light"}, "experiments": {"light", "geometry", "experiments"}}
+    found = violations(pkg, table, {"cleaning", "param_sweep", "grid_homing"})
+    assert len(found) == 3, found
+    text = "\n".join(found)
+    assert "sun.py:1: light imports experiments" in text
+    assert "param_sweep.py:1: experiment module param_sweep imports the experiment grid_homing" in text
+    assert "room 'newroom' is not in" in text
+
+
+def test_one_definition_per_concept():
+    """The issue's grep: each of these is defined at most once in bionav/."""
+    pattern = re.compile(r"^\s*(def (sun_position|resize_panorama|butterworth_lowpass|sift_features|edge_filter|"
+                         r"parse_time|cache_key|default_cache_dir|write_atomic|write_json_atomic|"
+                         r"direction_from_angles|compass_to_azimuth|wrap_axial|evaluate_agents|neighbour_table)\b"
+                         r"|class (CloudField|SiftFeatures|SunPosition)\b)", re.M)
+    seen: dict[str, list[str]] = {}
+    for path in (ROOT / "bionav").rglob("*.py"):
+        for m in pattern.finditer(path.read_text(encoding="utf-8")):
+            seen.setdefault(m.group(1).split("(")[0].strip(), []).append(str(path.relative_to(ROOT)))
+    twice = {k: v for k, v in seen.items() if len(v) > 1}
+    assert twice == {}, twice
+    assert "def sun_position" in seen and "def butterworth_lowpass" in seen  # the pattern does match
