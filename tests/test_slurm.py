@@ -115,7 +115,7 @@ def test_sweep_on_slurm_with_failure_cancellations_and_resume(tmp_path, folders)
             proc.communicate()
             subprocess.run(["scancel", "-n", name])
     first_s = time.monotonic() - started
-    assert proc.returncode == 0, stderr
+    assert proc.returncode == 1 and "3 of 5 jobs failed: 1, 2, 4" in stderr, stderr  # ended, failures named
     assert "Traceback" not in stderr
     rows = _rows(sweep / "summary.csv")
     assert sorted(rows) == ["0", "1", "2", "3", "4"]
@@ -134,7 +134,7 @@ def test_sweep_on_slurm_with_failure_cancellations_and_resume(tmp_path, folders)
     proc = subprocess.run([*command, "bionav.resume=true"], cwd=tmp_path, env=env, capture_output=True, text=True,
                           timeout=OUTER_TIMEOUT_S)
     resume_s = time.monotonic() - started
-    assert proc.returncode == 0, proc.stderr
+    assert proc.returncode == 1 and "1 of 5 jobs failed: 2" in proc.stderr, proc.stderr  # the missing database
     rows = _rows(sweep / "summary.csv")
     assert [rows[j]["status"] for j in "01234"] == ["completed", "completed", "failed", "completed", "completed"]
     assert {j: (sweep / j / "metrics.json").stat().st_mtime_ns for j in ("0", "3")} == before
