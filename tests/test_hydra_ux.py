@@ -9,8 +9,6 @@ import sys
 import pytest
 from helpers import run_bionav
 
-from bionav.config import config_dirs
-
 
 def _groups(help_text: str) -> list[str]:
     section = help_text.split("== Configuration groups ==", 1)[1].split("== Config ==", 1)[0]
@@ -29,7 +27,11 @@ def test_help_lists_each_group_once(tmp_path):
 def test_primary_search_path_is_bionavs_config_folder(tmp_path):
     proc = run_bionav("--info", "searchpath", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    own = dict(config_dirs())["bionav"]
+    # the folder of the bionav that `python -m bionav` imports outside the checkout (the installed
+    # package; the test process itself may import the source tree)
+    own = subprocess.run([sys.executable, "-c", "from bionav.config import config_dirs; "
+                          "print(dict(config_dirs())['bionav'])"], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=120, check=True).stdout.strip()
     rows = [line for line in proc.stdout.splitlines() if "file://" in line or "pkg://" in line]
     assert any(re.search(rf"\|\s*main\s*\|\s*file://{re.escape(str(own))}\s*\|", r) for r in rows), rows
     assert sum(str(own) in r for r in rows) == 1, rows  # searched once
