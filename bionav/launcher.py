@@ -227,13 +227,12 @@ def register(store=None) -> None:
 
     Called through the ``bionav.schemas`` entry point ``submitit_slurm`` with Hydra's ConfigStore.
     """
-    from hydra.core.config_store import ConfigStore
-    from hydra.core.plugins import Plugins
-
     import sys
     import types
 
     import hydra_plugins
+    from hydra.core.config_store import ConfigStore
+    from hydra.core.plugins import Plugins
 
     module = sys.modules.get(BionavSlurmLauncher.__module__)
     if module is None:  # what Hydra imports to instantiate the launcher (see the class docstring)

@@ -2,9 +2,7 @@
 
 import base64
 import json
-import math
 import time
-from datetime import datetime, timezone
 
 import numpy as np
 import pytest
@@ -100,13 +98,12 @@ def test_recorded_panoramas_are_foxglove_images_and_replay_exactly(tmp_path):
     """Rendered panoramas grabbed during ticks: RawImage for Foxglove, exact captures for replay, real dates."""
     from types import SimpleNamespace
 
+    from bionav.logs.reader import read_messages
     from bionav.robot.controller import Command, Observation
     from bionav.robot.kinematics import Pose
     from bionav.robot.recording import EpisodeRecorder, load_logged_runs
     from bionav.robot.simulator import image_digest
     from bionav.testing.pillar_scene import render_pillar_panorama
-
-    from bionav.logs.reader import read_messages
 
     views = [render_pillar_panorama((0.5 + 0.2 * k, 0.4), width=96, height=16, supersample=1)[0] for k in range(3)]
     path = tmp_path / "run.mcap"

@@ -28,7 +28,8 @@ def _slurm_answers() -> str | None:
         return "no SLURM client tools (scontrol, sbatch); start a local cluster with scripts/slurm-localhost.sh start"
     ping = subprocess.run(["scontrol", "ping"], capture_output=True, text=True, timeout=30)
     if ping.returncode != 0 or "UP" not in ping.stdout:
-        return f"no slurmctld answers (scontrol ping: {(ping.stdout + ping.stderr).strip()}); run scripts/slurm-localhost.sh start"
+        said = (ping.stdout + ping.stderr).strip()
+        return f"no slurmctld answers (scontrol ping: {said}); run scripts/slurm-localhost.sh start"
     nodes = subprocess.run(["sinfo", "-h", "-o", "%t"], capture_output=True, text=True, timeout=30).stdout.split()
     if not any(state.rstrip("*") in ("idle", "mix", "alloc") for state in nodes):
         return f"no SLURM node is up (sinfo: {' '.join(nodes) or 'none'})"

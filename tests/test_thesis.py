@@ -240,7 +240,8 @@ def test_cli_runs_through_a_hydra_launcher(tmp_path):
     jobs = {}
     for m in out.glob("sweeps/*/*/metrics.json"):
         ov = yaml.safe_load((m.parent / ".hydra" / "overrides.yaml").read_text())
-        jobs[next(o for o in ov if o.startswith("experiment.sky.cloud_cover") or o.startswith("mode="))] = json.loads(m.read_text())
+        key = next(o for o in ov if o.startswith("experiment.sky.cloud_cover") or o.startswith("mode="))
+        jobs[key] = json.loads(m.read_text())
     assert {"experiment.sky.cloud_cover=0.0", "experiment.sky.cloud_cover=0.6", "mode=vs_em_compass"} <= set(jobs)
     assert not (out / "runs").exists()
     by = {(r["item"], r["quantity"]): r for r in _rows(out / "items.csv")}

@@ -14,7 +14,7 @@ from __future__ import annotations
 import csv
 import math
 import shutil
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
@@ -606,8 +606,6 @@ def _ranking_csv(res: RunResult) -> Path | None:
 
 
 def _param_item(table: str, fig: str, db: str):
-    label = f"Table {table[5:].replace('_', '.')}"
-
     class _P:
         @staticmethod
         def runs(preset: Preset) -> list[RunSpec]:
@@ -635,8 +633,8 @@ def _param_item(table: str, fig: str, db: str):
                     b_rank.append(int(g["rank"]))
             out.checks.append(rho_check("the 19 signatures by RR*", t_rank, b_rank))
             best = min(got.values(), key=lambda r: int(r["rank"]))["parameter"].strip("[]") if got else None
-            out.checks.append(Check(f"best signature is [{ref[0][1]}] as in the thesis", None if best is None else best == ref[0][1],
-                                    f"bionav's best: [{best}]"))
+            out.checks.append(Check(f"best signature is [{ref[0][1]}] as in the thesis",
+                                    None if best is None else best == ref[0][1], f"bionav's best: [{best}]"))
             if db == "original":
                 low = [g for g in got.values() if int(g["rank"]) > 8]
                 inv = [str(g.get("rot_invariant", "")).lower() in ("j", "y", "yes", "true", "1") for g in low]
@@ -653,7 +651,8 @@ def _param_item(table: str, fig: str, db: str):
                 shutil.copyfile(md, ctx.out / f"{table}.md")
                 out.tables.append(f"{table}.md")
             copy_plot(ctx, res, f"plots/{path.stem}.png", f"{fig}.png", out)
-            out.notes.append(f"sweep grid experiment.grid={ctx.preset.param_grid}; figure {fig.replace('fig', 'fig. ').replace('_', '.')}: "
+            fig_name = fig.replace('fig', 'fig. ').replace('_', '.')
+            out.notes.append(f"sweep grid experiment.grid={ctx.preset.param_grid}; figure {fig_name}: "
                              "per-snapshot RR and AAE of the eight best signatures.")
             return out
 
@@ -697,7 +696,10 @@ def _b_evaluate(ctx: Context, specs: list[RunSpec]) -> Outcome:
             if not res.ok:
                 out.missing.append(f"{db} {s[0]}x{s[1]}: {why_missing(res)}")
             t = sizes.index(tuple(s)) if tuple(s) in sizes else None
-            th = (lambda key: None if t is None else vals[key][t])
+
+            def th(key, t=t, vals=vals):
+                return None if t is None else vals[key][t]
+
             keys = metric(res, "keypoints_per_image")
             out.rows.append(Row(f"{db} {s[0]}x{s[1]} keys", th("keys"), keys, None,
                                 "" if keys is not None else "bionav's metrics report no keypoint count"))
@@ -1112,7 +1114,8 @@ def _stability_item(fig: str):
             ax.set_xlabel("scan after the reference (one-day series)")
             ax.set_ylabel(measure)
             ax.legend(fontsize=6, ncol=4)
-            ax.set_title(f"{measure}{' after skyline separation' if separated else ''} (thesis {fig.replace('fig', 'fig. ').replace('_', '.')})", fontsize=9)
+            fig_name = fig.replace('fig', 'fig. ').replace('_', '.')
+            ax.set_title(f"{measure}{' after skyline separation' if separated else ''} (thesis {fig_name})", fontsize=9)
             save_figure(fig_, ctx.figure(f"{fig}.png"), dpi=100)
             out.figures.append(f"{fig}.png")
             ok = {k: v for k, v in means.items() if v is not None}

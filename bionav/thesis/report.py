@@ -37,8 +37,9 @@ def csv_rows(sections: Sequence[Section]) -> list[dict[str, str]]:
     for s in sections:
         o = s.outcome
         passed, total = o.score
-        rows.append({"item": s.id, "label": s.label, "quantity": "(item verdict)", "thesis": "", "bionav": f"{passed}/{total} checks pass",
-                     "difference": "", "tolerance": "", "verdict": o.verdict, "level": "item"})
+        rows.append({"item": s.id, "label": s.label, "quantity": "(item verdict)", "thesis": "",
+                     "bionav": f"{passed}/{total} checks pass", "difference": "", "tolerance": "",
+                     "verdict": o.verdict, "level": "item"})
         for c in o.checks:
             rows.append({"item": s.id, "label": s.label, "quantity": c.rule, "thesis": "claim", "bionav": c.detail,
                          "difference": "", "tolerance": "",
