@@ -100,8 +100,7 @@ def test_optuna_ranks_failed_jobs_worst(tmp_path):
         "-m", "hydra/sweeper=optuna", "hydra.sweeper.n_trials=2", "hydra.sweeper.direction=maximize",
         "objective.metric=rr", "objective.direction=maximize", "homing=mfdid",
         "seed=range(0,5)",
-        "db=folder", f"db.path={tmp_path / 'missing'}", f"hydra.sweep.dir={sweep}",
-        "bionav.fail_on_job_error=false", cwd=tmp_path,  # failed trials are part of this study
+        "db=folder", f"db.path={tmp_path / 'missing'}", f"hydra.sweep.dir={sweep}", cwd=tmp_path,
     )
     assert proc.returncode == 1 and "2 of 2 jobs failed" in proc.stderr, proc.stderr  # the sweep still ends
     result = yaml.safe_load((sweep / "optimization_results.yaml").read_text())
