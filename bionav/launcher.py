@@ -102,7 +102,8 @@ class BionavSlurmLauncher(SlurmLauncher):
     def launch(self, job_overrides: Sequence[Sequence[str]], initial_job_idx: int) -> Sequence[JobReturn]:
         import submitit
 
-        assert self.config is not None
+        if self.config is None:
+            raise RuntimeError("the SLURM launcher was not set up by Hydra (setup() was not called)")
         own_keys = {"submitit_folder", "max_num_timeout"}
         executor = submitit.AutoExecutor(
             cluster=self._EXECUTOR,
@@ -183,7 +184,8 @@ class BionavSlurmLauncher(SlurmLauncher):
         from bionav.experiments.runner import is_completed
         from bionav.files import write_json_atomic
 
-        assert self.hydra_context is not None and self.config is not None
+        if self.hydra_context is None or self.config is None:
+            raise RuntimeError("the SLURM launcher was not set up by Hydra (setup() was not called)")
         sweep_config = self.hydra_context.config_loader.load_sweep_config(self.config, list(overrides))
         with open_dict(sweep_config.hydra.job):
             sweep_config.hydra.job.num = num
