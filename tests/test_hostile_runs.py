@@ -15,10 +15,9 @@ import sys
 import time
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pytest
-from helpers import run_bionav
+from helpers import run_bionav, write_tiny_folder
 from mcap.reader import make_reader
 from mcap.records import Message
 from mcap.stream_reader import StreamReader
@@ -53,14 +52,7 @@ def render_cache():
 
 @pytest.fixture
 def tiny_folder(tmp_path):
-    folder = tmp_path / "tiny"
-    folder.mkdir()
-    rng = np.random.default_rng(0)
-    for x in range(3):
-        for y in range(3):
-            img = cv2.GaussianBlur(rng.random((16, 64)).astype(np.float32), (0, 0), 2.0)
-            cv2.imwrite(str(folder / f"{x}_{y}.png"), np.uint8(255 * img / img.max()))
-    return folder
+    return write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
 
 
 def _start(args, cwd, cache) -> subprocess.Popen:

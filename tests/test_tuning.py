@@ -3,11 +3,9 @@
 import json
 import math
 
-import cv2
-import numpy as np
 import pytest
 import yaml
-from helpers import run_bionav
+from helpers import run_bionav, write_tiny_folder
 
 from bionav.errors import UserError
 from bionav.experiments.objective import Objective, objective_from_config
@@ -16,14 +14,7 @@ from bionav.experiments.objective import Objective, objective_from_config
 @pytest.fixture
 def textured_folder(tmp_path):
     """A 3 x 3 Vardy-named database of textured 128 x 32 panoramas (enough SIFT features)."""
-    folder = tmp_path / "tiny"
-    folder.mkdir()
-    rng = np.random.default_rng(0)
-    for x in range(3):
-        for y in range(3):
-            img = cv2.GaussianBlur(rng.random((32, 128)).astype(np.float32), (0, 0), 1.5)
-            cv2.imwrite(str(folder / f"{x}_{y}.png"), np.uint8(255 * img / img.max()))
-    return folder
+    return write_tiny_folder(tmp_path / "tiny", shape=(32, 128), sigma=1.5)
 
 
 def test_objective_value_and_worst():
