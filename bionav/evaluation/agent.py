@@ -180,21 +180,14 @@ _TIE_MARGIN = 1e-9
 
 
 @njit(cache=True)
-def _nearest_cell(px, py, lut, origin, cand_start, cand, cx, cy):
-    qx = int(np.floor(px + 0.5)) + origin
-    qy = int(np.floor(py + 0.5)) + origin
-    if 0 <= qx < lut.shape[0] and 0 <= qy < lut.shape[1]:
-        i = lut[qx, qy]
-        if i >= 0 and abs(px - cx[i]) < 0.5 - _TIE_MARGIN and abs(py - cy[i]) < 0.5 - _TIE_MARGIN:
-            return i  # the cell at the rounded point, strictly nearer than every other
-        k = qx * lut.shape[1] + qy
-        lo, hi = cand_start[k], cand_start[k + 1]
-    else:
-        lo, hi = -1, -1
+def _nearest_cell_search(px, py, qx, qy, lut, cand_start, cand, cx, cy):
+    """Nearest cell among the candidates of lattice point ``(qx, qy)`` (table indices), first minimum."""
     best = 0
     best_d = np.inf
-    if lo < 0:  # beyond the table: all cells
-        for i in range(cx.size):
+    if 0 <= qx < lut.shape[0] and 0 <= qy < lut.shape[1]:
+        k = qx * lut.shape[1] + qy
+        for j in range(cand_start[k], cand_start[k + 1]):
+            i = cand[j]
             dx = px - cx[i]
             dy = py - cy[i]
             d = dx * dx + dy * dy
@@ -202,8 +195,7 @@ def _nearest_cell(px, py, lut, origin, cand_start, cand, cx, cy):
                 best_d = d
                 best = i
         return best
-    for j in range(lo, hi):  # the cells that can be nearest within this lattice square, ascending index
-        i = cand[j]
+    for i in range(cx.size):  # beyond the table: all cells
         dx = px - cx[i]
         dy = py - cy[i]
         d = dx * dx + dy * dy
@@ -217,10 +209,14 @@ def _nearest_cell(px, py, lut, origin, cand_start, cand, cx, cy):
 def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_start, cand, cx, cy, n_steps_max,
                           step_length, radius, out):
     n_levels, n_snap, _ = dir_x.shape
+    nx, ny = lut.shape
+    margin = 0.5 - _TIE_MARGIN
     for lv in range(n_levels):
         for s in range(n_snap):
             sx = snapshots[s, 0]
             sy = snapshots[s, 1]
+            row_x = dir_x[lv, s]
+            row_y = dir_y[lv, s]
             for c in range(starts.shape[0]):
                 px = starts[c, 0]
                 py = starts[c, 1]
@@ -230,9 +226,16 @@ def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_sta
                     out[lv, s, c] = True
                     continue
                 for _ in range(n_steps_max):
-                    i = _nearest_cell(px, py, lut, origin, cand_start, cand, cx, cy)
-                    px += step_length * dir_x[lv, s, i]
-                    py += step_length * dir_y[lv, s, i]
+                    qx = int(np.floor(px + 0.5)) + origin
+                    qy = int(np.floor(py + 0.5)) + origin
+                    i = -1
+                    if 0 <= qx < nx and 0 <= qy < ny:
+                        i = lut[qx, qy]
+                    if i < 0 or not (abs(px - cx[i]) < margin and abs(py - cy[i]) < margin):
+                        # next to a missing cell, on a tie or off the table: compare the candidate cells
+                        i = _nearest_cell_search(px, py, qx, qy, lut, cand_start, cand, cx, cy)
+                    px += step_length * row_x[i]
+                    py += step_length * row_y[i]
                     dx = px - sx
                     dy = py - sy
                     if np.sqrt(dx * dx + dy * dy) < radius:
