@@ -19,6 +19,7 @@ Documented choices
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -209,8 +210,10 @@ def _nearest_cell_search(px, py, qx, qy, lut, cand_start, cand, cx, cy):
 def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_start, cand, cx, cy, n_steps_max,
                           step_length, radius, out):
     n_levels, n_snap, _ = dir_x.shape
-    nx, ny = lut.shape
     margin = 0.5 - _TIE_MARGIN
+    # the lattice rectangle of the cells (the table extends ``origin`` beyond it)
+    x_lo, x_hi = np.floor(cx.min()), np.floor(cx.max())
+    y_lo, y_hi = np.floor(cy.min()), np.floor(cy.max())
     for lv in range(n_levels):
         for s in range(n_snap):
             sx = snapshots[s, 0]
@@ -226,14 +229,27 @@ def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_sta
                     out[lv, s, c] = True
                     continue
                 for _ in range(n_steps_max):
-                    qx = int(np.floor(px + 0.5)) + origin
-                    qy = int(np.floor(py + 0.5)) + origin
-                    i = -1
-                    if 0 <= qx < nx and 0 <= qy < ny:
-                        i = lut[qx, qy]
-                    if i < 0 or not (abs(px - cx[i]) < margin and abs(py - cy[i]) < margin):
-                        # next to a missing cell, on a tie or off the table: compare the candidate cells
-                        i = _nearest_cell_search(px, py, qx, qy, lut, cand_start, cand, cx, cy)
+                    # squared distances are separable: the grid's nearest lattice point is the clamped rounded
+                    # point, strictly nearest unless a coordinate inside the grid is (nearly) half-integer
+                    rx = np.floor(px + 0.5)
+                    ry = np.floor(py + 0.5)
+                    clear = True
+                    if rx < x_lo:
+                        rx = x_lo
+                    elif rx > x_hi:
+                        rx = x_hi
+                    else:
+                        clear = abs(px - rx) < margin
+                    if ry < y_lo:
+                        ry = y_lo
+                    elif ry > y_hi:
+                        ry = y_hi
+                    else:
+                        clear = clear and abs(py - ry) < margin
+                    i = lut[int(rx) + origin, int(ry) + origin] if clear else -1
+                    if i < 0:  # next to a missing cell or on a tie: compare the candidate cells
+                        i = _nearest_cell_search(px, py, int(np.floor(px + 0.5)) + origin,
+                                                 int(np.floor(py + 0.5)) + origin, lut, cand_start, cand, cx, cy)
                     px += step_length * row_x[i]
                     py += step_length * row_y[i]
                     dx = px - sx
@@ -241,6 +257,11 @@ def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_sta
                     if np.sqrt(dx * dx + dy * dy) < radius:
                         out[lv, s, c] = True
                         break
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_cell_tables(key: bytes, n: int, margin: int):
+    return _cell_tables(np.frombuffer(key, dtype=np.float64).reshape(n, 2), margin)
 
 
 def _cell_tables(positions: np.ndarray, margin: int):
@@ -326,7 +347,12 @@ def agent_success(
     out = np.zeros(a.shape, dtype=np.bool_)
     n_steps_max = int(np.ceil(max_travel_length(grid_shape) / step_length))
     travel = int(np.ceil(n_steps_max * step_length)) + 2
-    lut, origin, cand_start, cand = _cell_tables(pos, travel)
+    lut, origin, cand_start, cand = _cached_cell_tables(pos.tobytes(), len(pos), travel)
+    if lut.size == 0:  # cells off the integer lattice: the plain trials
+        for idx in np.ndindex(a.shape[:2]):
+            out[idx] = run_agents(a[idx], pos, snaps[idx[1]], pos, grid_shape=grid_shape, step_length=step_length,
+                                  success_radius=success_radius)[0].success
+        return out.reshape(lead + (n_snap, n_cells))
     _agent_success_kernel(dir_x, dir_y, snaps, pos, lut, origin, cand_start, cand, np.ascontiguousarray(pos[:, 0]),
                           np.ascontiguousarray(pos[:, 1]), n_steps_max, float(step_length), float(success_radius), out)
     return out.reshape(lead + (n_snap, n_cells))

@@ -251,6 +251,13 @@ def _levels_index(n_coeffs, coeff_index: np.ndarray) -> np.ndarray:
     return ks - 1
 
 
+def _coefficient_blocks(coeff_index: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Column order grouping the entries by coefficient (stable) and the bounds of coefficients ``0 .. n-1``."""
+    order = np.argsort(coeff_index, kind="stable")
+    bounds = np.searchsorted(coeff_index[order], np.arange(n + 1), side="left")
+    return order, bounds
+
+
 def potential_matrices_by_coefficients(
     f_snapshots: np.ndarray, f_currents: np.ndarray, coeff_index: np.ndarray, n_coeffs
 ) -> np.ndarray:
@@ -279,16 +286,17 @@ def potential_matrices_by_coefficients(
     """
     from scipy.spatial.distance import cdist
 
-    fs = np.asarray(f_snapshots, dtype=np.float64)
-    fc = np.asarray(f_currents, dtype=np.float64)
     kidx = np.asarray(coeff_index, dtype=np.int64)
     levels = _levels_index(n_coeffs, kidx)
+    order, bounds = _coefficient_blocks(kidx, int(levels.max()) + 1)
+    fs = np.ascontiguousarray(np.asarray(f_snapshots, dtype=np.float64)[:, order])
+    fc = fs if f_currents is f_snapshots else np.ascontiguousarray(np.asarray(f_currents, dtype=np.float64)[:, order])
     total = np.zeros((len(fs), len(fc)))
     out = np.empty((len(levels), len(fs), len(fc)))
-    for k in range(int(levels.max()) + 1):
-        cols = kidx == k
-        if np.any(cols):
-            total += cdist(fs[:, cols], fc[:, cols], "sqeuclidean")
+    for k in range(len(bounds) - 1):
+        lo, hi = bounds[k], bounds[k + 1]
+        if hi > lo:
+            total += cdist(fs[:, lo:hi], fc[:, lo:hi], "sqeuclidean")
         out[levels == k] = total
     return out
 
@@ -318,16 +326,16 @@ def matched_filter_gradient_matrices_by_coefficients(
     -------
     ndarray, shape (N, S, C, 2)
     """
-    fs = np.asarray(f_snapshots, dtype=np.float64)
-    fc = np.asarray(f_currents, dtype=np.float64)
     kidx = np.asarray(coeff_index, dtype=np.int64)
     levels = _levels_index(n_coeffs, kidx)
+    order, bounds = _coefficient_blocks(kidx, int(levels.max()) + 1)
+    fs, fc, dx, dy = (np.ascontiguousarray(np.asarray(a, dtype=np.float64)[:, order])
+                      for a in (f_snapshots, f_currents, df_dx, df_dy))
     total = np.zeros((len(fs), len(fc), 2))
     out = np.empty((len(levels), len(fs), len(fc), 2))
-    for k in range(int(levels.max()) + 1):
-        cols = kidx == k
-        if np.any(cols):
-            total += matched_filter_gradient_matrix(fs[:, cols], fc[:, cols], np.asarray(df_dx)[:, cols],
-                                                    np.asarray(df_dy)[:, cols])
+    for k in range(len(bounds) - 1):
+        lo, hi = bounds[k], bounds[k + 1]
+        if hi > lo:
+            total += matched_filter_gradient_matrix(fs[:, lo:hi], fc[:, lo:hi], dx[:, lo:hi], dy[:, lo:hi])
         out[levels == k] = total
     return out
