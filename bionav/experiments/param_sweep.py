@@ -200,23 +200,13 @@ def _finite(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def run(cfg: DictConfig, ctx) -> dict[str, Any]:
-    from bionav.experiments.common import load_configured_database
-
-    exp = experiment_config(cfg, "param_sweep")
-    homing_cls, homing_cfg, sig_name, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
-    db = load_configured_database(cfg)
-    levels = sweep_levels(sig_cls, rings=list(exp.rings), n_coeffs=list(exp.n_coeffs))
-    preprocess = str(OmegaConf.select(cfg, "preprocess.name", default="none"))
+def _rows(db: ImageDatabase, sig_name: str, preprocess: str, homings, measures, ms: float) -> list[dict[str, Any]]:
+    """One configuration record per level (see the module docstring)."""
     size = f"{db.geometry.width}x{db.geometry.height}"
-    rows: list[dict[str, Any]] = []
-    homings, measures, ms = evaluate_levels(
-        homing_cls, homing_cfg, sig_cls, sig_cfg, levels, db,
-        step_length=float(exp.step_length), success_radius=float(exp.success_radius),
-    )
+    rows = []
     for homing, q in zip(homings, measures):
         sig = homing.signature
-        row = {
+        rows.append({
             "db": db.name,
             "signature": sig_name,
             "rings": getattr(sig.config, "rings", None),
@@ -234,14 +224,37 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             "positions": db.positions.tolist(),
             "aae_s": [_finite(v) for v in q.aae_s],
             "rr_s": [_finite(v) for v in q.rr_s],
-        }
-        rows.append(row)
+        })
+    return rows
+
+
+def _write_rows(ctx, rows: list[dict[str, Any]]) -> None:
+    for row in rows:
         ctx.log.write(
             "/param_sweep/configuration", row, schema_name="bionav.ParameterConfiguration", schema=CONFIGURATION_SCHEMA
         )
     with open(ctx.dir / ROWS_FILE, "w") as f:
         for row in rows:
             f.write(json.dumps(row) + "\n")
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    from bionav.experiments.common import load_configured_database
+
+    exp = experiment_config(cfg, "param_sweep")
+    if str(exp.scope) == "grid":
+        return _run_grid(cfg, ctx, exp)
+    homing_cls, homing_cfg, sig_name, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
+    db = load_configured_database(cfg)
+    levels = sweep_levels(sig_cls, rings=list(exp.rings), n_coeffs=list(exp.n_coeffs))
+    preprocess = str(OmegaConf.select(cfg, "preprocess.name", default="none"))
+    size = f"{db.geometry.width}x{db.geometry.height}"
+    homings, measures, ms = evaluate_levels(
+        homing_cls, homing_cfg, sig_cls, sig_cfg, levels, db,
+        step_length=float(exp.step_length), success_radius=float(exp.success_radius),
+    )
+    rows = _rows(db, sig_name, preprocess, homings, measures, ms)
+    _write_rows(ctx, rows)
     _plot_levels(ctx.plots / "levels.png", rows, title=f"[{sig_name}] on {db.name}, {size}, {preprocess}")
 
     best = max(rows, key=lambda r: (r["rr"], -r["aae"]))
@@ -263,6 +276,168 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         if best[key] is not None and key in levels[0]:
             metrics[f"best_{key}"] = best[key]
     return metrics
+
+
+# --- experiment.scope=grid: the whole grid in one run ------------------------------------------
+
+
+def _grid_values(value: Any, *, what: str) -> list[Any]:
+    """The values of one sweep key of a grid: a list, or the sweeper's comma-separated string."""
+    import yaml
+
+    if isinstance(value, (list, tuple)) or OmegaConf.is_list(value):
+        return list(OmegaConf.to_container(value) if OmegaConf.is_list(value) else value)
+    try:
+        parsed = yaml.safe_load(f"[{value}]")
+    except yaml.YAMLError:
+        parsed = None
+    if not isinstance(parsed, list) or not parsed:
+        raise UserError(f"experiment.grids.<grid>.{what}={value!r} is not a comma-separated list of values; "
+                        f"write it as the sweeper does, e.g. {what}: a,b,c.")
+    return parsed
+
+
+def _preprocess_node(name: str) -> dict[str, Any]:
+    """The ``preprocess=<name>`` config of bionav's config group, as a plain dict."""
+    from importlib import resources
+
+    path = resources.files("bionav.conf") / "preprocess" / f"{name}.yaml"
+    if not path.is_file():
+        known = sorted(p.name[:-5] for p in (resources.files("bionav.conf") / "preprocess").iterdir()
+                       if p.name.endswith(".yaml"))
+        raise UserError(f"preprocessing {name!r} of the sweep grid is not one of bionav's: {', '.join(known)}. "
+                        f"Fix experiment.grids.<grid>.preprocess.")
+    return OmegaConf.to_container(OmegaConf.load(str(path)), resolve=True)
+
+
+@dataclasses.dataclass(frozen=True)
+class _GridTask:
+    """One preprocessing of a grid run: every image size and signature of the grid (runs in a worker)."""
+
+    db_node: dict
+    data_dir: str
+    cache_dir: str
+    preprocess: dict
+    sizes: tuple
+    signatures: tuple
+    homing_cfg: Any
+    rings: tuple
+    n_coeffs: tuple
+    step_length: float
+    success_radius: float
+
+
+def _grid_task(task: _GridTask) -> list[dict[str, Any]]:
+    """Rows of every image size x signature of one preprocessing (see :func:`_run_grid`)."""
+    from pathlib import Path
+
+    from bionav.db.loading import load_database
+    from bionav.db.preprocess import resize_database
+    from bionav.db.rotation import rotate_views
+    from bionav.plugins.homing.parameter import ParameterHoming
+    from bionav.plugins.signatures import signature_class
+
+    node = dict(task.db_node)
+    rotate = str(node.get("source", "")).lower() == "folder" and bool(node.get("rotate_current"))
+    node.update(image_size=None, rotate_current=False if rotate else node.get("rotate_current", False))
+    native = load_database(node, data_dir=Path(task.data_dir), cache_dir=Path(task.cache_dir),
+                           preprocess=task.preprocess)
+    rows: list[dict[str, Any]] = []
+    for size in task.sizes:
+        db = resize_database(native, size)
+        if rotate:
+            db = rotate_views(db, seed=int(node.get("rotation_seed", 0)))
+        for sig_name in task.signatures:
+            sig_cls = signature_class(sig_name)
+            sig_cfg = sig_cls.Config()
+            names = {f.name for f in dataclasses.fields(sig_cfg)}
+            passed = {k: getattr(task.homing_cfg, k) for k in ("rings", "n_coeffs", "bins")
+                      if getattr(task.homing_cfg, k) is not None and k in names}
+            sig_cfg = dataclasses.replace(sig_cfg, **passed)
+            homing_cfg = dataclasses.replace(task.homing_cfg, signature=sig_name, rings=None, n_coeffs=None, bins=None)
+            levels = sweep_levels(sig_cls, rings=task.rings, n_coeffs=task.n_coeffs)
+            homings, measures, ms = evaluate_levels(ParameterHoming, homing_cfg, sig_cls, sig_cfg, levels, db,
+                                                    step_length=task.step_length, success_radius=task.success_radius)
+            rows += _rows(db, sig_name, str(task.preprocess.get("name", "none")), homings, measures, ms)
+    return rows
+
+
+def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
+    """``experiment.scope=grid``: every signature x image size x preprocessing of the grid in this run.
+
+    The work is split by preprocessing over ``workers`` processes; each
+    preprocesses the database once at its native size and resizes it to every
+    size of the grid. The database is rendered (or read from the cache) once
+    before the workers start.
+    """
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+    from pathlib import Path
+
+    from bionav.config import plugin_config
+    from bionav.db.loading import load_database
+    from bionav.report.ranking import write_parameter_report
+
+    if str(cfg.homing.name) != "parameter":
+        raise UserError(
+            f"experiment=param_sweep sweeps parameter homing, but homing={cfg.homing.name} is selected. "
+            f"Drop the homing= override (the experiment selects homing=parameter)."
+        )
+    _, homing_cfg = plugin_config("homing", cfg.homing)
+    grid_name = str(exp.grid)
+    grid = exp.grids.get(grid_name) if exp.grids else None
+    if grid is None:
+        raise UserError(f"experiment.grid={grid_name!r} is not one of the sweep grids "
+                        f"({', '.join(exp.grids or [])}); choose one of them.")
+    from bionav.plugins.signatures import signature_class
+
+    signatures = tuple(str(v) for v in _grid_values(grid.signature, what="signature"))
+    for name in signatures:
+        signature_class(name)  # a clear error for an unknown name before any work
+    sizes = tuple(tuple(int(v) for v in size) for size in _grid_values(grid.image_size, what="image_size"))
+    preprocessings = [_preprocess_node(str(v)) for v in _grid_values(grid.preprocess, what="preprocess")]
+    db_node = OmegaConf.to_container(cfg.db, resolve=True)
+    data_dir, cache_dir = str(cfg.data_dir), str(cfg.cache_dir)
+
+    t0 = time.perf_counter()
+    native = load_database(dict(db_node, image_size=None), data_dir=Path(data_dir), cache_dir=Path(cache_dir))
+    render_s = time.perf_counter() - t0
+    tasks = [
+        _GridTask(db_node=db_node, data_dir=data_dir, cache_dir=cache_dir, preprocess=pre, sizes=sizes,
+                  signatures=signatures, homing_cfg=homing_cfg, rings=tuple(int(r) for r in exp.rings),
+                  n_coeffs=tuple(int(k) for k in exp.n_coeffs), step_length=float(exp.step_length),
+                  success_radius=float(exp.success_radius))
+        for pre in preprocessings
+    ]
+    workers = max(1, min(int(cfg.get("workers") or 1), len(tasks)))
+    t1 = time.perf_counter()
+    rows: list[dict[str, Any]] = []
+    desc = f"param_sweep grid on {native.name} (preprocessings)"
+    if workers == 1:
+        for task in ctx.progress(tasks, desc=desc, total=len(tasks)):
+            rows += _grid_task(task)
+    else:
+        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+            for part in ctx.progress(pool.map(_grid_task, tasks), desc=desc, total=len(tasks)):
+                rows += part
+    sweep_s = time.perf_counter() - t1
+    _write_rows(ctx, rows)
+    write_parameter_report(ctx.dir)
+    best = max(rows, key=lambda r: (r["rr"], -r["aae"]))
+    return {
+        "db": native.name,
+        "signature": best["signature"],
+        "image_size": best["image_size"],
+        "preprocess": best["preprocess"],
+        "aae": best["aae"],
+        "mae": best["mae"],
+        "rr": best["rr"],
+        "n_configs": len(rows),
+        "n_images": len(native),
+        "render_s": render_s,
+        "sweep_s": sweep_s,
+        "workers": workers,
+    }
 
 
 def _plot_levels(path, rows: list[dict[str, Any]], *, title: str) -> None:
