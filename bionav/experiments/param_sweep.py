@@ -312,70 +312,75 @@ def _preprocess_node(name: str) -> dict[str, Any]:
 
 @dataclasses.dataclass(frozen=True)
 class _GridTask:
-    """One preprocessing of a grid run: every image size and signature of the grid (runs in a worker)."""
+    """One image size x preprocessing of a grid run: every signature of the grid (runs in a worker)."""
 
     db_node: dict
     data_dir: str
     cache_dir: str
-    preprocess: dict
-    sizes: tuple
-    signatures: tuple
-    homing_cfg: Any
-    rings: tuple
-    n_coeffs: tuple
-    step_length: float
-    success_radius: float
+    size: tuple
+    preprocess: Any
+    signatures: tuple = ()
+    homing_cfg: Any = None
+    rings: tuple = ()
+    n_coeffs: tuple = ()
+    step_length: float = 0.5
+    success_radius: float = 1.0
 
 
-def _grid_task(task: _GridTask) -> list[dict[str, Any]]:
-    """Rows of every image size x signature of one preprocessing (see :func:`_run_grid`)."""
+def _grid_database(task: _GridTask):
+    """The database of one grid unit, exactly as a job of the multirun loads it."""
     from pathlib import Path
 
     from bionav.db.loading import load_database
-    from bionav.db.preprocess import resize_database
-    from bionav.db.rotation import rotate_views
+
+    return load_database(dict(task.db_node, image_size=list(task.size)), data_dir=Path(task.data_dir),
+                         cache_dir=Path(task.cache_dir), preprocess=task.preprocess)
+
+
+def _grid_render(task: _GridTask) -> float:
+    """Render (or read from the cache) the database at one size; returns the wall time in s."""
+    t0 = time.perf_counter()
+    _grid_database(dataclasses.replace(task, preprocess=None))
+    return time.perf_counter() - t0
+
+
+def _grid_task(task: _GridTask) -> list[dict[str, Any]]:
+    """Rows of every signature of one image size x preprocessing (see :func:`_run_grid`)."""
     from bionav.plugins.homing.parameter import ParameterHoming
     from bionav.plugins.signatures import signature_class
 
-    node = dict(task.db_node)
-    rotate = str(node.get("source", "")).lower() == "folder" and bool(node.get("rotate_current"))
-    node.update(image_size=None, rotate_current=False if rotate else node.get("rotate_current", False))
-    native = load_database(node, data_dir=Path(task.data_dir), cache_dir=Path(task.cache_dir),
-                           preprocess=task.preprocess)
+    db = _grid_database(task)
+    preprocess = "none" if not task.preprocess else str(task.preprocess.get("name", "custom"))
     rows: list[dict[str, Any]] = []
-    for size in task.sizes:
-        db = resize_database(native, size)
-        if rotate:
-            db = rotate_views(db, seed=int(node.get("rotation_seed", 0)))
-        for sig_name in task.signatures:
-            sig_cls = signature_class(sig_name)
-            sig_cfg = sig_cls.Config()
-            names = {f.name for f in dataclasses.fields(sig_cfg)}
-            passed = {k: getattr(task.homing_cfg, k) for k in ("rings", "n_coeffs", "bins")
-                      if getattr(task.homing_cfg, k) is not None and k in names}
-            sig_cfg = dataclasses.replace(sig_cfg, **passed)
-            homing_cfg = dataclasses.replace(task.homing_cfg, signature=sig_name, rings=None, n_coeffs=None, bins=None)
-            levels = sweep_levels(sig_cls, rings=task.rings, n_coeffs=task.n_coeffs)
-            homings, measures, ms = evaluate_levels(ParameterHoming, homing_cfg, sig_cls, sig_cfg, levels, db,
-                                                    step_length=task.step_length, success_radius=task.success_radius)
-            rows += _rows(db, sig_name, str(task.preprocess.get("name", "none")), homings, measures, ms)
+    for sig_name in task.signatures:
+        sig_cls = signature_class(sig_name)
+        sig_cfg = sig_cls.Config()
+        names = {f.name for f in dataclasses.fields(sig_cfg)}
+        passed = {k: getattr(task.homing_cfg, k) for k in ("rings", "n_coeffs", "bins")
+                  if getattr(task.homing_cfg, k) is not None and k in names}
+        sig_cfg = dataclasses.replace(sig_cfg, **passed)
+        homing_cfg = dataclasses.replace(task.homing_cfg, signature=sig_name, rings=None, n_coeffs=None, bins=None)
+        levels = sweep_levels(sig_cls, rings=task.rings, n_coeffs=task.n_coeffs)
+        homings, measures, ms = evaluate_levels(ParameterHoming, homing_cfg, sig_cls, sig_cfg, levels, db,
+                                                step_length=task.step_length, success_radius=task.success_radius)
+        rows += _rows(db, sig_name, preprocess, homings, measures, ms)
     return rows
 
 
 def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
     """``experiment.scope=grid``: every signature x image size x preprocessing of the grid in this run.
 
-    The work is split by preprocessing over ``workers`` processes; each
-    preprocesses the database once at its native size and resizes it to every
-    size of the grid. The database is rendered (or read from the cache) once
-    before the workers start.
+    Each image size x preprocessing is one task for a pool of ``workers``
+    processes (largest images first); a task loads the database exactly as
+    the multirun's job would (rendered at that size, then preprocessed) and
+    evaluates every signature of the grid on it (:func:`evaluate_levels`).
+    Stand-ins not yet in the cache are rendered first, one size per task.
     """
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
-    from pathlib import Path
 
     from bionav.config import plugin_config
-    from bionav.db.loading import load_database
+    from bionav.plugins.signatures import signature_class
     from bionav.report.ranking import write_parameter_report
 
     if str(cfg.homing.name) != "parameter":
@@ -389,43 +394,41 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
     if grid is None:
         raise UserError(f"experiment.grid={grid_name!r} is not one of the sweep grids "
                         f"({', '.join(exp.grids or [])}); choose one of them.")
-    from bionav.plugins.signatures import signature_class
-
     signatures = tuple(str(v) for v in _grid_values(grid.signature, what="signature"))
     for name in signatures:
         signature_class(name)  # a clear error for an unknown name before any work
-    sizes = tuple(tuple(int(v) for v in size) for size in _grid_values(grid.image_size, what="image_size"))
+    sizes = [tuple(int(v) for v in size) for size in _grid_values(grid.image_size, what="image_size")]
+    sizes.sort(key=lambda wh: -wh[0] * wh[1])  # largest first: the pool ends with short tasks
     preprocessings = [_preprocess_node(str(v)) for v in _grid_values(grid.preprocess, what="preprocess")]
-    db_node = OmegaConf.to_container(cfg.db, resolve=True)
-    data_dir, cache_dir = str(cfg.data_dir), str(cfg.cache_dir)
-
-    t0 = time.perf_counter()
-    native = load_database(dict(db_node, image_size=None), data_dir=Path(data_dir), cache_dir=Path(cache_dir))
-    render_s = time.perf_counter() - t0
-    tasks = [
-        _GridTask(db_node=db_node, data_dir=data_dir, cache_dir=cache_dir, preprocess=pre, sizes=sizes,
-                  signatures=signatures, homing_cfg=homing_cfg, rings=tuple(int(r) for r in exp.rings),
-                  n_coeffs=tuple(int(k) for k in exp.n_coeffs), step_length=float(exp.step_length),
-                  success_radius=float(exp.success_radius))
-        for pre in preprocessings
-    ]
+    base = _GridTask(db_node=OmegaConf.to_container(cfg.db, resolve=True), data_dir=str(cfg.data_dir),
+                     cache_dir=str(cfg.cache_dir), size=sizes[0], preprocess=None, signatures=signatures,
+                     homing_cfg=homing_cfg, rings=tuple(int(r) for r in exp.rings),
+                     n_coeffs=tuple(int(k) for k in exp.n_coeffs), step_length=float(exp.step_length),
+                     success_radius=float(exp.success_radius))
+    renders = [dataclasses.replace(base, size=size) for size in sizes]
+    tasks = [dataclasses.replace(base, size=size, preprocess=pre) for size in sizes for pre in preprocessings]
     workers = max(1, min(int(cfg.get("workers") or 1), len(tasks)))
-    t1 = time.perf_counter()
+    name = str(base.db_node.get("name", "db"))
     rows: list[dict[str, Any]] = []
-    desc = f"param_sweep grid on {native.name} (preprocessings)"
+    t0 = time.perf_counter()
     if workers == 1:
-        for task in ctx.progress(tasks, desc=desc, total=len(tasks)):
+        render_s = sum(_grid_render(t) for t in renders)
+        t1 = time.perf_counter()
+        for task in ctx.progress(tasks, desc=f"param_sweep grid on {name}", total=len(tasks)):
             rows += _grid_task(task)
     else:
         with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-            for part in ctx.progress(pool.map(_grid_task, tasks), desc=desc, total=len(tasks)):
+            render_s = sum(pool.map(_grid_render, renders))
+            t1 = time.perf_counter()
+            for part in ctx.progress(pool.map(_grid_task, tasks), desc=f"param_sweep grid on {name}",
+                                     total=len(tasks)):
                 rows += part
     sweep_s = time.perf_counter() - t1
     _write_rows(ctx, rows)
     write_parameter_report(ctx.dir)
     best = max(rows, key=lambda r: (r["rr"], -r["aae"]))
     return {
-        "db": native.name,
+        "db": rows[0]["db"],
         "signature": best["signature"],
         "image_size": best["image_size"],
         "preprocess": best["preprocess"],
@@ -433,9 +436,9 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
         "mae": best["mae"],
         "rr": best["rr"],
         "n_configs": len(rows),
-        "n_images": len(native),
-        "render_s": render_s,
-        "sweep_s": sweep_s,
+        "render_wall_s": t1 - t0,
+        "render_task_s": render_s,
+        "sweep_wall_s": sweep_s,
         "workers": workers,
     }
 
