@@ -107,8 +107,10 @@ def main(argv=None) -> int:
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + ("all",), default="minwarping",
-                        help="method to time (default: minwarping)")
+    from bionav.bench.runs import RUN_METHODS, add_arguments, run_benchmark
+
+    parser.add_argument("--method", choices=METHODS + ("all",) + RUN_METHODS, default="minwarping",
+                        help="method to time (default: minwarping); sweep and cleaning time whole runs")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -127,7 +129,12 @@ def main(argv=None) -> int:
                         help="start N busy processes while measuring (default: 0)")
     parser.add_argument("--render-size", type=int, nargs=2, default=[576, 100], metavar=("W", "H"),
                         help="size of the rendered input panoramas (default: 576 100)")
+    add_arguments(parser)
     args = parser.parse_args(argv)
+    if args.method in RUN_METHODS:
+        for row in run_benchmark(args):
+            print(json.dumps(row) if args.json else "  ".join(f"{k}={v}" for k, v in row.items()))
+        return 0
     if args.threads < 1 or args.threads > 64:
         parser.error("--threads must lie in 1..64")
     if args.repeat < 1:
