@@ -40,3 +40,22 @@ def test_bench_rejects_bad_arguments(capsys, argv, message):
         main(argv)
     assert exc.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_bench_whole_runs_print_cpu_and_wall(capsys, tmp_path):
+    """--method sweep / cleaning run the documented commands (tiny inputs here) and report their times."""
+    from helpers import write_tiny_folder
+
+    folder = write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
+    assert main(["--json", "--method", "sweep", "--grid", "ci", "--dbs", "folder", "--override", f"db.path={folder}",
+                 "--override", "experiment.grids.ci.signature='mean,fc'"]) == 0
+    (row,) = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert row["method"] == "sweep" and row["variant"] == "ci_warm" and row["dbs"] == ["folder"]
+    assert row["configurations"] == 2 + 2  # [mean] at 2 ring counts, [fc] at 2 numbers of coefficients
+    assert row["cpu_s"] > 0 and row["wall_s"] > 0 and len(row["loadavg_1min"]) == 2
+    assert row["command"].startswith("python -m bionav -m experiment=param_sweep_grid experiment.grid=ci db=folder")
+    assert main(["--json", "--method", "cleaning", "--runs", "2", "--override", "experiment.vision=oracle",
+                 "--override", "layout.n_lanes=2", "--override", "layout.lane_length=1.0"]) == 0
+    (row,) = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert row["method"] == "cleaning" and row["runs"] == 2 and row["workers"] == 2
+    assert row["cpu_s"] > 0 and row["wall_s"] > 0 and 0 < row["coverage"] <= 1

@@ -44,6 +44,9 @@ def add_arguments(parser) -> None:
     group.add_argument("--runs", type=int, default=10,
                        help="cleaning: runs of the layout (default: 10, the thesis')")
     group.add_argument("--layout", default="long_lanes", help="cleaning: layout (default: long_lanes)")
+    group.add_argument("--override", action="append", default=[], metavar="KEY=VALUE",
+                       help="sweep / cleaning: an extra python -m bionav override (repeatable), e.g. "
+                            "--override layout.n_lanes=3")
 
 
 def _children_cpu() -> float:
@@ -82,6 +85,7 @@ def run_benchmark(args) -> list[dict]:
                        f"workers={args.workers}", f"hydra.sweep.dir={tmp / 'sweep'}"]
             if args.cold:
                 command.append(f"cache_dir={tmp / 'cache'}")
+            command += list(args.override)
             wall, cpu = _run(command, cwd=tmp, env=env)
             metrics = _metrics(tmp / "sweep")
             row = {
@@ -95,7 +99,7 @@ def run_benchmark(args) -> list[dict]:
             if args.runs < 1:
                 raise SystemExit("--runs must be >= 1")
             command = ["experiment=cleaning", f"layout={args.layout}", f"runs={args.runs}",
-                       f"workers={args.workers}", f"hydra.run.dir={tmp / 'cleaning'}"]
+                       f"workers={args.workers}", f"hydra.run.dir={tmp / 'cleaning'}", *args.override]
             wall, cpu = _run(command, cwd=tmp, env=env)
             (m,) = _metrics(tmp / "cleaning")
             row = {

@@ -188,12 +188,17 @@ def _signature_setup(cfg: DictConfig, ctx):
         sig_cls = signature_class(homing_cfg.signature)
         sig_cfg = sig_cls.Config()
         sig_name = str(homing_cfg.signature)
-    # homing.rings/n_coeffs/bins pass through to the signature's base config; the sweep varies R or K on top
+    homing_cfg, sig_cfg = _pass_through(homing_cfg, sig_name, sig_cfg)
+    return ParameterHoming, homing_cfg, sig_name, sig_cls, sig_cfg
+
+
+def _pass_through(homing_cfg, sig_name: str, sig_cfg):
+    """homing.rings/n_coeffs/bins pass through to the signature's base config; the sweep varies R or K on top."""
     names = {f.name for f in dataclasses.fields(sig_cfg)}
     passed = {k: getattr(homing_cfg, k) for k in ("rings", "n_coeffs", "bins") if getattr(homing_cfg, k) is not None}
     sig_cfg = dataclasses.replace(sig_cfg, **{k: v for k, v in passed.items() if k in names})
     homing_cfg = dataclasses.replace(homing_cfg, signature=sig_name, rings=None, n_coeffs=None, bins=None)
-    return ParameterHoming, homing_cfg, sig_name, sig_cls, sig_cfg
+    return homing_cfg, sig_cfg
 
 
 def _finite(x: float) -> float | None:
@@ -354,12 +359,7 @@ def _grid_task(task: _GridTask) -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = []
     for sig_name in task.signatures:
         sig_cls = signature_class(sig_name)
-        sig_cfg = sig_cls.Config()
-        names = {f.name for f in dataclasses.fields(sig_cfg)}
-        passed = {k: getattr(task.homing_cfg, k) for k in ("rings", "n_coeffs", "bins")
-                  if getattr(task.homing_cfg, k) is not None and k in names}
-        sig_cfg = dataclasses.replace(sig_cfg, **passed)
-        homing_cfg = dataclasses.replace(task.homing_cfg, signature=sig_name, rings=None, n_coeffs=None, bins=None)
+        homing_cfg, sig_cfg = _pass_through(task.homing_cfg, sig_name, sig_cls.Config())
         levels = sweep_levels(sig_cls, rings=task.rings, n_coeffs=task.n_coeffs)
         homings, measures, ms = evaluate_levels(ParameterHoming, homing_cfg, sig_cls, sig_cfg, levels, db,
                                                 step_length=task.step_length, success_radius=task.success_radius)
