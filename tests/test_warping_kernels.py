@@ -300,3 +300,46 @@ def test_quantised_kernels_compile_to_packed_byte_and_word_instructions():
     # |a - b| of 16-bit values as packed max - min, summed in packed 16-bit adds
     assert re.search(r"\bv?pmaxsw\b", asm) and re.search(r"\bv?pminsw\b", asm)
     assert re.search(r"\bv?paddw\b", asm)
+
+
+@pytest.mark.parametrize("step", [1, 3])
+@pytest.mark.parametrize("quantised", [False, True])
+def test_runs_of_directions_equal_single_hypotheses(step, quantised):
+    # the fine search's block kernel: runs of consecutive directions (any start,
+    # wrapping past column W - 1) per rotation, against the reference loops
+    from bionav.homing.warping.kernels import minwarp_scores_at, minwarp_scores_runs
+    from bionav.homing.warping.search import _window_minima
+
+    snap, cur = _pair(43)
+    tau = default_thresholds(SCALES)
+    windows = minwarp_windows(minwarp_template(W, SCALES, tau), max_level=2)
+    levels = _window_minima(snap, cur, step, windows, quantised).copy()
+    a_first = np.array([0, W - 2, 5, 17], np.int64)
+    p_cols = np.array([3, 0, W - 1, 40], np.int64)  # 40: taken modulo W
+    runs = minwarp_scores_runs(levels, a_first, 5, p_cols, *windows)
+    assert runs.shape == (4, 5)
+    a_all = ((a_first[:, None] + np.arange(5)) % W).ravel()
+    p_all = np.repeat(p_cols, 5)
+    np.testing.assert_array_equal(runs.ravel(), minwarp_scores_at(levels, a_all, p_all, *windows))
+    if not quantised:
+        for t in (0, 7, 19):
+            ref = minwarping_scores_reference(snap, cur, a_cols=[a_all[t]], p_cols=[p_all[t] % W], thresholds=tau)
+            assert runs.ravel()[t] == pytest.approx(ref[0, 0], rel=1e-5)
+
+
+@pytest.mark.parametrize("step", [1, 2, 3])
+def test_compass_measure_is_the_best_plane_distance_along_each_rotation(step):
+    from bionav.homing.warping.kernels import compass_measure
+
+    snap, cur = _pair(44)
+    p_cols = np.array([0, 1, 5, W - 1], np.int64)
+    ref_d = column_distance_matrix(snap, cur)  # (K, i, j)
+    want = [sum(ref_d[:, i, (i - p) % W].min() for i in range(W)) for p in p_cols]
+    got = compass_measure(diagonal_distances(snap, cur, step=step), p_cols)
+    np.testing.assert_allclose(got, want, rtol=1e-5)
+    q, _ = distance_quantum(W)
+    dq = diagonal_distances(snap, cur, step=step, quantised=True)
+    want_q = [sum(int(min(dq[k, (-p) % W, i % step, i // step] for k in range(len(SCALES)))) for i in range(W))
+              for p in p_cols]
+    np.testing.assert_array_equal(compass_measure(dq, p_cols), want_q)
+    assert np.abs(compass_measure(dq, p_cols) / q - want).max() <= W * (0.5 + 0.02 * q) / q

@@ -166,27 +166,20 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
                 for m in range(n):
                     o0[m] = t[m]
                     o0[m + n] = t[m]
-            elif step == 3:  # constant stride: compiles to byte shuffles
-                o0 = o[0]
-                o1 = o[1]
-                o2 = o[2]
-                for m in range(n):
-                    x0 = t[3 * m]
-                    x1 = t[3 * m + 1]
-                    x2 = t[3 * m + 2]
-                    o0[m] = x0
-                    o1[m] = x1
-                    o2[m] = x2
-                    o0[m + n] = x0
-                    o1[m + n] = x1
-                    o2[m + n] = x2
+            elif step == 3:  # constant stride, one phase at a time: byte shuffles
+                for rr in range(3):
+                    orr = o[rr]
+                    for m in range(n):
+                        orr[m] = t[3 * m + rr]
+                    for m in range(n):
+                        orr[m + n] = orr[m]
             else:
                 for rr in range(step):
                     orr = o[rr]
                     for m in range(n):
-                        x = t[m * step + rr]
-                        orr[m] = x
-                        orr[m + n] = x
+                        orr[m] = t[m * step + rr]
+                    for m in range(n):
+                        orr[m + n] = orr[m]
 
 
 @njit(nogil=True, fastmath=True, cache=True)

@@ -199,6 +199,68 @@ def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
 
 
 @njit(nogil=True, fastmath=True, cache=True)
+def minwarp_scores_runs(levels, a_first, n_a, p_cols, start, w_plane, w_level, w_v):
+    """Min-warping match values of runs of consecutive movement directions.
+
+    For each rotation ``p_cols[t]`` the ``n_a`` directions ``a_first[t] ..
+    a_first[t] + n_a - 1`` (columns, modulo ``W``): the fine search's block of
+    hypotheses around the best grid point, for the pair and (with shifted
+    directions) for the swapped pair. Reads the same windows as
+    :func:`minwarp_scores`; per window and rotation one row of the table, the
+    directions of a run at offsets fixed per snapshot column.
+
+    Parameters
+    ----------
+    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    a_first : ndarray, shape (P,), int64
+        First movement direction of each run, in columns.
+    n_a : int
+        Directions per run.
+    p_cols : ndarray, shape (P,), int64
+        Rotation of each run, in columns.
+    start, w_plane, w_level, w_v : ndarray
+        Min-warping windows.
+
+    Returns
+    -------
+    ndarray, shape (P, n_a), float64
+        In the units of ``levels``.
+    """
+    n_levels, n_planes, width, step, m2 = levels.shape
+    row = step * m2
+    flat = levels.reshape(-1)
+    n_p = p_cols.shape[0]
+    total = np.zeros((n_p, n_a))
+    best = np.empty((n_p, n_a))
+    offs = np.empty((n_p, n_a), np.uint64)
+    p_t = np.empty(n_p, np.int64)
+    for t in range(n_p):
+        p_t[t] = p_cols[t] % width
+    for u in range(width):
+        for t in range(n_p):
+            for a in range(n_a):
+                i = (u + a_first[t] + a) % width
+                m = i // step
+                offs[t, a] = np.uint64((i - m * step) * m2 + m)
+                best[t, a] = np.inf
+        for e in range(start[u], start[u + 1]):
+            base = (w_level[e] * n_planes + w_plane[e]) * width
+            v0 = w_v[e] - u
+            for t in range(n_p):
+                rb = np.uint64((base + _wrap(v0 - p_t[t], width)) * row)
+                bt = best[t]
+                ot = offs[t]
+                for a in range(n_a):
+                    x = np.float64(flat[rb + ot[a]])
+                    if x < bt[a]:
+                        bt[a] = x
+        for t in range(n_p):
+            for a in range(n_a):
+                total[t, a] += best[t, a]
+    return total
+
+
+@njit(nogil=True, fastmath=True, cache=True)
 def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
     """2D-warping match values for every (rho, psi, alpha step).
 
@@ -276,17 +338,24 @@ def compass_measure(dist, p_cols):
     n_planes, width, step, m2 = dist.shape
     n = width // step
     out = np.zeros(p_cols.shape[0])
+    best = np.empty(n, dtype=dist.dtype)
+    # per rotation one diagonal d: the minimum over the planes is taken on
+    # whole rows (packed byte minima), then summed
     for ip in range(p_cols.shape[0]):
         d = (-p_cols[ip]) % width
         total = 0.0
         for rr in range(step):
+            row = dist[0, d, rr]
             for m in range(n):
-                best = dist[0, d, rr, m]
-                for k in range(1, n_planes):
-                    x = dist[k, d, rr, m]
-                    if x < best:
-                        best = x
-                total += best
+                best[m] = row[m]
+            for k in range(1, n_planes):
+                row = dist[k, d, rr]
+                for m in range(n):
+                    best[m] = min(best[m], row[m])
+            s = 0.0
+            for m in range(n):
+                s += np.float64(best[m])
+            total += s
         out[ip] = total
     return out
 
