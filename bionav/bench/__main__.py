@@ -212,6 +212,10 @@ def main(argv=None) -> int:
                         help="snapshots of the grid run, each against every cell (default: 4)")
     parser.add_argument("--grid-rounds", type=int, default=3,
                         help="alternate rounds of the grid run (default: 3)")
+    parser.add_argument("--pairs", type=int, default=len(POSES), choices=range(1, len(POSES) + 1),
+                        metavar=f"1..{len(POSES)}",
+                        help=f"current views (pairs with the snapshot) cycled through (default: {len(POSES)}; "
+                             "1: the first pair only, as the reference driver of docs/performance.md)")
     parser.add_argument("--render-size", type=int, nargs=2, default=[576, 100], metavar=("W", "H"),
                         help="size of the rendered input panoramas (default: 576 100)")
     args = parser.parse_args(argv)
@@ -241,7 +245,8 @@ def main(argv=None) -> int:
 
     rw, rh = args.render_size
     snap, geometry = render_pillar_panorama((0.0, 0.0), width=rw, height=rh, supersample=2)
-    currents = [render_pillar_panorama(p, heading=h, width=rw, height=rh, supersample=2)[0] for p, h in POSES]
+    currents = [render_pillar_panorama(p, heading=h, width=rw, height=rh, supersample=2)[0]
+                for p, h in POSES[:args.pairs]]
 
     names = METHODS if args.method == "all" else (args.method,)
     runs = []
@@ -286,6 +291,7 @@ def main(argv=None) -> int:
             "compass_fraction": args.compass_fraction if "compass" in run["variant"] else None,
             "rounds": args.repeat,
             "home_vectors_per_round": batch,
+            "pairs": args.pairs,
             "background_load": args.background_load,
             "loadavg_1min": [round(load_before, 2), round(load_after, 2)],
             "machine": f"{platform.machine()} {os.cpu_count()} cpus",
