@@ -165,33 +165,25 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
                 o0 = o[0]
                 for m in range(n):
                     o0[m] = t[m]
-                    o0[m + n] = t[m]
             elif step == 3:  # constant stride, one phase at a time: byte shuffles
                 for rr in range(3):
                     orr = o[rr]
                     for m in range(n):
                         orr[m] = t[3 * m + rr]
-                    for m in range(n):
-                        orr[m + n] = orr[m]
             else:
                 for rr in range(step):
                     orr = o[rr]
                     for m in range(n):
                         orr[m] = t[m * step + rr]
-                    for m in range(n):
-                        orr[m + n] = orr[m]
 
 
 @njit(nogil=True, fastmath=True, cache=True)
 def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
-    """Fill ``out[k, d, i % step, i // step (+ n)] = NSAD(snap[k, :, i], cur[k, :, (i + d) % W])``.
+    """Fill ``out[k, d, i % step, i // step] = NSAD(snap[k, :, i], cur[k, :, (i + d) % W])``.
 
     ``cur2`` and ``cur_norm2`` hold the current view's planes and norms twice
     side by side (width ``2 W``) so that column ``i + d`` needs no wrap.
-    ``out`` has shape ``(K, W, step, 2 * n)`` with ``n = W // step``; the second
-    half of the last axis repeats the first, so that ``n`` consecutive entries
-    starting anywhere in the first half are a contiguous slice (the search
-    kernels read the distances of all ``n`` alpha steps as one vector).
+    ``out`` has shape ``(K, W, step, n)`` with ``n = W // step``.
     """
     n_planes, n_rows, width = snap.shape
     n = width // step
@@ -216,7 +208,6 @@ def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
                     if den > 0:
                         val = acc[i] / den
                     out[k, d, rr, m] = val
-                    out[k, d, rr, m + n] = val
 
 
 def _absmax(stack, key):
@@ -234,7 +225,7 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
         Scale-plane stacks (see :func:`column_distance_matrix`).
     step : int
         Alpha step in columns (``W`` must be a multiple of it).
-    out : ndarray, shape (K, W, step, 2 * W // step), optional
+    out : ndarray, shape (K, W, step, W // step), optional
         Array to fill (C-contiguous, float32 or uint8 for ``quantised``), e.g.
         the first level of the search's window minima; a new one by default.
     quantised : bool
@@ -244,9 +235,8 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
 
     Returns
     -------
-    ndarray, shape (K, W, step, 2 * W // step), float32 or uint8
-        ``E[k, d, i % step, i // step]`` (and again at ``i // step + W // step``)
-        equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``
+    ndarray, shape (K, W, step, W // step), float32 or uint8
+        ``E[k, d, i % step, i // step]`` equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``
         (times ``q`` and rounded when quantised).
     """
     snap = np.ascontiguousarray(snapshot["snap"], dtype=np.float32)
@@ -259,7 +249,7 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
     if width % step:
         raise ValueError(f"width {width} is not a multiple of the alpha step {step}")
     n = width // step
-    shape = (n_planes, width, step, 2 * n)
+    shape = (n_planes, width, step, n)
     dtype = np.uint8 if quantised else np.float32
     if out is None:
         out = np.empty(shape, dtype=dtype)

@@ -60,7 +60,7 @@ def fill_window_minima(levels):
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
         ``levels[0]`` filled; levels ``1 .. J`` are overwritten.
     """
     n_levels, n_planes, width, step, m2 = levels.shape
@@ -85,7 +85,7 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
         Column distances (diagonal layout) and their sliding minima
         (:func:`fill_window_minima`).
     n_alpha : int
@@ -109,33 +109,36 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     ndarray, shape (P, n_alpha)
         ``out``: ``sum_u min_{v, k allowed} dist`` for each (psi, alpha); lower is better.
     """
-    _, n_planes, width, step, m2 = levels.shape
+    _, n_planes, width, step, n = levels.shape
     n_p = p_cols.shape[0]
-    best = np.empty((n_p, n_alpha), dtype=levels.dtype)
-    row_stride = step * m2
+    best = np.empty((n_p, n), dtype=levels.dtype)
+    row_stride = step * n
     # snapshot columns in phase order (u = rr, rr + step, ...): one phase reads
     # a third of the table (step 3), which keeps the reads in cache; per window
     # all rotations at once (the window's plane and level stay fixed); the
     # first window of a column is copied, the others compared and selected
-    # (packed byte compares)
+    # (packed byte compares). The minima are kept over whole rows (column
+    # i // step of the snapshot, any alpha) and added to the match values of
+    # alpha step (i // step - u // step) mod n afterwards, so that the table
+    # holds every distance once.
     for rr in range(step):
         for u in range(rr, width, step):
             e0 = start[u]
             e1 = start[u + 1]
-            off = rr * m2 + u // step
+            off = u // step
             for e in range(e0, e1):
                 flat = levels[w_level[e], w_plane[e]].reshape(-1)
                 v0 = w_v[e] - u
                 first = e == e0
                 for ip in range(n_p):
-                    base = _wrap(v0 - p_cols[ip], width) * row_stride + off
-                    row = flat[base:base + n_alpha]
+                    base = _wrap(v0 - p_cols[ip], width) * row_stride + rr * n
+                    row = flat[base:base + n]
                     b = best[ip]
                     if first:
-                        for a in range(n_alpha):
+                        for a in range(n):
                             b[a] = row[a]
                     else:
-                        for a in range(n_alpha):
+                        for a in range(n):
                             x = row[a]
                             if x < b[a]:
                                 b[a] = x
@@ -144,8 +147,14 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
             for ip in range(n_p):
                 acc = out[ip]
                 b = best[ip]
-                for a in range(n_alpha):
-                    acc[a] += b[a]
+                # slices: plain contiguous loops (indices ``a + off`` would
+                # keep them from vectorising)
+                b1 = b[off:]
+                acc2 = acc[n - off:]
+                for a in range(n - off):
+                    acc[a] += b1[a]
+                for a in range(off):
+                    acc2[a] += b[a]
     return out
 
 
@@ -158,7 +167,7 @@ def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
     a_cols, p_cols : ndarray, shape (N,), int64
         Movement direction and rotation of each pair, in columns.
     start, w_plane, w_level, w_v : ndarray
@@ -211,7 +220,7 @@ def minwarp_scores_runs(levels, a_first, n_a, p_cols, start, w_plane, w_level, w
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
     a_first : ndarray, shape (P,), int64
         First movement direction of each run, in columns.
     n_a : int
@@ -266,7 +275,7 @@ def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step), float32
+    dist : ndarray, shape (K, W, step, W // step), float32
     n_alpha : int
     p_cols : ndarray, shape (P,), int64
         Rotations in columns.
@@ -291,8 +300,12 @@ def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
                 rr = u - m0 * step
                 d = _wrap(v_tab[ir, u] - u - pc, width)
                 row = dist[k_tab[ir, u], d, rr]
-                for a in range(n_alpha):
-                    acc[a] += row[m0 + a]
+                row1 = row[m0:]
+                acc2 = acc[n_alpha - m0:]
+                for a in range(n_alpha - m0):
+                    acc[a] += row1[a]
+                for a in range(m0):
+                    acc2[a] += row[a]
     return out
 
 
@@ -329,7 +342,7 @@ def compass_measure(dist, p_cols):
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step), float32 or uint8
+    dist : ndarray, shape (K, W, step, W // step), float32 or uint8
 
     Returns
     -------
@@ -372,10 +385,10 @@ def swap_roles(dist, out):
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step)
+    dist : ndarray, shape (K, W, step, W // step)
         Diagonal-layout distances of the pair.
     out : ndarray, same shape and dtype
-        Filled with those of the swapped pair (both halves of the last axis).
+        Filled with those of the swapped pair.
     """
     n_planes, width, step, m2 = dist.shape
     n = width // step
@@ -391,8 +404,7 @@ def swap_roles(dist, out):
                 ph = c - off * step
                 if off >= n:
                     off -= n
-                row = s[ph, off:off + n]
+                row = s[ph]
                 dst = o[rj]
-                for m in range(n):
-                    dst[m] = row[m]
-                    dst[m + n] = row[m]
+                dst[:n - off] = row[off:]
+                dst[n - off:] = row[:off]

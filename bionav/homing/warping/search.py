@@ -132,7 +132,7 @@ def _window_minima(snapshot, current, step, windows, quantised, name="levels"):
     n_levels = int(windows[2].max(initial=0)) + 1
     n_planes, _, width = np.shape(snapshot["snap"])
     dtype = np.dtype(np.uint8 if quantised else np.float32)
-    levels = _buffer(name, (n_levels, n_planes, width, step, 2 * (width // step)), dtype)
+    levels = _buffer(name, (n_levels, n_planes, width, step, width // step), dtype)
     diagonal_distances(snapshot, current, step=step, out=levels[0], quantised=quantised)
     if n_levels > 1:
         fill_window_minima(levels)
