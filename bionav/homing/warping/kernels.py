@@ -247,11 +247,23 @@ def minwarp_scores_runs(levels, a_first, n_a, p_cols, start, w_plane, w_level, w
         p_t[t] = p_cols[t] % width
     for u in range(width):
         for t in range(n_p):
+            # column i = u + a_first[t] + a (mod W) as (i % step, i // step),
+            # advanced without dividing
+            i = (u + a_first[t]) % width
+            m = i // step
+            r = i - m * step
             for a in range(n_a):
-                i = (u + a_first[t] + a) % width
-                m = i // step
-                offs[t, a] = np.uint64((i - m * step) * m2 + m)
+                offs[t, a] = np.uint64(r * m2 + m)
                 best[t, a] = np.inf
+                i += 1
+                r += 1
+                if r == step:
+                    r = 0
+                    m += 1
+                if i == width:
+                    i = 0
+                    r = 0
+                    m = 0
         for e in range(start[u], start[u + 1]):
             base = (w_level[e] * n_planes + w_plane[e]) * width
             v0 = w_v[e] - u
@@ -406,5 +418,9 @@ def swap_roles(dist, out):
                     off -= n
                 row = s[ph]
                 dst = o[rj]
-                dst[:n - off] = row[off:]
-                dst[n - off:] = row[:off]
+                row1 = row[off:]
+                dst2 = dst[n - off:]
+                for m in range(n - off):
+                    dst[m] = row1[m]
+                for m in range(off):
+                    dst2[m] = row[m]
