@@ -98,9 +98,9 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     """8-bit NSAD in diagonal layout from 16-bit stacks.
 
     ``sq`` (K, R, W) and ``sn`` (K, W): quantised snapshot planes and column
-    norms; ``cq2`` (K, R, 2 W) and ``cn2`` (K, 2 W): the current view's, twice
-    side by side, so that the columns ``i + d`` of all snapshot columns ``i``
-    are one contiguous run. The sums of a plane are kept for all diagonals
+    norms; ``cq2`` (K, R, 2 W + 1) and ``cn2`` (K, 2 W + 1): the current view's,
+    twice side by side (and one more column), so that the columns ``i + d`` of
+    all snapshot columns ``i`` are one contiguous run. The sums of a plane are kept for all diagonals
     (``W x W`` 16-bit, in L2 cache) and built eight rows at a time, so that
     those rows stay in L1 cache while every diagonal visits them; the inner
     loops run over all ``W`` columns (32 16-bit lanes). The bytes are then
@@ -108,12 +108,13 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     """
     n_planes, n_rows, width = sq.shape
     n = width // step
-    acc = np.empty((width, width), np.uint16)
+    acc = np.empty((width + 1, width), np.uint16)  # row W: scratch for odd W
     t = np.zeros(width, np.uint8)
     qf = np.float32(quantum)
     for k in range(n_planes):
         acc[:] = 0
-        # |a - b| as max - min keeps the loops in 16-bit lanes
+        # |a - b| of 16-bit values (|a|, |b| <= 2047: no overflow); two
+        # diagonals per pass share the loads of the snapshot rows
         r = 0
         while r + 8 <= n_rows:
             a0 = sq[k, r]
@@ -124,22 +125,37 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
             a5 = sq[k, r + 5]
             a6 = sq[k, r + 6]
             a7 = sq[k, r + 7]
-            for d in range(width):
-                b0 = cq2[k, r, d:d + width]
-                b1 = cq2[k, r + 1, d:d + width]
-                b2 = cq2[k, r + 2, d:d + width]
-                b3 = cq2[k, r + 3, d:d + width]
-                b4 = cq2[k, r + 4, d:d + width]
-                b5 = cq2[k, r + 5, d:d + width]
-                b6 = cq2[k, r + 6, d:d + width]
-                b7 = cq2[k, r + 7, d:d + width]
+            for d in range(0, width, 2):
+                b0 = cq2[k, r, d:d + width + 1]
+                b1 = cq2[k, r + 1, d:d + width + 1]
+                b2 = cq2[k, r + 2, d:d + width + 1]
+                b3 = cq2[k, r + 3, d:d + width + 1]
+                b4 = cq2[k, r + 4, d:d + width + 1]
+                b5 = cq2[k, r + 5, d:d + width + 1]
+                b6 = cq2[k, r + 6, d:d + width + 1]
+                b7 = cq2[k, r + 7, d:d + width + 1]
                 ac = acc[d]
+                ad = acc[d + 1]
                 for i in range(width):
+                    x0 = a0[i]
+                    x1 = a1[i]
+                    x2 = a2[i]
+                    x3 = a3[i]
+                    x4 = a4[i]
+                    x5 = a5[i]
+                    x6 = a6[i]
+                    x7 = a7[i]
                     ac[i] += np.uint16(
-                        max(a0[i], b0[i]) - min(a0[i], b0[i]) + max(a1[i], b1[i]) - min(a1[i], b1[i])
-                        + max(a2[i], b2[i]) - min(a2[i], b2[i]) + max(a3[i], b3[i]) - min(a3[i], b3[i])
-                        + max(a4[i], b4[i]) - min(a4[i], b4[i]) + max(a5[i], b5[i]) - min(a5[i], b5[i])
-                        + max(a6[i], b6[i]) - min(a6[i], b6[i]) + max(a7[i], b7[i]) - min(a7[i], b7[i])
+                        abs(np.int16(x0 - b0[i])) + abs(np.int16(x1 - b1[i]))
+                        + abs(np.int16(x2 - b2[i])) + abs(np.int16(x3 - b3[i]))
+                        + abs(np.int16(x4 - b4[i])) + abs(np.int16(x5 - b5[i]))
+                        + abs(np.int16(x6 - b6[i])) + abs(np.int16(x7 - b7[i]))
+                    )
+                    ad[i] += np.uint16(
+                        abs(np.int16(x0 - b0[i + 1])) + abs(np.int16(x1 - b1[i + 1]))
+                        + abs(np.int16(x2 - b2[i + 1])) + abs(np.int16(x3 - b3[i + 1]))
+                        + abs(np.int16(x4 - b4[i + 1])) + abs(np.int16(x5 - b5[i + 1]))
+                        + abs(np.int16(x6 - b6[i + 1])) + abs(np.int16(x7 - b7[i + 1]))
                     )
             r += 8
         while r < n_rows:
@@ -148,7 +164,7 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
                 b0 = cq2[k, r, d:d + width]
                 ac = acc[d]
                 for i in range(width):
-                    ac[i] += np.uint16(max(a0[i], b0[i]) - min(a0[i], b0[i]))
+                    ac[i] += np.uint16(abs(np.int16(a0[i] - b0[i])))
             r += 1
         na = sn[k]
         for d in range(width):
@@ -260,8 +276,8 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
         scale = np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
         sq = np.empty((n_planes, n_rows, width), np.int16)
         sn = np.empty((n_planes, width), np.int32)
-        cq2 = np.empty((n_planes, n_rows, 2 * width), np.int16)
-        cn2 = np.empty((n_planes, 2 * width), np.int32)
+        cq2 = np.empty((n_planes, n_rows, 2 * width + 1), np.int16)
+        cn2 = np.empty((n_planes, 2 * width + 1), np.int32)
         _quantise(snap, scale, sq, sn)
         _quantise(cur, scale, cq2, cn2)
         _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
