@@ -20,6 +20,8 @@ summed in 16 bits, and the distance is stored as a byte,
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from numba import njit
 
@@ -226,6 +228,19 @@ def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
                     out[k, d, rr, m] = val
 
 
+_SCRATCH = threading.local()
+
+
+def _scratch(name, shape, dtype):
+    """A per-thread array kept between calls (contents undefined)."""
+    cache = _SCRATCH.__dict__.setdefault("arrays", {})
+    arr = cache.get(name)
+    if arr is None or arr.shape != shape or arr.dtype != dtype:
+        arr = np.empty(shape, dtype=dtype)
+        cache[name] = arr
+    return arr
+
+
 def _absmax(stack, key):
     if f"{key}_absmax" in stack:
         return float(stack[f"{key}_absmax"])
@@ -274,10 +289,11 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
     if quantised:
         top = max(_absmax(snapshot, "snap"), _absmax(current, "cur"))
         scale = np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
-        sq = np.empty((n_planes, n_rows, width), np.int16)
-        sn = np.empty((n_planes, width), np.int32)
-        cq2 = np.empty((n_planes, n_rows, 2 * width + 1), np.int16)
-        cn2 = np.empty((n_planes, 2 * width + 1), np.int32)
+        # per-thread scratch arrays: fresh ones would be new pages (page faults) on every call
+        sq = _scratch("sq", (n_planes, n_rows, width), np.int16)
+        sn = _scratch("sn", (n_planes, width), np.int32)
+        cq2 = _scratch("cq2", (n_planes, n_rows, 2 * width + 1), np.int16)
+        cn2 = _scratch("cn2", (n_planes, 2 * width + 1), np.int32)
         _quantise(snap, scale, sq, sn)
         _quantise(cur, scale, cq2, cn2)
         _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
