@@ -393,9 +393,12 @@ def sift_home_angles_all_pairs(
                 angles[a, b], used[a, b] = home_angle_from_keys(key_b, ib.x, ib.y, ib.where, ia.x, ia.y, ia.where,
                                                                 *geo)
 
-    # rows of small ``a`` hold the most pairs: hand them out first
-    with ThreadPoolExecutor(max(1, int(workers))) as pool:
+    # rows of small ``a`` hold the most pairs: handed out first
+    pool = ThreadPoolExecutor(max(1, int(workers)))
+    try:
         done = pool.map(row, range(n))
         for _ in (progress(done, desc="home vectors (SIFT pairs)", total=n) if progress else done):
             pass
+    finally:  # on Ctrl-C or an error, rows not yet started are dropped instead of awaited
+        pool.shutdown(wait=True, cancel_futures=True)
     return angles, used

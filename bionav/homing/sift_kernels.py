@@ -1,6 +1,6 @@
 """Compiled kernels of SIFT homing: neighbourhood matching through a column index (thesis eqs. 5.1-5.3).
 
-Keypoints of each image are sorted by column once; for a group of four
+Keypoints of each image are sorted by column once; for a group of eight
 neighbouring current keypoints only the snapshot keypoints whose columns lie
 within the search radius of the group (two contiguous index ranges at most on
 the circular panorama) are visited, and the exact neighbourhood test decides.
@@ -21,8 +21,11 @@ import numpy as np
 #: keys pack (distance, original index) into one int64: distance * 2**32 + index
 _SHIFT = np.int64(1) << np.int64(32)
 _NONE = np.iinfo(np.int64).max
+_TWO_SHIFT = np.int64(2) * _SHIFT
+#: pixels kept between the radius and the core, where the neighbourhood test is skipped (far above rounding)
+_CORE_MARGIN = 1e-6
 #: current keypoints handled together (their descriptors stay in registers)
-GROUP = 4
+GROUP = 8
 
 
 @nb.njit(nogil=True, cache=True)
@@ -39,35 +42,42 @@ def _segments(lo: float, hi: float, x: np.ndarray, width: float):
 
 
 @nb.njit(nogil=True, cache=True, fastmath={"reassoc", "contract"})
-def _dot4(da, g0, db, j):
-    """Dot products of descriptor ``j`` of b with descriptors ``g0 .. g0 + 3`` of a.
+def _dot8(da, g0, db, j):
+    """Dot products of descriptor ``j`` of b with descriptors ``g0 .. g0 + 7`` of a.
 
     float32 sums of integer products in any order are exact while every
     partial sum stays below 2**24 (SIFT: at most 128 * 255**2 < 2**23), so
     reassociation (vectorisation) changes nothing.
     """
-    acc0 = np.float32(0.0)
-    acc1 = np.float32(0.0)
-    acc2 = np.float32(0.0)
-    acc3 = np.float32(0.0)
+    a0 = a1 = a2 = a3 = a4 = a5 = a6 = a7 = np.float32(0.0)
     for k in range(da.shape[1]):
         bk = db[j, k]
-        acc0 += da[g0, k] * bk
-        acc1 += da[g0 + 1, k] * bk
-        acc2 += da[g0 + 2, k] * bk
-        acc3 += da[g0 + 3, k] * bk
-    return np.int64(acc0), np.int64(acc1), np.int64(acc2), np.int64(acc3)
+        a0 += da[g0, k] * bk
+        a1 += da[g0 + 1, k] * bk
+        a2 += da[g0 + 2, k] * bk
+        a3 += da[g0 + 3, k] * bk
+        a4 += da[g0 + 4, k] * bk
+        a5 += da[g0 + 5, k] * bk
+        a6 += da[g0 + 6, k] * bk
+        a7 += da[g0 + 7, k] * bk
+    return (np.int32(a0), np.int32(a1), np.int32(a2), np.int32(a3), np.int32(a4), np.int32(a5), np.int32(a6),
+            np.int32(a7))
 
 
 @nb.njit(nogil=True, cache=True)
 def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, key_b, symmetric):
     """Best neighbourhood matches between two column-sorted keypoint sets.
 
+    For each group of 8 sorted a-keypoints the dot products with every
+    b-keypoint in the group's column window are computed (into a buffer),
+    then each a-keypoint's row of the buffer is scanned with the exact
+    neighbourhood test (vectorised passes).
+
     Parameters
     ----------
     xa, ya : float64 (NA,)
         Columns (sorted ascending) and rows of image a's keypoints.
-    da : float32 (ceil(NA / 4) * 4, 128)
+    da : float32 (ceil(NA / 8) * 8, 128)
         Their descriptors, integers in [-255, 255] (rows beyond NA are zero padding).
     na : int64 (NA,)
         Squared descriptor norms.
@@ -94,17 +104,22 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
         key_b[:] = _NONE
     if n_a == 0 or n_b == 0:
         return
-    inside = True
+    inside_image = True
     for i in range(n_a):
         if not (0.0 <= xa[i] < width):
-            inside = False
+            inside_image = False
     for j in range(n_b):
         if not (0.0 <= xb[j] < width):
-            inside = False
-    dots = np.zeros(GROUP, np.int64)
+            inside_image = False
+    y_lo = np.min(yb)
+    y_hi = np.max(yb)
+    base_b = np.empty(n_b, np.int64)
+    for j in range(n_b):
+        base_b[j] = nbs[j] * _SHIFT + rb[j]
+    buf = np.empty((GROUP, n_b), np.int32)
     for g0 in range(0, n_a, GROUP):
         g1 = min(g0 + GROUP, n_a)
-        if inside:
+        if inside_image:
             s0, e0, s1, e1 = _segments(xa[g0] - radius - 1.0, xa[g1 - 1] + radius + 1.0, xb, width)
         else:
             s0, e0, s1, e1 = 0, n_b, 0, 0
@@ -112,24 +127,77 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
             start = s0 if seg == 0 else s1
             stop = e0 if seg == 0 else e1
             for j in range(start, stop):
-                acc0, acc1, acc2, acc3 = _dot4(da, g0, db, j)
-                dots[0] = acc0
-                dots[1] = acc1
-                dots[2] = acc2
-                dots[3] = acc3
-                for t in range(g1 - g0):
-                    i = g0 + t
-                    dx = abs(xa[i] - xb[j])
-                    dx = min(dx, width - dx)
-                    dy = ya[i] - yb[j]
-                    if dx * dx + dy * dy < r2:
-                        k_ab = (nbs[j] - 2 * dots[t]) * _SHIFT + rb[j]
-                        if k_ab < key_a[i]:
-                            key_a[i] = k_ab
-                        if symmetric:
-                            k_ba = (na[i] - 2 * dots[t]) * _SHIFT + ra[i]
-                            if k_ba < key_b[j]:
-                                key_b[j] = k_ba
+                t8 = _dot8(da, g0, db, j)
+                for t in range(GROUP):
+                    buf[t, j] = t8[t]
+            for t in range(g1 - g0):
+                i = g0 + t
+                xi = xa[i]
+                yi = ya[i]
+                # core: columns closer than h, where every row of b is inside the radius for sure
+                dy_max = max(abs(yi - y_lo), abs(yi - y_hi))
+                h = np.sqrt(max(r2 - dy_max * dy_max, 0.0)) - _CORE_MARGIN
+                if h <= 0.0 or not inside_image:
+                    c0 = c1 = c2 = c3 = c4 = c5 = start
+                else:
+                    # the core is x in [xi - h, xi + h] and, across the border, x <= xi + h - W or x >= xi - h + W
+                    c0 = start
+                    c1 = max(start, min(stop, np.searchsorted(xb, xi + h - width, side="right")))
+                    c2 = max(c1, min(stop, np.searchsorted(xb, xi - h)))
+                    c3 = max(c2, min(stop, np.searchsorted(xb, xi + h, side="right")))
+                    c4 = max(c3, min(stop, np.searchsorted(xb, xi - h + width)))
+                    c5 = stop
+                best = key_a[i]
+                base_a = na[i] * _SHIFT + ra[i]
+                row = buf[t]
+                # pieces [c0, c1) core, [c1, c2) edge, [c2, c3) core, [c3, c4) edge, [c4, c5) core
+                best = _scan_core(row, base_b, base_a, key_b, symmetric, c0, c1, best)
+                best = _scan_edge(row, base_b, base_a, key_b, symmetric, c1, c2, best, xi, yi, xb, yb, width, r2)
+                best = _scan_core(row, base_b, base_a, key_b, symmetric, c2, c3, best)
+                best = _scan_edge(row, base_b, base_a, key_b, symmetric, c3, c4, best, xi, yi, xb, yb, width, r2)
+                best = _scan_core(row, base_b, base_a, key_b, symmetric, c4, c5, best)
+                if c5 == start:  # no core: the whole range with the test
+                    best = _scan_edge(row, base_b, base_a, key_b, symmetric, start, stop, best, xi, yi, xb, yb,
+                                      width, r2)
+                key_a[i] = best
+
+
+@nb.njit(nogil=True, cache=True)
+def _scan_core(row, base_b, base_a, key_b, symmetric, start, stop, best):
+    """Keys of candidates ``start .. stop - 1``, all inside the radius; returns the row's best key."""
+    # slices and loops from 0: indices the compiler knows are non-negative vectorise without gathers
+    dots = row[start:stop]
+    bb = base_b[start:stop]
+    if symmetric:
+        kb = key_b[start:stop]
+        for j in range(dots.shape[0]):
+            d = np.int64(dots[j]) * _TWO_SHIFT
+            best = min(best, bb[j] - d)
+            kb[j] = min(kb[j], base_a - d)
+    else:
+        for j in range(dots.shape[0]):
+            best = min(best, bb[j] - np.int64(dots[j]) * _TWO_SHIFT)
+    return best
+
+
+@nb.njit(nogil=True, cache=True)
+def _scan_edge(row, base_b, base_a, key_b, symmetric, start, stop, best, xi, yi, xb, yb, width, r2):
+    """Keys of candidates ``start .. stop - 1`` with the exact neighbourhood test (eq. 5.3)."""
+    dots = row[start:stop]
+    bb = base_b[start:stop]
+    xs = xb[start:stop]
+    ys = yb[start:stop]
+    kb = key_b[start:stop] if symmetric else key_b[:0]
+    for j in range(dots.shape[0]):
+        dx = abs(xi - xs[j])
+        dx = min(dx, width - dx)
+        dy = yi - ys[j]
+        inside = dx * dx + dy * dy < r2
+        d = np.int64(dots[j]) * _TWO_SHIFT
+        best = min(best, bb[j] - d if inside else _NONE)
+        if symmetric:
+            kb[j] = min(kb[j], base_a - d if inside else _NONE)
+    return best
 
 
 @nb.njit(nogil=True, cache=True)
