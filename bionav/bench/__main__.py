@@ -199,8 +199,11 @@ def main(argv=None) -> int:
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all",), default="minwarping",
-                        help="method to time (default: minwarping; all = the pair methods, not sift)")
+    from bionav.bench.runs import RUN_METHODS, add_arguments, run_benchmark
+
+    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all",) + RUN_METHODS, default="minwarping",
+                        help="method to time (default: minwarping; all = the pair methods, not sift); "
+                             "sweep and cleaning time whole runs")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -239,7 +242,12 @@ def main(argv=None) -> int:
                       help="comma-separated SIFT variants: plain, histeq (default: both)")
     sift.add_argument("--images", type=int, default=None, metavar="N",
                       help="use the first N images of the grid (default: all)")
+    add_arguments(parser)
     args = parser.parse_args(argv)
+    if args.method in RUN_METHODS:
+        for row in run_benchmark(args):
+            print(json.dumps(row) if args.json else "  ".join(f"{k}={v}" for k, v in row.items()))
+        return 0
     if args.threads < 1 or args.threads > 64:
         parser.error("--threads must lie in 1..64")
     if args.repeat is None:
