@@ -66,6 +66,22 @@ POSE_ERRORS = {
 }
 
 
+def raw_horizon_radius(mirror: str, camera: CameraConfig | None = None) -> float:
+    """Radius in pixels of the horizon circle in the full raw frame, ``gamma / xi`` (thesis Butterworth cutoffs).
+
+    Parameters
+    ----------
+    mirror : str
+        ``ultra-wide`` or ``normal-view`` (:data:`MIRRORS`), used when ``camera`` is None.
+    camera : CameraConfig, optional
+        An explicit camera.
+    """
+    cam = camera if camera is not None else CameraConfig(**MIRRORS[mirror])
+    proj = MirrorProjection.from_rim(xi=float(cam.mirror_xi), rim_elevation_deg=float(cam.rim_elevation_deg),
+                                     rim_radius_px=float(cam.rim_radius_px), center=(0.0, 0.0))
+    return float(proj.radius_from_elevation(0.0))
+
+
 def camera_config_for(mirror: str, **overrides) -> CameraConfig:
     """The :class:`CameraConfig` of a mirror type (``ultra-wide`` or ``normal-view``) plus overrides."""
     return CameraConfig(**{**MIRRORS[mirror], **overrides})
