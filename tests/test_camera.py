@@ -260,3 +260,19 @@ def test_bad_camera_values_are_rejected_with_one_clear_message(override, words, 
     msg = str(info.value)
     assert all(w in msg for w in words), msg
     assert "\n" not in msg.strip()
+
+
+def test_documented_camera_sheet_command_on_a_tiny_input(tmp_path):
+    import cv2
+
+    from helpers import run_bionav
+
+    proc = run_bionav("camera", "sim_uni", "--out", str(tmp_path / "sheets"), "--cells", "2", "db.image_size=[48,8]",
+                      module="bionav.db", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    sheet = cv2.imread(str(tmp_path / "sheets" / "sim_uni_camera.png"), cv2.IMREAD_GRAYSCALE)
+    assert sheet is not None and sheet.shape[1] >= 400
+    assert "wrote" in proc.stdout and sheet.std() > 20  # raw thumbnails and panoramas, not a blank page
+    bad = run_bionav("camera", "sim_uni", "--out", str(tmp_path / "s2"), "db.camera.mirror_xi=0.2",
+                     module="bionav.db", cwd=tmp_path)
+    assert bad.returncode == 2 and "db.camera.mirror_xi" in bad.stderr and "Traceback" not in bad.stderr
