@@ -66,6 +66,22 @@ POSE_ERRORS = {
 }
 
 
+def raw_horizon_radius(mirror: str, camera: CameraConfig | None = None) -> float:
+    """Radius in pixels of the horizon circle in the full raw frame, ``gamma / xi`` (thesis Butterworth cutoffs).
+
+    Parameters
+    ----------
+    mirror : str
+        ``ultra-wide`` or ``normal-view`` (:data:`MIRRORS`), used when ``camera`` is None.
+    camera : CameraConfig, optional
+        An explicit camera.
+    """
+    cam = camera if camera is not None else CameraConfig(**MIRRORS[mirror])
+    proj = MirrorProjection.from_rim(xi=float(cam.mirror_xi), rim_elevation_deg=float(cam.rim_elevation_deg),
+                                     rim_radius_px=float(cam.rim_radius_px), center=(0.0, 0.0))
+    return float(proj.radius_from_elevation(0.0))
+
+
 def camera_config_for(mirror: str, **overrides) -> CameraConfig:
     """The :class:`CameraConfig` of a mirror type (``ultra-wide`` or ``normal-view``) plus overrides."""
     return CameraConfig(**{**MIRRORS[mirror], **overrides})
@@ -175,17 +191,22 @@ def sensor_frame(radiance: np.ndarray, setup: CameraSetup, *, rng: np.random.Gen
     import cv2
 
     cam = setup.camera
-    x = np.asarray(radiance, dtype=np.float32)
+    h, w, n_ch = radiance.shape
+    # the sensor is simulated on the square around the rendered annulus; the rest of the frame reads 0
+    reach = setup.layout.radius_range[1] + 1.0
+    cx, cy = setup.projection.center
+    y0, y1 = max(0, int(math.floor(cy - reach))), min(h, int(math.ceil(cy + reach)) + 1)
+    x0, x1 = max(0, int(math.floor(cx - reach))), min(w, int(math.ceil(cx + reach)) + 1)
+    x = np.ascontiguousarray(radiance[y0:y1, x0:x1], dtype=np.float32)
     if setup.psf_sigma > 0.05:
         k = 2 * int(math.ceil(3.0 * setup.psf_sigma)) + 1
-        x = cv2.GaussianBlur(x, (k, k), setup.psf_sigma, borderType=cv2.BORDER_REFLECT)
-        x = x.reshape(radiance.shape)
-    rad = setup.layout.radius
-    x = x * (1.0 - float(cam.vignetting) * (rad / setup.projection.rim_radius) ** 2)[:, :, None]
+        x = cv2.GaussianBlur(x, (k, k), setup.psf_sigma, borderType=cv2.BORDER_REFLECT).reshape(x.shape)
+    rad = setup.layout.radius[y0:y1, x0:x1]
+    x = x * (1.0 - float(cam.vignetting) * (rad / setup.projection.rim_radius) ** 2)[:, :, None].astype(np.float32)
     time, gain = 1.0, 1.0
     if cam.auto_exposure:
         inside = (rad >= setup.band[0]) & (rad <= setup.band[1])
-        level = float(x[inside].mean()) if inside.any() else 0.0
+        level = float(x[inside].mean(dtype=np.float64)) if inside.any() else 0.0
         if level > 0:
             time = min(float(cam.ae_target) / level, float(cam.max_exposure))
             gain = float(np.clip(float(cam.ae_target) / (level * time), 1.0, float(cam.max_gain)))
@@ -196,7 +217,9 @@ def sensor_frame(radiance: np.ndarray, setup: CameraSetup, *, rng: np.random.Gen
     if setup.read_noise > 0:
         noisy += setup.read_noise * rng.standard_normal(electrons.shape)
     value = noisy * (gain / setup.full_well)
-    return np.clip(np.rint(value * 255.0), 0, 255).astype(np.uint8)
+    out = np.zeros((h, w, n_ch), np.uint8)
+    out[y0:y1, x0:x1] = np.clip(np.rint(value * 255.0), 0, 255).astype(np.uint8)
+    return out
 
 
 def unfold_frame(raw_u8: np.ndarray, setup: CameraSetup, geometry: PanoramaGeometry) -> np.ndarray:

@@ -366,6 +366,9 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "rotation_seed": int(rotation_seed),
         "realism": realism,
     }
+    from bionav.db.camera import raw_horizon_radius
+
+    meta["raw_horizon_radius_px"] = raw_horizon_radius(spec.mirror, camera if realism == "camera" else None)
     if realism == "camera":
         meta.pop("noise")
         meta["camera"] = dataclasses.asdict(camera)

@@ -140,12 +140,12 @@ class RawFrameLayout:
 
 
 def raw_frame_layout(projection: MirrorProjection, *, raw_size: Sequence[int], radius_range: Sequence[float],
-                     n_bands: int = 8) -> RawFrameLayout:
+                     n_bands: int = 4) -> RawFrameLayout:
     """Ray grids covering the annulus ``radius_range`` of a raw frame, and the weights that resample them.
 
     The annulus is split into ``n_bands`` rings; each ring is a polar ray grid
-    with rows at the elevations of the integer radii it spans (one more on each
-    side) and ``ceil(2 pi r_max)`` azimuths, so every raw pixel is covered by
+    with rows at the elevations of the integer radii that bracket it and
+    ``ceil(2 pi r_max)`` azimuths, so every raw pixel is covered by
     at least one ray per pixel pitch in both directions. Raw pixel centres
     are resampled bilinearly in (radius, azimuth), periodic in azimuth.
 
@@ -177,8 +177,9 @@ def raw_frame_layout(projection: MirrorProjection, *, raw_size: Sequence[int], r
         flat = np.flatnonzero((rad >= b0) & ((rad < b1) if b + 2 < edges.size else (rad <= b1)))
         if flat.size == 0:
             continue
-        radii = np.arange(math.floor(max(b0 - 1.0, 0.0)), math.ceil(b1 + 1.0) + 1.0, 1.0)
-        n_az = max(8, int(math.ceil(TWO_PI * radii[-1])))
+        r0 = math.floor(b0)
+        radii = np.arange(r0, max(math.ceil(b1), r0 + 1) + 1.0, 1.0)  # brackets every radius in [b0, b1]
+        n_az = max(8, int(math.ceil(TWO_PI * b1)))  # at least one ray per pixel along the band's outer circle
         el = projection.elevation_from_radius(np.maximum(radii, 1e-6))
         step_el = float(np.max(np.abs(np.diff(el)))) if el.size > 1 else TWO_PI / n_az
         fr = np.clip(rad[flat] - radii[0], 0.0, radii.size - 1.0)
