@@ -25,13 +25,15 @@ SPACING = 0.5
 CAMERA_HEIGHT = 0.6
 N_MISSING = 30
 #: Probability that a lamp position under the galleries has its lamp on (night: few are).
-LAMPS_ON = 0.5
+LAMPS_ON = 0.75
 #: Radiant intensity of one fluorescent lamp (downward Lambertian panel).
 LAMP_INTENSITY = 14.0
 #: Bounce light on upward / downward faces.
-AMBIENT = (0.05, 0.03)
+AMBIENT = (0.09, 0.055)
 #: Camera gain.
 EXPOSURE = 3.2
+#: Camera tilt std (degrees) on the hall's stone floor (joints, mast sway; World.floor_tilt_deg).
+FLOOR_TILT_DEG = 0.5
 
 
 def _missing_cells(origin, obstacles, n_missing: int) -> np.ndarray:
@@ -190,4 +192,5 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
     scene.ambient = Ambient(up=AMBIENT[0], down=AMBIENT[1])
     scene.exposure = EXPOSURE
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT, cells=cells, info={"room": (lx, ly, lz), "part": part})
+                 camera_height=CAMERA_HEIGHT, cells=cells, info={"room": (lx, ly, lz), "part": part},
+                 floor_tilt_deg=FLOOR_TILT_DEG)

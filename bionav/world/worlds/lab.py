@@ -25,6 +25,8 @@ from bionav.world.worlds.furniture import cabinet, chair, potted_plant, shelf, t
 GRID_SHAPE = (10, 17)
 SPACING = 0.3
 CAMERA_HEIGHT = 0.6
+#: Camera tilt std (degrees) on the lab's hard, level floor (mast sway only; World.floor_tilt_deg).
+FLOOR_TILT_DEG = 0.3
 #: Bounce light per band that is on, on upward / downward faces (relative to a band's direct light).
 AMBIENT_PER_BAND = (0.07, 0.045)
 #: Total intensity of one ceiling light band (four point emitters).
@@ -235,7 +237,7 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
 
     scene.exposure = 2.4
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)})
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG)
 
 
 def build_lab_variant(variant: str, seed: int = 0) -> World:

@@ -30,6 +30,8 @@ SPACING = 1.0
 CAMERA_HEIGHT = 0.8
 #: Least distance in metres between a tree and the capture area (thesis 3.1: distant buildings and trees).
 TREE_CLEARANCE = 7.0
+#: Camera tilt std (degrees) of the four-wheeled robot on the paving (joints, kerbs, slope; World.floor_tilt_deg).
+FLOOR_TILT_DEG = 1.5
 #: Value range of the paving texture (worn grey slabs, low contrast in the building's shadow).
 PAVING_TEXTURE = (0.45, 0.6)
 
@@ -185,4 +187,4 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
                  camera_height=CAMERA_HEIGHT,
                  info={"sun_elevation": float(sun_elevation), "sun_azimuth": float(sun_azimuth),
-                       "channels": channels})
+                       "channels": channels}, floor_tilt_deg=FLOOR_TILT_DEG)
