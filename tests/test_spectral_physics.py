@@ -7,9 +7,11 @@ from bionav.geometry import direction_from_angles
 from bionav.light.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import (
+    GROUND_ALBEDO,
     SkyState,
     clear_sky_radiance,
     illumination,
+    ozone_air_mass,
     rayleigh_optical_depth,
     relative_air_mass,
     sky_radiance,
@@ -73,13 +75,35 @@ def test_clear_sky_is_blue_and_clouds_flatten_it():
 
 
 def test_single_scattering_thin_limit():
-    """Optically thin limit: L = E0 tau P(gamma) / (4 pi) m_v exp(-tau m_s) (m_v ~ m_s)."""
+    """Optically thin limit, sun and view at the zenith, no aerosol, no ozone absorption at 800 nm.
+
+    Single scattering (both layers together): ``E0 tau P(0) / (4 pi) exp(-tau)`` with ``P(0) = 1.5``;
+    second order: the ambient light ``(E_sky (1 + a_g) + a_g E0 exp(-tau)) / (2 pi)`` scattered into the
+    line of sight with weight ``tau``, where the thin Rayleigh sky sends half the scattered light down,
+    ``E_sky = E0 tau / 2``.
+    """
     wl = np.array([800.0])
     state = SkyState(np.deg2rad(90.0), turbidity=1e-9)
     tau = rayleigh_optical_depth(wl)
     d = direction_from_angles(0.0, np.deg2rad(89.999))
-    expected = solar_spectrum(wl) * tau * 0.75 * 2 / (4 * np.pi) * np.exp(-tau)
+    e0 = solar_spectrum(wl)
+    ambient = (e0 * tau / 2 * (1 + GROUND_ALBEDO) + GROUND_ALBEDO * e0 * np.exp(-tau)) / (2 * np.pi)
+    expected = e0 * tau * np.exp(-tau) * 1.5 / (4 * np.pi) + tau * ambient
     assert clear_sky_radiance(state, d, wl)[0] == pytest.approx(expected[0], rel=0.01)
+
+
+def test_ozone_filters_the_low_sun_in_the_chappuis_band():
+    """Direct beam ratio with/without ozone = exp(-a_o(600) * column * m_oz), a_o(600 nm) ~ 0.12 /cm."""
+    wl = np.array([440.0, 600.0])
+    low = SkyState(np.deg2rad(5.0), turbidity=0.05)
+    none = SkyState(np.deg2rad(5.0), turbidity=0.05, ozone_atm_cm=0.0)
+    ratio = illumination(low, wl).direct_normal / illumination(none, wl).direct_normal
+    m_oz = ozone_air_mass(np.deg2rad(5.0))
+    assert ratio[1] == pytest.approx(np.exp(-0.3 * np.interp(600.0, [593.0, 610.0], [0.119, 0.12]) * m_oz), rel=1e-3)
+    assert ratio[0] == pytest.approx(1.0)  # no ozone absorption at 440 nm
+    # the ozone-layer air mass at the horizon is finite (spherical shell), at the zenith 1
+    assert ozone_air_mass(np.pi / 2) == pytest.approx(1.0, abs=1e-3)
+    assert 10 < ozone_air_mass(0.0) < 20
 
 
 def test_cloud_field_cover_fraction_and_motion():
@@ -119,9 +143,15 @@ def test_sensor_chain():
 
 
 def test_vegetation_red_edge_and_low_uv():
+    """Vegetation uses the measured green leaf: chlorophyll trough at 680 nm, red edge, UV a few per cent."""
+    from bionav.light.bands import WAVELENGTHS_NM
+
+    at = {w: int(np.argmin(np.abs(WAVELENGTHS_NM - w))) for w in (350, 550, 680, 800)}
     for name in ("grass", "shrub", "tree"):
+        spec = MATERIALS[name].mean_spectrum()
+        assert spec[at[800]] > 3 * spec[at[680]] and spec[at[680]] < spec[at[550]] and spec[at[350]] < 0.06
         uv, b, g, r, ir = MATERIALS[name].reflectance
-        assert ir > 5 * r and r < g and uv < 0.05
+        assert ir > 2 * r and uv < b < g  # band means (the R band's Gaussian reaches into the red edge)
     for name in ("paint_white", "plastic_white"):
         assert MATERIALS[name].reflectance[0] < 0.1 < MATERIALS[name].reflectance[1]
     assert len(CHANNELS) == 5
