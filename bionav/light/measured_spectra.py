@@ -13,10 +13,11 @@ files are rebuilt by ``scripts/make_spectra_data.py``):
   300-700 nm, from the bumbleview package 0.2.8 (T. M. Huber, MIT licence).
 * **D65**: CIE standard illuminant D65 (relative), as shipped by bumbleview.
 
-Resampling: a value on the target grid is the mean of the source over the
-target cell (``lambda +- step / 2``; piecewise-linear source), so spiky spectra
-(the solar Fraunhofer lines) are averaged rather than aliased. Outside a
-table's range the functions say what they do (their ``Notes``).
+Resampling: the finely sampled sun (0.5-1 nm) is averaged over each target
+cell (``lambda +- step / 2``, :func:`cell_mean`), so its Fraunhofer lines are
+averaged rather than aliased; the 5-nm reflectance tables (the petals already
+averaged into 5-nm bins) and the coarse ozone table are interpolated linearly.
+Outside a table's range the functions say what they do (their ``Notes``).
 """
 
 from __future__ import annotations
@@ -149,8 +150,8 @@ def green_leaf_reflectance(wavelengths_nm) -> np.ndarray:
     _, v = _table("green_leaf.csv")
     wl = np.asarray(wavelengths_nm, dtype=float)
     end = v[-1, 0]
-    measured = cell_mean(v[:, 0], v[:, 1], wl)
-    r_end = float(cell_mean(v[:, 0], v[:, 1], [end - 5.0, end])[1])
+    measured = np.interp(wl, v[:, 0], v[:, 1])
+    r_end = float(v[-1, 1])
 
     def s(x):
         return 1.0 / (1.0 + np.exp(-(x - LEAF_RED_EDGE_NM) / LEAF_RED_EDGE_WIDTH_NM))
@@ -164,9 +165,9 @@ def petal_reflectances(wavelengths_nm) -> tuple[list[str], np.ndarray]:
 
     Notes
     -----
-    Measured 300-700 nm (5-nm bin means of bumbleview's ~0.4 nm samples;
-    measurement noise can make single bins slightly negative, they are clipped
-    at 0.005). Beyond 700 nm each spectrum holds the mean of its 690-700 nm
+    Measured 300-700 nm (5-nm bin means of bumbleview's ~0.4 nm samples,
+    interpolated linearly; measurement noise can make single bins slightly
+    negative, they are clipped at 0.005). Beyond 700 nm each spectrum holds the mean of its 690-700 nm
     bins: petal pigments (anthocyanins, carotenoids, flavonoids) absorb below
     about 650 nm, so the 700 nm value is the pigment-free scattering of the
     petal tissue that continues into the near infrared (an assumption: petals
@@ -176,14 +177,14 @@ def petal_reflectances(wavelengths_nm) -> tuple[list[str], np.ndarray]:
     header, v = _table("petals.csv")
     wl = np.asarray(wavelengths_nm, dtype=float)
     end = v[-1, 0]
-    measured = cell_mean(v[:, 0], v[:, 1:], wl)
+    measured = np.stack([np.interp(wl, v[:, 0], col) for col in v[:, 1:].T], axis=-1)
     tail = v[v[:, 0] >= end - 10.0, 1:].mean(axis=0)
     out = np.where((wl <= end)[:, None], measured, tail[None, :])
     return list(header[1:]), np.clip(out.T, 0.005, 1.0)
 
 
 def d65(wavelengths_nm) -> np.ndarray:
-    """CIE D65 relative spectral power (100 at 560 nm), shape ``(L,)``; NaN outside the table (300-830 nm)."""
+    """CIE D65 relative spectral power (100 at 560 nm), shape ``(L,)``; NaN outside the table (300-750 nm)."""
     _, v = _table("d65.csv")
     wl = np.asarray(wavelengths_nm, dtype=float)
     return np.where((wl >= v[0, 0]) & (wl <= v[-1, 0]), np.interp(wl, v[:, 0], v[:, 1]), np.nan)
