@@ -8,8 +8,8 @@ only to rebuild them from their sources (see ``bionav/data/spectra/README.md``):
 
 * ASTM G-173-03 (extraterrestrial, global tilt, direct + circumsolar), 280-1200 nm,
   from colour-science's copy of the NREL table (``colour.plotting.datasets.astm_g_173``).
-* Ozone absorption coefficients of Bird & Riordan (1986), 300-1200 nm, from
-  pvlib's SPECTRL2 implementation (``pvlib.spectrum.spectrl2``).
+* Ozone, water-vapour and mixed-gas absorption coefficients of Bird & Riordan
+  (1986), 300-1200 nm, from pvlib's SPECTRL2 implementation (``pvlib.spectrum.spectrl2``).
 * bumbleview 0.2.8 (MIT): the 120 petal reflectances averaged into 5-nm bins
   centred on 300, 305, ..., 700 nm (percent -> fraction), the green-leaf
   background 300-700 nm (its 705-750 nm rows are zero padding, not data, and are
@@ -58,13 +58,15 @@ def main() -> None:
     from pvlib.spectrum.spectrl2 import _SPECTRL2_COEFFS as c
 
     sel = (c["wavelength"] >= 300) & (c["wavelength"] <= 1200)
-    with open(OUT / "ozone_absorption.csv", "w", newline="") as fh:
-        fh.write("# Ozone absorption coefficient a_o (1/cm of an ozone column in atm-cm), Bird & Riordan (1986) "
-                 "after Leckner (1978); via pvlib (BSD-3). See README.md.\n")
+    with open(OUT / "bird_riordan_absorption.csv", "w", newline="") as fh:
+        fh.write("# Absorption coefficients of ozone (1/cm of column in atm-cm), water vapour (1/cm of precipitable "
+                 "water) and uniformly mixed gases (O2, CO2; per air mass), Bird & Riordan (1986) after Leckner "
+                 "(1978); via pvlib (BSD-3). See README.md.\n")
         w = csv.writer(fh)
-        w.writerow(["wavelength_nm", "ozone_absorption_per_cm"])
-        for x, a in zip(c["wavelength"][sel], c["ozone_absorption"][sel]):
-            w.writerow([f"{x:g}", f"{a:.6g}"])
+        w.writerow(["wavelength_nm", "ozone", "water_vapor", "mixed_gases"])
+        for x, a, b, u in zip(c["wavelength"][sel], c["ozone_absorption"][sel], c["water_vapor_absorption"][sel],
+                              c["mixed_absorption"][sel]):
+            w.writerow([f"{x:g}", f"{a:.6g}", f"{b:.6g}", f"{u:.6g}"])
 
     src = args.bumbleview
     data = np.loadtxt(src / "xmpl_data.csv", delimiter=",")

@@ -1,5 +1,7 @@
 """Physics of the five-channel sensor model against closed forms and known facts."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -10,6 +12,8 @@ from bionav.light.daylight import (
     GROUND_ALBEDO,
     SkyState,
     clear_sky_radiance,
+    diffuse_irradiance_bird,
+    gas_transmittance,
     illumination,
     ozone_air_mass,
     rayleigh_optical_depth,
@@ -75,21 +79,38 @@ def test_clear_sky_is_blue_and_clouds_flatten_it():
 
 
 def test_single_scattering_thin_limit():
-    """Optically thin limit, sun and view at the zenith, no aerosol, no ozone absorption at 800 nm.
+    """Optically thin limit, sun and view at the zenith, no aerosol, no gas absorption at 800 nm.
 
-    Single scattering (both layers together): ``E0 tau P(0) / (4 pi) exp(-tau)`` with ``P(0) = 1.5``;
-    second order: the ambient light ``(E_sky (1 + a_g) + a_g E0 exp(-tau)) / (2 pi)`` scattered into the
-    line of sight with weight ``tau``, where the thin Rayleigh sky sends half the scattered light down,
-    ``E_sky = E0 tau / 2``.
+    Single scattering (both layers together): ``E0 tau P(0) / (4 pi) exp(-tau)`` with ``P(0) = 1.5``.
     """
     wl = np.array([800.0])
-    state = SkyState(np.deg2rad(90.0), turbidity=1e-9)
+    state = SkyState(np.deg2rad(90.0), turbidity=1e-9, precipitable_water_cm=0.0)
     tau = rayleigh_optical_depth(wl)
     d = direction_from_angles(0.0, np.deg2rad(89.999))
-    e0 = solar_spectrum(wl)
-    ambient = (e0 * tau / 2 * (1 + GROUND_ALBEDO) + GROUND_ALBEDO * e0 * np.exp(-tau)) / (2 * np.pi)
-    expected = e0 * tau * np.exp(-tau) * 1.5 / (4 * np.pi) + tau * ambient
-    assert clear_sky_radiance(state, d, wl)[0] == pytest.approx(expected[0], rel=0.01)
+    expected = solar_spectrum(wl) * tau * np.exp(-tau) * 1.5 / (4 * np.pi)
+    assert clear_sky_radiance(state, d, wl, multiple_scattering=False)[0] == pytest.approx(expected[0], rel=0.01)
+
+
+def test_sky_integrates_to_the_bird_riordan_diffuse_budget():
+    """Where single scattering falls short (UV/blue, low sun) the sky's hemispheric integral is Bird & Riordan's."""
+    wl = np.array([350.0, 440.0, 500.0])
+    for el in (50.0, 12.0, 6.0):
+        state = SkyState(np.deg2rad(el), np.deg2rad(37.0), turbidity=0.1)
+        budget = diffuse_irradiance_bird(state, wl)
+        got = illumination(state, wl).diffuse_horizontal
+        single = illumination(replace(state), wl, n_elevation=8)  # same state: consistency of the cache
+        np.testing.assert_allclose(got, single.diffuse_horizontal)
+        np.testing.assert_allclose(got, budget, rtol=0.03)
+    # Bird & Riordan without aerosol and gases, sun at the zenith: I_r = 0.5 E0 (1 - T_r^0.95) (half of the
+    # scattered light) plus the ground-sky reflections (E0 T_r + I_r) r_s a_g / (1 - r_s a_g), r_s = 0.5 (1 - T_r(1.8))
+    thin = SkyState(np.deg2rad(90.0), turbidity=1e-9, ozone_atm_cm=0.0, precipitable_water_cm=0.0)
+    e = diffuse_irradiance_bird(thin, np.array([800.0]))[0]
+    tau = rayleigh_optical_depth([800.0])[0]
+    e0 = solar_spectrum([800.0])[0]
+    i_r = 0.5 * e0 * (1 - np.exp(-0.95 * tau))
+    r_s = 0.5 * (1 - np.exp(-1.8 * tau))
+    i_g = (e0 * np.exp(-tau) + i_r) * r_s * GROUND_ALBEDO / (1 - r_s * GROUND_ALBEDO)
+    assert e == pytest.approx(i_r + i_g, rel=1e-3)
 
 
 def test_ozone_filters_the_low_sun_in_the_chappuis_band():
@@ -104,6 +125,16 @@ def test_ozone_filters_the_low_sun_in_the_chappuis_band():
     # the ozone-layer air mass at the horizon is finite (spherical shell), at the zenith 1
     assert ozone_air_mass(np.pi / 2) == pytest.approx(1.0, abs=1e-3)
     assert 10 < ozone_air_mass(0.0) < 20
+
+
+def test_water_vapour_and_oxygen_bands_in_the_ir():
+    """Bird & Riordan's transmittance laws at the zenith: 940 nm water band, 760 nm oxygen A band."""
+    state = SkyState(np.deg2rad(90.0), precipitable_water_cm=2.0, ozone_atm_cm=0.0)
+    t = gas_transmittance(state, np.array([660.0, 762.5, 937.0]), np.pi / 2)
+    aw = 55.0 * 2.0  # a_w(937 nm) = 55 /cm
+    assert t[2] == pytest.approx(np.exp(-0.2385 * aw / (1 + 20.07 * aw) ** 0.45), rel=1e-3)
+    assert t[1] == pytest.approx(np.exp(-1.41 * 4.0 / (1 + 118.93 * 4.0) ** 0.45), rel=1e-3)
+    assert t[0] > 0.99
 
 
 def test_cloud_field_cover_fraction_and_motion():

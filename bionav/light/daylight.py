@@ -18,8 +18,10 @@ clear noon sky down to the low evening sun:
   the scattering air, so it filters the sunlight once, before it is scattered:
   at a low sun its long slant path through the Chappuis band takes orange and
   red out of the whole sky, which keeps the dusk sky blue (Hulburt 1953,
-  doi:10.1364/JOSA.43.000113). Water vapour is ignored (its bands at 720, 820
-  and 940 nm touch only the wide IR channel).
+  doi:10.1364/JOSA.43.000113). Water vapour (720, 820, 940 nm) and the oxygen
+  A band (760 nm) absorb in the R and IR channels (Bird & Riordan's
+  transmittance laws, :func:`gas_transmittance`; precipitable water
+  ``SkyState.precipitable_water_cm``).
 * **Clear sky**: single scattering in two stacked plane-parallel layers viewed
   from the ground: the free troposphere and stratosphere (pure Rayleigh, the
   molecules above ``AEROSOL_LAYER_M``) over a boundary layer holding the rest of
@@ -31,15 +33,17 @@ clear noon sky down to the low evening sun:
   ``3/4 (1 + cos^2 gamma)``, Henyey-Greenstein aerosol phase function (g = 0.7,
   single-scattering albedo 0.9). With the aerosol at the bottom, the blue and UV
   light scattered high up at a low sun is not dimmed by the long slant path
-  through the hazy boundary layer, as in the real evening sky. Higher orders of
-  scattering add the ambient term below.
-* **Multiple scattering** (second and higher orders, isotropic approximation):
-  every line of sight scatters the ambient diffuse light (first-order sky plus
-  the ground's reflection, ``(E_sky + a_g E_global) / pi`` with ground albedo
-  0.15) by its scattering optical depth, ``L_ms = omega_eff (1 - exp(-tau m_v))
-  * L_ambient / (1 - omega_eff * tau / (1 + tau))`` (the denominator sums
-  the higher orders as a geometric series). This adds the diffuse UV and blue
-  that single scattering misses, most at a low sun.
+  through the hazy boundary layer, as in the real evening sky.
+* **Multiple scattering**: single scattering alone loses the light that is
+  scattered again on its way down, a large share of the UV and blue sky at a low
+  sun. bionav closes the energy budget with Bird & Riordan's (1986) SPCTRAL2
+  diffuse irradiance (half of all Rayleigh-scattered light reaches the ground,
+  the forward fraction of the aerosol-scattered light, ground-sky reflections,
+  their short-wave correction; :func:`diffuse_irradiance_bird`, validated there
+  against rigorous radiative transfer and measurements): the irradiance the
+  single-scattering sky lacks is spread over the sky in proportion to each line
+  of sight's scattering depth ``1 - exp(-tau m_v)``. The sky's angular structure
+  (sun aureole, horizon, colour across the sky) stays that of single scattering.
 * **Clouds**: spectrally grey scatterers. A cloud of optical depth ``tau_c`` seen
   from below has radiance ``E_top mu_s T(tau_c) / pi`` with the two-stream
   diffuse transmittance ``T = 1 / (1 + 0.75 (1 - g) tau_c)``, g = 0.85; broken
@@ -104,11 +108,24 @@ def solar_spectrum(wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
     return np.where(np.isnan(measured), black_body_sun(wavelengths_nm), measured)
 
 
-def ozone_optical_depth(wavelengths_nm=WAVELENGTHS_NM, *, column_atm_cm: float = 0.3) -> np.ndarray:
-    """Vertical ozone optical depth for a column in atm-cm (Bird & Riordan 1986 coefficients), shape ``(L,)``."""
-    from bionav.light.measured_spectra import ozone_absorption
+def gas_transmittance(state: "SkyState", wavelengths_nm, elevation) -> np.ndarray:
+    """Transmittance of a beam from ``elevation`` through ozone, water vapour and mixed gases, shape ``(L,)``.
 
-    return column_atm_cm * ozone_absorption(wavelengths_nm)
+    Bird & Riordan (1986), eqs. 4-6: ozone ``exp(-a_o O3 M_o)`` along the ozone-layer
+    air mass :func:`ozone_air_mass`; water vapour
+    ``exp(-0.2385 a_w W M / (1 + 20.07 a_w W M)^0.45)`` and mixed gases
+    ``exp(-1.41 a_u M / (1 + 118.93 a_u M)^0.45)`` along the air mass ``M`` of
+    :func:`relative_air_mass` (sea level), with the column ``state.ozone_atm_cm``
+    and precipitable water ``state.precipitable_water_cm``.
+    """
+    from bionav.light.measured_spectra import gas_absorption
+
+    a = gas_absorption(wavelengths_nm)
+    m = float(relative_air_mass(elevation))
+    aw = a["water_vapor"] * state.precipitable_water_cm * m
+    au = a["mixed_gases"] * m
+    return np.exp(-a["ozone"] * state.ozone_atm_cm * float(ozone_air_mass(elevation))
+                  - 0.2385 * aw / (1 + 20.07 * aw) ** 0.45 - 1.41 * au / (1 + 118.93 * au) ** 0.45)
 
 
 def ozone_air_mass(elevation) -> np.ndarray:
@@ -153,6 +170,8 @@ class SkyState:
         Angstrom exponent.
     ozone_atm_cm : float
         Ozone column in atm-cm (Dobson units / 1000; mid-latitude summer about 0.3-0.35).
+    precipitable_water_cm : float
+        Precipitable water in cm (mid-latitude summer 1-3).
     clouds : CloudLayer
         Cloud layer (``cover = 0`` for a clear sky).
     time_s : float
@@ -164,6 +183,7 @@ class SkyState:
     turbidity: float = 0.1
     angstrom_alpha: float = 1.3
     ozone_atm_cm: float = 0.3
+    precipitable_water_cm: float = 1.5
     clouds: CloudLayer = CloudLayer()
     time_s: float = 0.0
 
@@ -198,11 +218,10 @@ def _optical_depths(state: SkyState, wl):
 
 
 def _sun_transmittance(state: SkyState, wl, *, rayleigh=1.0, aerosol=1.0) -> np.ndarray:
-    """Transmittance of the sun's beam through ozone and fractions of the Rayleigh and aerosol depths, ``(L,)``."""
+    """Transmittance of the sun's beam through the gases and fractions of the Rayleigh and aerosol depths, ``(L,)``."""
     tr, ta = _optical_depths(state, wl)
     m_s = float(relative_air_mass(state.sun_elevation))
-    t_oz = ozone_optical_depth(wl, column_atm_cm=state.ozone_atm_cm) * float(ozone_air_mass(state.sun_elevation))
-    return np.exp(-(rayleigh * tr + aerosol * ta) * m_s - t_oz)
+    return np.exp(-(rayleigh * tr + aerosol * ta) * m_s) * gas_transmittance(state, wl, state.sun_elevation)
 
 
 def _layer_path(tau, m_s, m_v):
@@ -218,7 +237,7 @@ def _single_scattering(state: SkyState, d, wl) -> np.ndarray:
     f_low = 1.0 - np.exp(-AEROSOL_LAYER_M / RAYLEIGH_SCALE_HEIGHT_M)
     tau_up = tr * (1 - f_low)
     tau_low = tr * f_low + ta
-    e_in = solar_spectrum(wl) * _sun_transmittance(state, wl, rayleigh=0.0, aerosol=0.0)  # ozone only
+    e_in = solar_spectrum(wl) * _sun_transmittance(state, wl, rayleigh=0.0, aerosol=0.0)  # gases only
     m_s = float(relative_air_mass(state.sun_elevation))
     m_v = relative_air_mass(np.arcsin(np.clip(d[..., 2], -1, 1)))[..., None]
     cos_g = np.clip(d @ state.sun_direction, -1, 1)[..., None]
@@ -231,34 +250,85 @@ def _single_scattering(state: SkyState, d, wl) -> np.ndarray:
     return e_in / (4 * np.pi) * (upper + lower)
 
 
-_AMBIENT_CACHE: dict = {}
+_MS_CACHE: dict = {}
 
 
-def _ambient(state: SkyState, wl) -> np.ndarray:
-    """Isotropic source of second-order scattering, ``(E_sky1 + a_g E_global) / (2 pi)``, shape ``(L,)`` (cached)."""
-    key = (state.sun_elevation, state.turbidity, state.angstrom_alpha, state.ozone_atm_cm, wl.tobytes())
-    hit = _AMBIENT_CACHE.get(key)
+def diffuse_irradiance_bird(state: SkyState, wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
+    """Clear-sky diffuse irradiance on a horizontal plane, multiple scattering included, W m^-2 nm^-1, ``(L,)``.
+
+    Bird & Riordan (1986), eqs. 7-13 (SPCTRAL2): the Rayleigh part
+    ``0.5 E0 cos Z T_gas T_aa (1 - T_r^0.95)`` -- half of all light the molecules
+    scatter reaches the ground, whatever the order of scattering -- the aerosol
+    part ``E0 cos Z T_gas T_aa T_r^1.5 (1 - T_as) F_s`` with the forward fraction
+    ``F_s`` of a Henyey-Greenstein aerosol (asymmetry g = 0.7, single-scattering
+    albedo 0.9, as in :func:`clear_sky_radiance`), and the ground-sky
+    reflections ``(E_dir cos Z + I_r + I_a) r_s a_g / (1 - r_s a_g)``, all times
+    Bird & Riordan's short-wave correction ``(lambda_um + 0.55)^1.8`` below 450 nm.
+    Rayleigh depth of Hansen & Travis, aerosol of Angstrom, gases of
+    :func:`gas_transmittance`; ground albedo :data:`GROUND_ALBEDO`.
+    """
+    wl = np.asarray(wavelengths_nm, dtype=float)
+    el = state.sun_elevation
+    if el <= 0:
+        return np.zeros_like(wl)
+    cos_z = np.sin(el)
+    tr, ta = _optical_depths(state, wl)
+    e0 = solar_spectrum(wl)
+    alg = np.log(1 - _HG_G_AEROSOL)
+    afs = alg * (1.459 + alg * (0.1595 + alg * 0.4129))
+    bfs = alg * (0.0783 + alg * (-0.3824 - alg * 0.5874))
+
+    def parts(m, gas, mu):
+        t_r = np.exp(-tr * m)
+        t_aa = np.exp(-(1 - _AEROSOL_SSA) * ta * m)
+        t_as = np.exp(-_AEROSOL_SSA * ta * m)
+        f_s = 1 - 0.5 * np.exp((afs + bfs * mu) * mu)
+        return t_r, t_aa, t_as, f_s, gas
+
+    m = float(relative_air_mass(el))
+    t_r, t_aa, t_as, f_s, gas = parts(m, gas_transmittance(state, wl, el), cos_z)
+    i_r = 0.5 * e0 * cos_z * gas * t_aa * (1 - t_r**0.95)
+    i_a = e0 * cos_z * gas * t_aa * t_r**1.5 * (1 - t_as) * f_s
+    direct_h = e0 * cos_z * gas * t_r * np.exp(-ta * m)
+    m2 = 1.8  # the sky's reflectance for light from the ground, at the effective air mass 1.8
+    t_r2, t_aa2, t_as2, f_s2, gas2 = parts(m2, gas_transmittance(state, wl, np.arcsin(1 / m2)), 1 / m2)
+    r_s = gas2 * t_aa2 * (0.5 * (1 - t_r2) + (1 - f_s2) * t_r2 * (1 - t_as2))
+    i_g = (direct_h + i_r + i_a) * r_s * GROUND_ALBEDO / (1 - r_s * GROUND_ALBEDO)
+    lam = wl / 1000.0
+    corr = np.where(lam <= 0.45, (lam + 0.55) ** 1.8, 1.0)
+    return (i_r + i_a + i_g) * corr
+
+
+def _multiple_scattering_source(state: SkyState, wl) -> tuple[np.ndarray, np.ndarray]:
+    """Radiance scale and the tau of the path shape of the multiple-scattering term (cached per sun and air)."""
+    key = (state.sun_elevation, state.turbidity, state.angstrom_alpha, state.ozone_atm_cm,
+           state.precipitable_water_cm, wl.tobytes())
+    hit = _MS_CACHE.get(key)
     if hit is not None:
         return hit
-    n_el, n_az = 6, 12
+    n_el, n_az = 8, 24  # the quadrature of :func:`illumination`
     el = (np.arange(n_el) + 0.5) * (np.pi / 2) / n_el
     az = (np.arange(n_az) + 0.5) * 2 * np.pi / n_az
     ee, aa = np.meshgrid(el, az, indexing="ij")
-    flat = SkyState(sun_elevation=state.sun_elevation, sun_azimuth=0.0, turbidity=state.turbidity,
-                    angstrom_alpha=state.angstrom_alpha, ozone_atm_cm=state.ozone_atm_cm)
+    flat = replace(state, sun_azimuth=0.0, clouds=CloudLayer())
     rad = _single_scattering(flat, direction_from_angles(aa, ee), wl)
     weight = (np.sin(ee) * np.cos(ee) * (np.pi / 2 / n_el) * (2 * np.pi / n_az))[..., None]
-    e_sky = np.sum(rad * weight, axis=(0, 1))
-    e_dir = solar_spectrum(wl) * _sun_transmittance(state, wl) * max(np.sin(state.sun_elevation), 0.0)
-    out = (e_sky + GROUND_ALBEDO * (e_sky + e_dir)) / (2 * np.pi)
-    if len(_AMBIENT_CACHE) > 256:
-        _AMBIENT_CACHE.clear()
-    _AMBIENT_CACHE[key] = out
+    e_single = np.sum(rad * weight, axis=(0, 1))
+    tr, ta = _optical_depths(state, wl)
+    tau = tr + ta
+    shape = -np.expm1(-tau * relative_air_mass(ee)[..., None])
+    norm = np.sum(shape * weight, axis=(0, 1))
+    scale = np.maximum(diffuse_irradiance_bird(state, wl) - e_single, 0.0) / norm
+    out = (scale, tau)
+    if len(_MS_CACHE) > 256:
+        _MS_CACHE.clear()
+    _MS_CACHE[key] = out
     return out
 
 
-def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
-    """Clear-sky spectral radiance (single scattering in two layers plus higher orders), W m^-2 sr^-1 nm^-1.
+def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM, *,
+                       multiple_scattering: bool = True) -> np.ndarray:
+    """Clear-sky spectral radiance, W m^-2 sr^-1 nm^-1: two-layer single scattering plus higher orders.
 
     Parameters
     ----------
@@ -267,6 +337,8 @@ def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_N
         Unit viewing directions (east-north-up); directions below the horizon
         are treated as looking 1 degree below it (horizon haze).
     wavelengths_nm : array_like, shape (L,)
+    multiple_scattering : bool
+        Add the higher orders (default); ``False`` gives single scattering only.
 
     Returns
     -------
@@ -275,20 +347,25 @@ def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_N
 
     Notes
     -----
-    See the module docstring: two-layer single scattering (Liou 2002, eq. 6.3.5
-    per layer), ozone on the solar path, and the isotropic second-order term
-    ``omega_eff (1 - exp(-tau m_v)) (E_sky + a_g E_global) / (2 pi)``.
+    Single scattering in two stacked homogeneous layers (module docstring; Liou
+    2002, eq. 6.3.5 per layer). Higher orders: the diffuse irradiance that the
+    single-scattering sky lacks against Bird & Riordan's (1986) energy budget
+    (:func:`diffuse_irradiance_bird`) is spread over the sky in proportion to
+    each line of sight's scattering depth ``1 - exp(-tau m_v)`` (brighter
+    towards the horizon), so the hemispheric integral of the sky equals that
+    budget wherever single scattering falls short of it (the UV and blue,
+    most at a low sun).
     """
     wl = np.asarray(wavelengths_nm, dtype=float)
     d = np.asarray(directions, dtype=float)
     if state.sun_elevation <= np.deg2rad(-1.0):
         return np.zeros(d.shape[:-1] + wl.shape)
-    tr, ta = _optical_depths(state, wl)
-    tau = tr + ta
-    omega = (tr + _AEROSOL_SSA * ta) / tau
+    single = _single_scattering(state, d, wl)
+    if not multiple_scattering or state.sun_elevation <= 0:
+        return single
+    scale, tau = _multiple_scattering_source(state, wl)
     m_v = relative_air_mass(np.arcsin(np.clip(d[..., 2], -1, 1)))[..., None]
-    second = omega * _ambient(state, wl) * -np.expm1(-tau * m_v)
-    return _single_scattering(state, d, wl) + second
+    return single + scale * -np.expm1(-tau * m_v)
 
 
 def _cloud_transmittance(tau_c):

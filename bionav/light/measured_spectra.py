@@ -5,9 +5,11 @@ files are rebuilt by ``scripts/make_spectra_data.py``):
 
 * **Sun**: ASTM G173-03 extraterrestrial spectrum (NREL, from SMARTS 2.9.2;
   Gueymard 2004, doi:10.1016/j.solener.2003.08.039), 280-1200 nm.
-* **Ozone**: absorption coefficients of Bird & Riordan (1986), J. Clim. Appl.
-  Meteorol. 25, 87-97, doi:10.1175/1520-0450(1986)025<0087:SSSMFD>2.0.CO;2
-  (Huggins band below 340 nm, Chappuis band 450-750 nm with its maximum near 600 nm).
+* **Gas absorption**: ozone, water-vapour and mixed-gas coefficients of Bird &
+  Riordan (1986), J. Clim. Appl. Meteorol. 25, 87-97,
+  doi:10.1175/1520-0450(1986)025<0087:SSSMFD>2.0.CO;2 (ozone: Huggins band below
+  340 nm, Chappuis band 450-750 nm with its maximum near 600 nm; water vapour at
+  720, 820 and 940 nm; the oxygen A band at 760 nm).
 * **Petals**: 120 reflectance spectra 300-700 nm of alpine flowers (Gentiana,
   Primula, Rhododendron, Silene), and a green-leaf background reflectance
   300-700 nm, from the bumbleview package 0.2.8 (T. M. Huber, MIT licence).
@@ -113,17 +115,28 @@ def astm_g173(wavelengths_nm) -> dict[str, np.ndarray]:
     return {name: np.where(inside, cell_mean(v[:, 0], v[:, k], wl), np.nan) for k, name in enumerate(header) if k}
 
 
-def ozone_absorption(wavelengths_nm) -> np.ndarray:
-    """Ozone absorption coefficient per cm of ozone column (atm-cm), shape ``(L,)`` (Bird & Riordan 1986).
+def gas_absorption(wavelengths_nm) -> dict[str, np.ndarray]:
+    """Absorption coefficients of ozone, water vapour and mixed gases (Bird & Riordan 1986), each ``(L,)``.
 
-    Optical depth = coefficient x column (about 0.3 atm-cm at mid latitudes).
-    Linear interpolation of the table (it is sampled at 5-25 nm); zero above
-    1200 nm; below 300 nm the 300 nm value (an underestimate: the Hartley band
-    rises further, but the UV channel's sensitivity there is below 1 %).
+    Returns
+    -------
+    dict
+        ``ozone`` (1/cm of an ozone column in atm-cm; optical depth = coefficient x column, about
+        0.3 atm-cm at mid latitudes), ``water_vapor`` (1/cm of precipitable water) and
+        ``mixed_gases`` (O2, CO2; per air mass) -- the last two enter Bird & Riordan's
+        non-exponential transmittance laws (:func:`bionav.light.daylight.gas_transmittance`).
+
+    Notes
+    -----
+    Linear interpolation of the table (sampled every 5-25 nm; the narrow water and
+    oxygen lines are thus smoothed as in the original model); zero above 1200 nm;
+    below 300 nm the 300 nm values (an underestimate of the Hartley band, where the
+    UV channel's sensitivity is below 1 %).
     """
-    _, v = _table("ozone_absorption.csv")
+    header, v = _table("bird_riordan_absorption.csv")
     wl = np.asarray(wavelengths_nm, dtype=float)
-    return np.where(wl > v[-1, 0], 0.0, np.interp(wl, v[:, 0], v[:, 1]))
+    return {name: np.where(wl > v[-1, 0], 0.0, np.interp(wl, v[:, 0], v[:, k]))
+            for k, name in enumerate(header) if k}
 
 
 #: Red edge of green leaves beyond the measured 700 nm (see :func:`green_leaf_reflectance`).
