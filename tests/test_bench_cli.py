@@ -47,7 +47,7 @@ def test_bench_whole_runs_print_cpu_and_wall(capsys, tmp_path):
     from helpers import write_tiny_folder
 
     folder = write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
-    assert main(["--json", "--method", "sweep", "--grid", "ci", "--dbs", "folder", "--override", f"db.path={folder}",
+    assert main(["--json", "--method", "sweep", "--sweep-grid", "ci", "--dbs", "folder", "--override", f"db.path={folder}",
                  "--override", "experiment.grids.ci.signature='mean,fc'"]) == 0
     (row,) = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert row["method"] == "sweep" and row["variant"] == "ci_warm" and row["dbs"] == ["folder"]
@@ -59,3 +59,25 @@ def test_bench_whole_runs_print_cpu_and_wall(capsys, tmp_path):
     (row,) = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert row["method"] == "cleaning" and row["runs"] == 2 and row["workers"] == 2
     assert row["cpu_s"] > 0 and row["wall_s"] > 0 and 0 < row["coverage"] <= 1
+
+
+def test_bench_grid_mode_times_the_grid_runner_with_1_and_2_workers(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("BIONAV_CACHE", str(tmp_path))
+    argv = ["--json", "--grid", "sim_original", "--grid-snapshots", "2", "--grid-rounds", "1", "--threads", "2",
+            "--steps", "12", "--size", "36", "8"]
+    assert main(argv) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(r["variant"], r["threads"]) for r in rows] == [
+        (v, w) for v in ("single", "double_fine", "compass", "compass_double_fine") for w in (1, 2)]
+    for r in rows:
+        assert r["experiment"] == "grid_homing" and r["db"] == "sim_original" and r["snapshots"] == 2
+        assert r["home_vectors_per_round"] == 2 * (170 - 1)  # every cell but the snapshot's own
+        assert r["cpu_ms_per_home_vector"] > 0 and r["wall_ms_per_home_vector"] > 0
+        assert r["workers_speedup"] > 0 and (r["threads"] == 2 or r["workers_speedup"] == 1.0)
+
+
+def test_bench_grid_mode_names_an_unknown_database(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--grid", "no_such_db"])
+    assert exc.value.code == 2
+    assert "--grid no_such_db" in capsys.readouterr().err

@@ -9,7 +9,7 @@ says about its own parts (render time, per-run seconds).
 
 * ``sweep``: ``python -m bionav -m experiment=param_sweep_grid db=<dbs>``,
   the thesis' parameter sweep (thesis 5.2.1, tables 5.5-5.7; 5,202
-  configurations per database with ``--grid full``). ``--cold`` gives the run
+  configurations per database with ``--sweep-grid full``). ``--cold`` gives the run
   an empty render cache (the stand-ins are rendered first, timed separately).
 * ``cleaning``: ``python -m bionav experiment=cleaning runs=<runs>`` with
   rendered vision (thesis chapter 7).
@@ -33,7 +33,7 @@ RUN_METHODS = ("sweep", "cleaning")
 def add_arguments(parser) -> None:
     """The options of the whole-run benchmarks."""
     group = parser.add_argument_group("--method sweep / cleaning (whole runs of python -m bionav)")
-    group.add_argument("--grid", choices=("full", "ci"), default="full",
+    group.add_argument("--sweep-grid", choices=("full", "ci"), default="full",
                        help="sweep: the parameter grid (default: full, 5202 configurations per database)")
     group.add_argument("--dbs", default="sim_original,sim_hall1,sim_uni",
                        help="sweep: comma-separated databases (default: the thesis' three stand-ins)")
@@ -81,7 +81,7 @@ def run_benchmark(args) -> list[dict]:
         load_before = os.getloadavg()[0]
         if args.method == "sweep":
             dbs = [d for d in args.dbs.split(",") if d]
-            command = ["-m", "experiment=param_sweep_grid", f"experiment.grid={args.grid}", f"db={','.join(dbs)}",
+            command = ["-m", "experiment=param_sweep_grid", f"experiment.grid={args.sweep_grid}", f"db={','.join(dbs)}",
                        f"workers={args.workers}", f"hydra.sweep.dir={tmp / 'sweep'}"]
             if args.cold:
                 command.append(f"cache_dir={tmp / 'cache'}")
@@ -89,7 +89,7 @@ def run_benchmark(args) -> list[dict]:
             wall, cpu = _run(command, cwd=tmp, env=env)
             metrics = _metrics(tmp / "sweep")
             row = {
-                "method": "sweep", "variant": f"{args.grid}{'_cold' if args.cold else '_warm'}",
+                "method": "sweep", "variant": f"{args.sweep_grid}{'_cold' if args.cold else '_warm'}",
                 "dbs": dbs, "configurations": sum(int(m.get("n_configs", 0)) for m in metrics),
                 "workers": args.workers, "wall_s": round(wall, 2), "cpu_s": round(cpu, 2),
                 "render_wall_s": round(sum(float(m.get("render_wall_s", 0.0)) for m in metrics), 2),
