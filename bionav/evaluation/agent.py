@@ -178,6 +178,8 @@ def evaluate_agents(db, hv, *, step_length: float, success_radius: float, record
 
 #: distance from a half-integer coordinate below which the rounded lattice point is not taken as the nearest cell
 _TIE_MARGIN = 1e-9
+#: slack (grid units) of the test that an agent is too far away to arrive in its remaining steps
+_REACH_MARGIN = 1e-6
 
 
 @njit(cache=True)
@@ -211,6 +213,7 @@ def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_sta
                           step_length, radius, out):
     n_levels, n_snap, _ = dir_x.shape
     margin = 0.5 - _TIE_MARGIN
+    reach = step_length * (1.0 + 1e-9)  # a step's length, with room for rounding
     # the lattice rectangle of the cells (the table extends ``origin`` beyond it)
     x_lo, x_hi = np.floor(cx.min()), np.floor(cx.max())
     y_lo, y_hi = np.floor(cy.min()), np.floor(cy.max())
@@ -228,7 +231,7 @@ def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_sta
                 if np.sqrt(dx * dx + dy * dy) < radius:
                     out[lv, s, c] = True
                     continue
-                for _ in range(n_steps_max):
+                for step in range(n_steps_max):
                     # squared distances are separable: the grid's nearest lattice point is the clamped rounded
                     # point, strictly nearest unless a coordinate inside the grid is (nearly) half-integer
                     rx = np.floor(px + 0.5)
@@ -250,13 +253,20 @@ def _agent_success_kernel(dir_x, dir_y, snapshots, starts, lut, origin, cand_sta
                     if i < 0:  # next to a missing cell or on a tie: compare the candidate cells
                         i = _nearest_cell_search(px, py, int(np.floor(px + 0.5)) + origin,
                                                  int(np.floor(py + 0.5)) + origin, lut, cand_start, cand, cx, cy)
-                    px += step_length * row_x[i]
-                    py += step_length * row_y[i]
+                    ux = row_x[i]
+                    uy = row_y[i]
+                    if ux == 0.0 and uy == 0.0:
+                        break  # no direction at this cell: the agent stays here for good
+                    px += step_length * ux
+                    py += step_length * uy
                     dx = px - sx
                     dy = py - sy
-                    if np.sqrt(dx * dx + dy * dy) < radius:
+                    d = np.sqrt(dx * dx + dy * dy)
+                    if d < radius:
                         out[lv, s, c] = True
                         break
+                    if d - radius > (n_steps_max - 1 - step) * reach + _REACH_MARGIN:
+                        break  # farther than the remaining steps can go: it cannot arrive any more
 
 
 @functools.lru_cache(maxsize=8)
@@ -313,8 +323,11 @@ def agent_success(
     The same trials as :func:`run_agents` (start at every cell, nearest-cell
     home vector, give-up after half the grid circumference) with identical
     arithmetic, compiled and looped per trial; the cell look-up rounds to the
-    lattice and only near ties, next to missing cells and off the grid
-    compares all cells (ties to the lower index, as :func:`nearest_cell_index`).
+    lattice and only near ties and next to missing cells compares candidate
+    cells (ties to the lower index, as :func:`nearest_cell_index`). A trial
+    stops early, as a failure, where it can no longer succeed: at a cell
+    without a direction, or farther from the snapshot than its remaining
+    steps reach.
 
     Parameters
     ----------
