@@ -325,14 +325,12 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
             finish(result, last_ns)
         return results
 
-    from concurrent.futures import ProcessPoolExecutor
-    from multiprocessing import get_context
+    from bionav.experiments.common import worker_pool
 
     jobs = [(k, tuple(int(v) for v in seeds[k]), errors[k]) for k in range(runs)]
     container = OmegaConf.to_container(cfg, resolve=True)
-    with ProcessPoolExecutor(workers, mp_context=get_context("spawn"), initializer=_init_worker,
-                             initargs=(container,)) as pool:
-        for result, messages, last_ns in ctx.progress(pool.map(_worker_run, jobs), desc="cleaning runs",
+    with worker_pool(workers, initializer=_init_worker, initargs=(container,)) as pool:
+        for result, messages, last_ns in ctx.progress(pool.imap(_worker_run, jobs), desc="cleaning runs",
                                                       total=runs):
             _BufferLog.replay(messages, ctx.log, offset_ns)
             finish(result, last_ns + offset_ns)

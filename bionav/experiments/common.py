@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +36,31 @@ def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageD
             "(and check db.grid_shape and the warnings about skipped files)."
         )
     return db
+
+
+@contextlib.contextmanager
+def worker_pool(workers: int, *, initializer=None, initargs: tuple = ()):
+    """A pool of ``workers`` spawned processes that is torn down at once when the run stops.
+
+    On leaving the ``with`` block normally the pool finishes its tasks; on
+    an exception (a failed task, Ctrl-C) the workers are terminated, so an
+    interrupted run does not wait for the tasks still queued.
+
+    Yields
+    ------
+    multiprocessing.pool.Pool
+    """
+    from multiprocessing import get_context
+
+    pool = get_context("spawn").Pool(int(workers), initializer=initializer, initargs=initargs)
+    try:
+        yield pool
+    except BaseException:
+        pool.terminate()
+        pool.join()
+        raise
+    pool.close()
+    pool.join()
 
 
 def make_homing(cfg: DictConfig, ctx, geometry):

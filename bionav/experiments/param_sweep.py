@@ -376,10 +376,8 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
     evaluates every signature of the grid on it (:func:`evaluate_levels`).
     Stand-ins not yet in the cache are rendered first, one size per task.
     """
-    from concurrent.futures import ProcessPoolExecutor
-    from multiprocessing import get_context
-
     from bionav.config import plugin_config
+    from bionav.experiments.common import worker_pool
     from bionav.plugins.signatures import signature_class
     from bionav.report.ranking import write_parameter_report
 
@@ -417,10 +415,10 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
         for task in ctx.progress(tasks, desc=f"param_sweep grid on {name}", total=len(tasks)):
             rows += _grid_task(task)
     else:
-        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-            render_s = sum(pool.map(_grid_render, renders))
+        with worker_pool(workers) as pool:
+            render_s = sum(pool.map(_grid_render, renders, chunksize=1))
             t1 = time.perf_counter()
-            for part in ctx.progress(pool.map(_grid_task, tasks), desc=f"param_sweep grid on {name}",
+            for part in ctx.progress(pool.imap(_grid_task, tasks), desc=f"param_sweep grid on {name}",
                                      total=len(tasks)):
                 rows += part
     sweep_s = time.perf_counter() - t1
