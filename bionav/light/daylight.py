@@ -54,7 +54,12 @@ clear noon sky down to the low evening sun:
   while cloud cover *flattens* the sky spectrum relative to the blue sky.
 * **Spatial clouds**: a cloud layer at height ``cloud_height_m`` carrying a
   smooth random field (sum of random plane waves), thresholded to the requested
-  cover fraction, drifting with the wind (see :class:`CloudLayer`).
+  cover fraction, drifting with the wind (see :class:`CloudLayer`). A line of
+  sight whose footprint on the layer spans several clouds sees their *fraction*
+  ``f`` (:func:`cloud_fraction`), each of the full optical depth: radiances and
+  the direct beam are averaged over the footprint (``(1 - f) + f exp(-tau m)``),
+  not computed from the footprint's mean optical depth, which would hide a low
+  sun behind a 10 % cover (``1 - exp(-x)`` is concave).
 
 Frames: directions are unit vectors in a local east-north-up frame (x east,
 y north, z up). Azimuths in this module are radians counter-clockwise from
