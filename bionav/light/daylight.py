@@ -380,6 +380,20 @@ def cloud_fraction(state: SkyState, directions, *, origin_m=(0.0, 0.0)) -> np.nd
     optical depth times the cloud density of the footprint (anti-aliased:
     distant, oblique footprints average many clouds and tend to the cover
     fraction); this is that density. Zero for a layer of zero optical depth.
+
+    Parameters
+    ----------
+    state : SkyState
+        Its ``clouds`` layer and ``time_s`` (drift).
+    directions : array_like, shape (..., 3)
+        Unit viewing directions (east-north-up).
+    origin_m : tuple of float
+        Observer position (east, north) in metres.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Cloud fraction in [0, 1].
     """
     depth = float(state.clouds.optical_depth)
     d = np.asarray(directions, dtype=float)
