@@ -64,6 +64,43 @@ def _dot8(da, g0, db, j):
             np.int32(a7))
 
 
+@nb.njit(nogil=True, cache=True, fastmath={"reassoc", "contract"})
+def _dot8x2(da, g0, db, j):
+    """:func:`_dot8` for b descriptors ``j`` and ``j + 1`` (first the 8 products with ``j``), exact likewise."""
+    a0 = a1 = a2 = a3 = a4 = a5 = a6 = a7 = np.float32(0.0)
+    c0 = c1 = c2 = c3 = c4 = c5 = c6 = c7 = np.float32(0.0)
+    for k in range(da.shape[1]):
+        bk = db[j, k]
+        ck = db[j + 1, k]
+        x0 = da[g0, k]
+        x1 = da[g0 + 1, k]
+        x2 = da[g0 + 2, k]
+        x3 = da[g0 + 3, k]
+        x4 = da[g0 + 4, k]
+        x5 = da[g0 + 5, k]
+        x6 = da[g0 + 6, k]
+        x7 = da[g0 + 7, k]
+        a0 += x0 * bk
+        a1 += x1 * bk
+        a2 += x2 * bk
+        a3 += x3 * bk
+        a4 += x4 * bk
+        a5 += x5 * bk
+        a6 += x6 * bk
+        a7 += x7 * bk
+        c0 += x0 * ck
+        c1 += x1 * ck
+        c2 += x2 * ck
+        c3 += x3 * ck
+        c4 += x4 * ck
+        c5 += x5 * ck
+        c6 += x6 * ck
+        c7 += x7 * ck
+    return (np.int32(a0), np.int32(a1), np.int32(a2), np.int32(a3), np.int32(a4), np.int32(a5), np.int32(a6),
+            np.int32(a7), np.int32(c0), np.int32(c1), np.int32(c2), np.int32(c3), np.int32(c4), np.int32(c5),
+            np.int32(c6), np.int32(c7))
+
+
 @nb.njit(nogil=True, cache=True)
 def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, key_b, symmetric):
     """Best neighbourhood matches between two column-sorted keypoint sets.
@@ -126,7 +163,14 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
         for seg in range(2):
             start = s0 if seg == 0 else s1
             stop = e0 if seg == 0 else e1
-            for j in range(start, stop):
+            j = start
+            while j + 1 < stop:  # two candidates at a time: each a-row load serves two b-rows
+                t16 = _dot8x2(da, g0, db, j)
+                for t in range(GROUP):
+                    buf[t, j] = t16[t]
+                    buf[t, j + 1] = t16[GROUP + t]
+                j += 2
+            if j < stop:
                 t8 = _dot8(da, g0, db, j)
                 for t in range(GROUP):
                     buf[t, j] = t8[t]
