@@ -393,11 +393,17 @@ def sift_home_angles_all_pairs(
                 angles[a, b], used[a, b] = home_angle_from_keys(key_b, ib.x, ib.y, ib.where, ia.x, ia.y, ia.where,
                                                                 *geo)
 
-    # rows of small ``a`` hold the most pairs: handed out first
+    def task(first: int) -> None:
+        """Rows ``first`` and ``n - 1 - first``: n - 1 pairs together, so every task is equally long."""
+        row(first)
+        if n - 1 - first != first:
+            row(n - 1 - first)
+
+    n_tasks = (n + 1) // 2
     pool = ThreadPoolExecutor(max(1, int(workers)))
     try:
-        done = pool.map(row, range(n))
-        for _ in (progress(done, desc="home vectors (SIFT pairs)", total=n) if progress else done):
+        done = pool.map(task, range(n_tasks))
+        for _ in (progress(done, desc="home vectors (SIFT, pairs of rows)", total=n_tasks) if progress else done):
             pass
     finally:  # on Ctrl-C or an error, rows not yet started are dropped instead of awaited
         pool.shutdown(wait=True, cancel_futures=True)
