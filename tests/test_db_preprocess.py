@@ -119,3 +119,26 @@ def test_thesis_presets_compose():
         assert cfg.name == name
         got = [(s["op"], s["order"], s["cutoff"]) if s["op"] == "butterworth" else (s["op"],) for s in cfg.steps]
         assert got == steps
+
+
+@pytest.mark.parametrize("size", [(346, 50), (561, 81), (1122, 162)])
+def test_raw_relative_butterworth_cutoff_is_the_same_angle_at_every_image_size(size):
+    """Thesis cutoffs are relative to the raw frame: gain at k cycles/rev is 1/sqrt(1 + (k / (pi r_h c))^(2n))."""
+    width, height = size
+    r_h, cutoff, order = 80.0, 0.03, 2
+    cols = np.arange(width)
+    for k in (3, 8, 20):
+        img = np.broadcast_to(0.5 + 0.2 * np.cos(2 * np.pi * k * cols / width), (height, width)).astype(np.float64)
+        step = {"op": "butterworth", "order": order, "cutoff": cutoff, "relative_to": "raw"}
+        out = preprocess_images(img, [step], raw_horizon_radius_px=r_h)
+        gain = 2 * np.abs(np.fft.rfft(out[height // 2]))[k] / width / 0.2
+        assert gain == pytest.approx(1 / np.sqrt(1 + (k / (np.pi * r_h * cutoff)) ** (2 * order)), rel=1e-3)
+        # relative to the panorama, the same cutoff keeps a size-dependent number of cycles per revolution
+        plain = preprocess_images(img, [{"op": "butterworth", "order": order, "cutoff": cutoff}])
+        gain_plain = 2 * np.abs(np.fft.rfft(plain[height // 2]))[k] / width / 0.2
+        assert gain_plain == pytest.approx(1 / np.sqrt(1 + (k / (cutoff * width / 2)) ** (2 * order)), rel=1e-3)
+
+
+def test_raw_relative_cutoff_needs_a_known_frame_of_reference():
+    with pytest.raises(UserError, match="relative_to"):
+        preprocess_images(np.zeros((4, 16)), [{"op": "butterworth", "cutoff": 0.1, "relative_to": "sensor"}])

@@ -224,7 +224,7 @@ def test_grid_homing_reports_sift_keypoints_per_image(tmp_path):
                       cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     metrics = json.loads((tmp_path / "run" / "metrics.json").read_text())
-    db = synthetic_database("sim_original", image_size=(120, 18), cache_dir=tmp_path / "cache")
+    db = synthetic_database("sim_original", image_size=(120, 18), cache_dir=tmp_path / "cache", realism="camera")
     counts = [len(cv2.SIFT_create().detect(np.clip(np.rint(im * 255.0), 0, 255).astype(np.uint8), None))
               for im in db.images]
     assert metrics["keypoints_per_image"] == pytest.approx(np.mean(counts))

@@ -2,6 +2,7 @@
 
     python -m bionav.db show <db> [--out DIR] [overrides ...]
     python -m bionav.db export <db> DIR [--bits 8|16] [--force] [overrides ...]
+    python -m bionav.db camera <db> [--out DIR] [--cells N] [overrides ...]
 
 Overrides are Hydra overrides of the composed config, e.g. ``db.seed=1``,
 ``db.image_size=[288,50]``, ``data_dir=/data/panoramas``, ``db.path=DIR``.
@@ -25,7 +26,7 @@ def _parser(names: list[str]) -> argparse.ArgumentParser:
         epilog=f"databases: {listing}. Real databases are read from data_dir/<name> "
                "(data_dir= or BIONAV_DATA); db=folder reads db.path=DIR.",
     )
-    sub = parser.add_subparsers(dest="command", required=True, metavar="{show,export}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="{show,export,camera}")
     show = sub.add_parser("show", help="write a contact sheet and a grid map PNG",
                           description="Write <db>_contact.png (thumbnails laid out like the grid) and "
                                       "<db>_grid.png (which cells exist).",
@@ -43,6 +44,15 @@ def _parser(names: list[str]) -> argparse.ArgumentParser:
                         help="PNG bit depth (default: 8 if lossless, else 16)")
     export.add_argument("--force", action="store_true", help="overwrite images already in DIR")
     export.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. db.seed=1")
+    camera = sub.add_parser("camera", help="write raw mirror frames and unfolded panoramas of a stand-in",
+                            description="Write <db>_camera.png: raw catadioptric frames of a few capture cells "
+                                        "and their unfolded panoramas (db.realism=camera) next to the ideal ones "
+                                        "(docs/databases.md).",
+                            epilog=f"databases: {listing}")
+    camera.add_argument("db", help="synthetic stand-in name (sim_...)")
+    camera.add_argument("--out", type=Path, default=None, help="output folder (default: outputs/db/<db>)")
+    camera.add_argument("--cells", type=int, default=3, help="number of capture cells shown (default 3)")
+    camera.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. db.camera.psf_sigma_px=1.5")
     return parser
 
 
@@ -58,6 +68,8 @@ def run(argv: list[str]) -> int:
         parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     args.overrides = list(args.overrides) + extra
     composed = compose_database(args.db, args.overrides)
+    if args.command == "camera":
+        return _camera(args, composed)
     db = load_database(composed.db, data_dir=composed.data_dir, cache_dir=composed.cache_dir)
     if args.command == "show":
         from bionav.db.sheets import write_show
@@ -78,6 +90,31 @@ def run(argv: list[str]) -> int:
         overrides = export_database(db, args.dir, bits=args.bits, overwrite=args.force)
         print(f"wrote {len(db)} images of {db.name} to {args.dir}")
         print("read back with: python -m bionav " + " ".join(overrides))
+    return 0
+
+
+def _camera(args, composed) -> int:
+    from bionav.db.loading import as_database_config
+    from bionav.db.sheets import write_camera_sheet
+    from bionav.db.synthetic import _camera_configs, get_spec
+    from bionav.homing.imageops import check_image_size
+
+    cfg = as_database_config(composed.db)
+    if str(cfg.source) != "synthetic":
+        raise UserError(f"db={args.db} is not a synthetic stand-in; the camera sheet exists for the sim_* "
+                        "stand-ins (python -m bionav.db camera sim_original).")
+    if not 1 <= args.cells <= 12:
+        raise UserError(f"--cells {args.cells}: choose 1 to 12 cells.")
+    spec = get_spec(cfg.name)
+    size = check_image_size(cfg.image_size, name="db.image_size", minimum=(8, 2)) or spec.native_size
+    camera, pose_error = _camera_configs(spec, cfg.camera, cfg.pose_error, spec.geometry(*size))
+    out = args.out if args.out is not None else Path("outputs") / "db" / args.db
+    try:
+        path = write_camera_sheet(cfg.name, out, camera=camera, pose_error=pose_error, seed=int(cfg.seed),
+                                  image_size=size, n_cells=args.cells)
+    except OSError as exc:
+        raise UserError(f"cannot write to {out}: {exc}; choose a writable folder with --out DIR.") from None
+    print(f"wrote {path}")
     return 0
 
 

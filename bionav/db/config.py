@@ -30,6 +30,54 @@ class UnfoldConfig:
 
 
 @dataclass
+class CameraConfig:
+    """Catadioptric camera of the synthetic stand-ins (used when ``db.realism=camera``).
+
+    Mirror (unified central catadioptric model, :mod:`bionav.world.catadioptric`):
+    ``mirror_xi`` and the rim (elevation and raw radius of the mirror's edge);
+    the raw frame is ``raw_size`` pixels with the mirror centred. Sensor
+    (:mod:`bionav.db.camera`): optics blur (Gaussian PSF), vignetting (relative
+    illumination ``1 - vignetting * (r / rim radius)**2``), automatic exposure
+    (mean raw level ``ae_target``, exposure time up to ``max_exposure`` times the
+    world's nominal exposure, then analogue gain up to ``max_gain``), shot noise
+    (``full_well_e`` electrons at full scale) and read noise, 8-bit raw frame.
+    Defaults: the ultra-wide-view mirror; ``db=sim_uni`` sets the normal-view mirror.
+    """
+
+    raw_size: list[int] = bounded([640, 480], length=2, item=Range(ge=64, le=4096))  # [w, h] pixels
+    mirror_xi: float = bounded(0.82, gt=0.05, lt=1.0)  # hyperbolic mirror parameter of the unified model
+    rim_elevation_deg: float = bounded(36.0, ge=0.0, le=80.0)  # upper limit of the field of view
+    rim_radius_px: float = bounded(230.0, ge=16.0, le=2048.0)  # raw radius of the mirror rim
+    psf_sigma_px: float = bounded(0.8, ge=0.0, le=10.0)  # optics blur, Gaussian std in raw pixels
+    vignetting: float = bounded(0.3, ge=0.0, le=0.95)  # illumination loss at the mirror rim
+    auto_exposure: bool = True
+    ae_target: float = bounded(0.4, gt=0.0, lt=1.0)  # mean raw level the automatic exposure aims at
+    max_exposure: float = bounded(4.0, ge=0.01, le=1000.0)  # longest exposure / the world's nominal one
+    max_gain: float = bounded(4.0, ge=1.0, le=64.0)  # largest analogue gain after the longest exposure
+    full_well_e: float = bounded(10000.0, ge=10.0, le=1e7)  # electrons at full scale (gain 1): shot noise
+    read_noise_e: float = bounded(12.0, ge=0.0, le=1e4)  # read noise std in electrons
+
+
+@dataclass
+class PoseErrorConfig:
+    """Capture-pose errors of the synthetic stand-ins (used when ``db.realism=camera``).
+
+    Each image is rendered at its grid position plus a Gaussian offset (std
+    ``position_sigma_m`` per axis, metres) and with a Gaussian heading error
+    (std ``heading_sigma_deg``) and tilt (std ``tilt_sigma_deg`` about each
+    horizontal axis; ``null``: the world's floor, ``World.floor_tilt_deg``); the
+    database still reports the nominal grid (the ground truth of the real
+    databases is the nominal grid too). Drawn from ``seed`` (together with
+    ``db.seed``).
+    """
+
+    position_sigma_m: float = bounded(0.02, ge=0.0, le=10.0)
+    heading_sigma_deg: float = bounded(1.5, ge=0.0, le=180.0)
+    tilt_sigma_deg: Optional[float] = bounded(None, ge=0.0, le=20.0)
+    seed: int = bounded(0, ge=0, le=2**32 - 1)
+
+
+@dataclass
 class DatabaseConfig:
     """Where a database comes from and how its images are to be read.
 
@@ -42,7 +90,12 @@ class DatabaseConfig:
     path: Optional[str] = None  # folder databases: the directory
     image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=2, le=MAX_IMAGE_SIDE))  # [W, H]; None: native
     seed: int = bounded(0, ge=0, le=2**32 - 1)  # synthetic worlds: which world of this kind
-    noise: float = bounded(0.01, ge=0.0, le=1.0)  # synthetic: camera noise std before 8-bit quantisation
+    noise: float = bounded(0.01, ge=0.0, le=1.0)  # synthetic, realism=ideal: noise std before 8-bit quantisation
+    # synthetic: 'camera' renders the raw mirror image and unfolds it (docs/databases.md), 'ideal' the old
+    # direct panoramas; db=sim_* configs choose camera
+    realism: str = bounded("ideal", choices=("ideal", "camera"))
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    pose_error: PoseErrorConfig = field(default_factory=PoseErrorConfig)
     naming: str = bounded("auto", choices=("auto", "vardy", "moeller", "csv"))
     # how azimuth grows with the column index on disk
     azimuth: str = bounded("clockwise", choices=("clockwise", "counterclockwise", "cw", "ccw", "anticlockwise",

@@ -119,9 +119,12 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
     if source == "synthetic":
         from bionav.db.synthetic import synthetic_database
 
+        camera = {} if cfg.realism == "ideal" else dict(realism=cfg.realism, camera=cfg.camera,
+                                                        pose_error=cfg.pose_error,
+                                                        progress=_render_progress(cfg.name), threads=2)
         db = synthetic_database(cfg.name, image_size=size, seed=cfg.seed, noise=cfg.noise,
                                 rotate_current=cfg.rotate_current, rotation_seed=cfg.rotation_seed,
-                                cache_dir=Path(cache_dir))
+                                cache_dir=Path(cache_dir), **camera)
     elif source == "folder":
         from bionav.db.folder import load_folder
 

@@ -26,12 +26,20 @@ magnitude (:func:`bionav.homing.imageops.edge_filter`). In the thesis a cutoff o
 unfiltered images"; bionav's Butterworth filter with cutoff 1.0 still halves the
 power at the Nyquist frequency, so use ``preprocess=none`` for unfiltered images.
 
-Deviation from the thesis: there, the filters were applied to the raw camera
-frame before unfolding. bionav filters the panorama at its native resolution
-(cyclic in azimuth) with the cutoff relative to the panorama's Nyquist
-frequency; at the databases' native 1122 pixels per 360 degrees a cutoff of
-0.03 keeps about 17 cycles per revolution, close to what the same relative
-cutoff keeps on a raw frame with a horizon circle of about 200 pixels radius.
+Cutoffs relative to the raw camera frame: in the thesis the filters were
+applied to the raw camera frame before unfolding, so a cutoff such as bw1's 0.03
+is relative to the Nyquist frequency of the *raw* frame (0.5 cycles per raw
+pixel) and keeps the same angular detail whatever size the panorama is unfolded
+to. Steps with ``relative_to: raw`` (the presets bw1, bw2, bw1e, bw2e) convert
+it to the panorama at hand with :func:`panorama_cutoff_from_raw`: on the raw
+frame's horizon circle of radius ``r_h`` pixels a raw frequency of ``f`` cycles
+per pixel is ``2 pi r_h f`` cycles per revolution, i.e. ``2 pi r_h f / W`` cycles
+per panorama pixel, so ``cutoff_panorama = cutoff_raw * 2 pi r_h / W``. ``r_h``
+is the database's ``meta["raw_horizon_radius_px"]`` (the stand-ins' mirror
+model, :func:`bionav.db.camera.raw_horizon_radius`), else the ultra-wide-view
+mirror's. The filter then runs on the panorama (cyclic in azimuth), isotropic
+in panorama pixels. Steps without ``relative_to`` (or ``relative_to:
+panorama``) keep a cutoff relative to the panorama's own Nyquist frequency.
 """
 
 from __future__ import annotations
@@ -72,7 +80,7 @@ class PreprocessConfig:
 # chains
 
 _PARAMS = {
-    "butterworth": {"order", "cutoff"},
+    "butterworth": {"order", "cutoff", "relative_to"},
     "edges": {"method"},
     "equalize": {"levels"},
     "resize": {"size"},
@@ -99,6 +107,11 @@ def _normalise_step(step) -> dict:
         order, cutoff = int(step.get("order", 1)), float(step["cutoff"])
         if order < 1 or not cutoff > 0:
             raise UserError(f"butterworth needs order >= 1 and cutoff > 0 (got order={order}, cutoff={cutoff}).")
+        rel = str(step.get("relative_to", "panorama")).strip().lower()
+        if rel not in ("panorama", "raw"):
+            raise UserError(f"butterworth relative_to={rel!r}: use relative_to: raw (cutoff relative to the raw "
+                            "camera frame's Nyquist frequency, as in the thesis) or relative_to: panorama.")
+        step["relative_to"] = rel
     if op == "resize":
         if "size" not in step or len(list(step["size"])) != 2:
             raise UserError("preprocessing op 'resize' needs size: [W, H].")
@@ -106,7 +119,31 @@ def _normalise_step(step) -> dict:
     return {"op": op, **step}
 
 
-def preprocess_images(images: np.ndarray, steps) -> np.ndarray:
+def panorama_cutoff_from_raw(cutoff: float, *, width: int, raw_horizon_radius_px: float) -> float:
+    """A Butterworth cutoff relative to the raw frame's Nyquist frequency, as one relative to a panorama's.
+
+    ``cutoff_panorama = cutoff * 2 pi r_h / W``: a frequency of ``cutoff / 2``
+    cycles per raw pixel on the raw horizon circle (radius ``r_h`` pixels) is
+    ``pi r_h cutoff`` cycles per revolution, whatever the panorama width ``W``.
+
+    Parameters
+    ----------
+    cutoff : float
+        Relative to the raw frame's Nyquist frequency (thesis 5.2.1: bw1 0.03, bw2 0.015).
+    width : int
+        Panorama width ``W`` in pixels (columns per 360 degrees).
+    raw_horizon_radius_px : float
+        Radius of the horizon circle in the raw frame, pixels.
+
+    Returns
+    -------
+    float
+        Cutoff relative to the panorama's Nyquist frequency (0.5 cycles per pixel).
+    """
+    return float(cutoff) * 2.0 * np.pi * float(raw_horizon_radius_px) / int(width)
+
+
+def preprocess_images(images: np.ndarray, steps, *, raw_horizon_radius_px: float | None = None) -> np.ndarray:
     """Apply a chain of preprocessing steps to a stack of panoramas.
 
     Parameters
@@ -117,6 +154,9 @@ def preprocess_images(images: np.ndarray, steps) -> np.ndarray:
         ``[{op: butterworth, order: 1, cutoff: 0.03}, {op: edges}, ...]``
         (see :class:`PreprocessConfig`), applied in order. An empty list
         returns the images unchanged.
+    raw_horizon_radius_px : float, optional
+        Horizon radius of the raw frame for steps with ``relative_to: raw``
+        (default: the ultra-wide-view mirror's, :func:`bionav.db.camera.raw_horizon_radius`).
 
     Returns
     -------
@@ -127,7 +167,15 @@ def preprocess_images(images: np.ndarray, steps) -> np.ndarray:
         step = _normalise_step(raw_step)
         op = step.pop("op")
         if op == "butterworth":
-            out = butterworth_lowpass(out, order=int(step.get("order", 1)), cutoff=float(step["cutoff"]), clip=(0.0, 1.0))
+            cutoff = float(step["cutoff"])
+            if step["relative_to"] == "raw":
+                if raw_horizon_radius_px is None:
+                    from bionav.db.camera import raw_horizon_radius
+
+                    raw_horizon_radius_px = raw_horizon_radius("ultra-wide")
+                cutoff = panorama_cutoff_from_raw(cutoff, width=out.shape[-1],
+                                                  raw_horizon_radius_px=raw_horizon_radius_px)
+            out = butterworth_lowpass(out, order=int(step.get("order", 1)), cutoff=cutoff, clip=(0.0, 1.0))
         elif op == "edges":
             out = edge_filter(out, method=str(step.get("method", "sobel")))
         elif op == "equalize":
@@ -164,7 +212,7 @@ def preprocess_database(db: ImageDatabase, preprocess) -> ImageDatabase:
     name, steps = _steps_of(preprocess)
     if not steps:
         return db
-    images = preprocess_images(db.images, steps)
+    images = preprocess_images(db.images, steps, raw_horizon_radius_px=db.meta.get("raw_horizon_radius_px"))
     geometry = db.geometry
     if images.shape[-2:] != db.images.shape[-2:]:
         geometry = geometry.resized(images.shape[-1], images.shape[-2])

@@ -29,6 +29,7 @@ sim_uni         10x17   1.0 m   170      normal  outdoors: buildings, trees, sky
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -100,6 +101,12 @@ class SyntheticSpec:
         ``builder(seed) -> World``.
     geometry : callable
         ``geometry(W, H) -> PanoramaGeometry``.
+    native_size : (int, int)
+        Native ``(W, H)``.
+    positions_from : str
+        How the real database's positions were recorded (thesis 3.1): ``odometry``,
+        ``semi-automatic`` or ``outdoor-odometry``; selects the pose errors of
+        ``realism="camera"`` (:data:`bionav.db.camera.POSE_ERRORS`).
     """
 
     name: str
@@ -111,11 +118,12 @@ class SyntheticSpec:
     builder: Callable
     geometry: Callable[[int, int], PanoramaGeometry] = ultra_wide_geometry
     native_size: tuple[int, int] = NATIVE_SIZE
+    positions_from: str = "odometry"
 
 
-def _spec(name, grid, spacing, n, mirror, description, builder) -> SyntheticSpec:
+def _spec(name, grid, spacing, n, mirror, description, builder, positions_from="odometry") -> SyntheticSpec:
     geom = normal_view_geometry if mirror == "normal-view" else ultra_wide_geometry
-    return SyntheticSpec(name, grid, spacing, n, mirror, description, builder, geom)
+    return SyntheticSpec(name, grid, spacing, n, mirror, description, builder, geom, NATIVE_SIZE, positions_from)
 
 
 #: The 13 synthetic stand-ins, by name.
@@ -143,13 +151,13 @@ SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
         _spec("sim_hall2", (10, 20), 0.5, 170, "ultra-wide", "another part of the hall",
               _lazy("bionav.world.worlds.hall", "build_hall", part=2)),
         _spec("sim_moeller1", (11, 22), 0.1, 242, "ultra-wide", "a living room",
-              _lazy("bionav.world.worlds.living", "build_living_room")),
+              _lazy("bionav.world.worlds.living", "build_living_room"), "semi-automatic"),
         _spec("sim_roeben1", (11, 36), 0.1, 396, "ultra-wide",
               "a living room with kitchen, furniture close to the grid",
-              _lazy("bionav.world.worlds.living", "build_living_kitchen")),
+              _lazy("bionav.world.worlds.living", "build_living_kitchen"), "semi-automatic"),
         _spec("sim_uni", (10, 17), 1.0, 170, "normal-view",
               "outdoors at a university entrance: buildings, trees, sky and sun",
-              _lazy("bionav.world.worlds.outdoor", "build_campus")),
+              _lazy("bionav.world.worlds.outdoor", "build_campus"), "outdoor-odometry"),
     ]
 }
 
@@ -227,7 +235,8 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
                        noise: float = 0.01, rotate_current: bool = False, rotation_seed: int = 0,
                        cache_dir: str | Path | None = None,
                        progress: Callable[[Iterable], Iterable] | None = None,
-                       threads: int | None = 1) -> ImageDatabase:
+                       threads: int | None = 1, realism: str = "ideal", camera=None,
+                       pose_error=None) -> ImageDatabase:
     """Render (or load from cache) one synthetic stand-in database.
 
     Parameters
@@ -257,6 +266,18 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     threads : int or None
         Render threads (see :func:`bionav.world.render.render_panorama`);
         the images do not depend on it.
+    realism : {"ideal", "camera"}
+        ``ideal``: panoramas rendered directly, Gaussian ``noise``, 8-bit (the
+        original pipeline). ``camera``: the raw catadioptric frame through the
+        mirror, sensor and unfolding of :mod:`bionav.db.camera`, at capture poses
+        with errors (``noise`` is not used). The ``db=sim_*`` configs choose
+        ``camera``.
+    camera : CameraConfig, optional
+        Camera of ``realism="camera"``; default: the stand-in's mirror
+        (:func:`bionav.db.camera.camera_config_for`).
+    pose_error : PoseErrorConfig, optional
+        Pose errors of ``realism="camera"``; default: the stand-in's
+        (:func:`bionav.db.camera.pose_error_config_for`).
 
     Returns
     -------
@@ -270,6 +291,9 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     w, h = check_image_size(image_size, name="db.image_size", minimum=(8, 2)) or spec.native_size
     if noise < 0:
         raise UserError(f"db.noise must be >= 0, got {noise}.")
+    if realism not in ("ideal", "camera"):
+        raise UserError(f"db.realism={realism!r} is not a realism level; use db.realism=camera (raw mirror image, "
+                        "sensor, pose errors) or db.realism=ideal (the clean original panoramas).")
     geometry = spec.geometry(w, h)
     world = spec.builder(int(seed))
     positions = np.argwhere(world.cells).astype(np.int64)
@@ -297,15 +321,31 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "exposure": float(world.scene.exposure),
         "scene": compiled_digest,
     }
+    if realism == "camera":
+        from bionav.db.camera import resolve_pose_error
+
+        camera, pose_error = _camera_configs(spec, camera, pose_error, geometry)
+        pose_error = resolve_pose_error(pose_error, world)  # tilt_sigma_deg=None: the world's floor
+        del params["noise"]
+        params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
+                      pose_error=dataclasses.asdict(pose_error), native_size=list(spec.native_size))
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    path = cdir / f"{name}-{w}x{h}-seed{int(seed)}-{key[:20]}.npz"
+    tag = "" if realism == "ideal" else "-camera"
+    path = cdir / f"{name}-{w}x{h}-seed{int(seed)}{tag}-{key[:20]}.npz"
     images_u8 = read_cached_images(path, key)
     cached = images_u8 is not None
-    if not cached:
+    if not cached and realism == "camera":
+        from bionav.db.camera import camera_images
+
+        images_u8, _, _ = camera_images(world, positions, geometry, camera=camera, pose_error=pose_error,
+                                        seed=int(seed), native_size=spec.native_size, progress=progress,
+                                        threads=threads)
+    elif not cached:
         imgs = render_world_images(world, positions, geometry, progress=progress, threads=threads)
         rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x6E6F6973]))
         images_u8 = quantise(imgs, noise=noise, rng=rng)
+    if not cached:
         try:
             write_atomic(path, lambda f: np.savez(f, images=images_u8, positions=positions, key=np.array(key),
                                                   params=np.array(json.dumps(params))))
@@ -327,7 +367,15 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "from_cache": cached,
         "rotate_current": bool(rotate_current),
         "rotation_seed": int(rotation_seed),
+        "realism": realism,
     }
+    from bionav.db.camera import raw_horizon_radius
+
+    meta["raw_horizon_radius_px"] = raw_horizon_radius(spec.mirror, camera if realism == "camera" else None)
+    if realism == "camera":
+        meta.pop("noise")
+        meta["camera"] = dataclasses.asdict(camera)
+        meta["pose_error"] = dataclasses.asdict(pose_error)
     db = ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
                        geometry=geometry, spacing_m=float(spec.spacing_m), meta=meta)
     if rotate_current:
@@ -337,6 +385,43 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     return db
 
 
+def _camera_version() -> int:
+    from bionav.db.camera import CAMERA_VERSION
+
+    return CAMERA_VERSION
+
+
+def _camera_configs(spec: SyntheticSpec, camera, pose_error, geometry: PanoramaGeometry):
+    """Validated camera and pose-error configs of ``realism="camera"`` (defaults: the stand-in's own)."""
+    from bionav.db.camera import camera_config_for, pose_error_config_for
+    from bionav.db.config import CameraConfig, PoseErrorConfig
+    from bionav.validation import check_config
+
+    if camera is None:
+        camera = camera_config_for(spec.mirror)
+    elif not isinstance(camera, CameraConfig):
+        camera = CameraConfig(**dict(camera))
+    if pose_error is None:
+        pose_error = pose_error_config_for(spec.positions_from)
+    elif not isinstance(pose_error, PoseErrorConfig):
+        pose_error = PoseErrorConfig(**dict(pose_error))
+    check_config(camera, prefix="db.camera")
+    check_config(pose_error, prefix="db.pose_error")
+    xi, rim = float(camera.mirror_xi), float(camera.rim_elevation_deg)
+    if not np.sin(np.radians(rim)) < xi:
+        raise UserError(f"db.camera.mirror_xi={xi:g} must exceed sin(db.camera.rim_elevation_deg)="
+                        f"{np.sin(np.radians(rim)):.3f}: a hyperbolic mirror sees only up to asin(xi) = "
+                        f"{np.degrees(np.arcsin(min(xi, 1.0))):.1f} deg; raise mirror_xi or lower the rim elevation.")
+    top = np.degrees((geometry.horizon_row + 0.5) * geometry.rad_per_row)
+    if not top < rim:
+        raise UserError(f"db.camera.rim_elevation_deg={rim:g} lies below the top of the panorama ({top:.1f} deg); "
+                        f"choose a rim elevation above {top:.1f} deg.")
+    if float(camera.rim_radius_px) > 0.5 * min(camera.raw_size):
+        raise UserError(f"db.camera.rim_radius_px={camera.rim_radius_px:g} does not fit in the raw frame "
+                        f"db.camera.raw_size={list(camera.raw_size)}; choose at most {0.5 * min(camera.raw_size):g}.")
+    return camera, pose_error
+
+
 def synthetic_database_from_config(cfg, *, cache_dir: str | Path | None = None,
                                    progress: Callable[[Iterable], Iterable] | None = None) -> ImageDatabase:
     """:func:`synthetic_database` from a ``db`` config node (:class:`bionav.db.config.DatabaseConfig`)."""
@@ -344,5 +429,6 @@ def synthetic_database_from_config(cfg, *, cache_dir: str | Path | None = None,
     return synthetic_database(
         cfg.name, image_size=None if size is None else list(size), seed=int(cfg.seed), noise=float(cfg.noise),
         rotate_current=bool(cfg.rotate_current), rotation_seed=int(cfg.rotation_seed), cache_dir=cache_dir,
-        progress=progress,
+        progress=progress, realism=str(getattr(cfg, "realism", "ideal")), camera=getattr(cfg, "camera", None),
+        pose_error=getattr(cfg, "pose_error", None),
     )

@@ -36,7 +36,8 @@ def _bilinear(src: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarr
     return (1.0 - fy) * top + fy * bottom
 
 
-def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float, outer_radius: float, size) -> np.ndarray:
+def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = None,
+                    outer_radius: float | None = None, size, radii=None) -> np.ndarray:
     """Unfold a raw omnidirectional camera frame into a panorama (polar to rectangular).
 
     Column ``j`` of the output samples the ray at polar angle
@@ -47,6 +48,10 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float, outer_radiu
     ``r_i = outer_radius + (inner_radius - outer_radius) * i / (H - 1)``, so
     row 0 (top) lies on the outer circle and the last row on the inner circle.
     Sampling is bilinear (exact, in float64); pixels outside the frame read 0.
+    A mirror whose radius is not linear in elevation is unfolded to rows
+    evenly spaced in elevation by giving every row's radius (``radii``, from
+    the mirror profile, e.g.
+    :meth:`bionav.world.catadioptric.MirrorProjection.radius_from_elevation`).
 
     The unfolded image is an *on-disk* panorama: which azimuth direction and
     which column looks along the grid's +x depend on the mirror and the camera
@@ -60,9 +65,13 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float, outer_radiu
     center : sequence of 2 float
         ``(cx, cy)`` mirror centre in pixels (column, row) of the raw frame.
     inner_radius, outer_radius : float
-        Radii in pixels of the bottom and top rows of the panorama.
+        Radii in pixels of the bottom and top rows of the panorama (linear in between).
     size : sequence of 2 int
         Output ``(W, H)``.
+    radii : array_like, shape (H,) or (H, W), optional
+        Radius in pixels of every row (row 0 on top), or of every pixel (a
+        tilted camera unfolded as if upright: :func:`bionav.db.camera.unfold_frame`);
+        replaces ``inner_radius`` and ``outer_radius``.
 
     Returns
     -------
@@ -71,7 +80,22 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float, outer_radiu
     width, height = int(size[0]), int(size[1])
     if width < 1 or height < 1:
         raise ValueError(f"unfold size must be positive, got {size}")
-    map_x, map_y = _unfold_maps((float(center[0]), float(center[1])), float(inner_radius),
-                                float(outer_radius), (width, height))
+    if radii is None:
+        if inner_radius is None or outer_radius is None:
+            raise ValueError("unfold_panorama needs inner_radius and outer_radius, or radii")
+        map_x, map_y = _unfold_maps((float(center[0]), float(center[1])), float(inner_radius),
+                                    float(outer_radius), (width, height))
+    else:
+        radius = np.asarray(radii, dtype=np.float64)
+        if radius.shape == (height, width):
+            pass
+        elif radius.size == height:
+            radius = radius.reshape(height, 1)
+        else:
+            raise ValueError(f"radii must give one radius per row ({height}) or per pixel ({height} x {width}), "
+                             f"got shape {radius.shape}")
+        phi = 2.0 * np.pi * np.arange(width) / width
+        map_x = float(center[0]) + radius * np.cos(phi)[None, :]
+        map_y = float(center[1]) + radius * np.sin(phi)[None, :]
     src = np.asarray(raw, dtype=np.float64)
     return _bilinear(src, map_x, map_y).astype(np.float32)

@@ -121,13 +121,58 @@ def render_panorama(scene: Scene | CompiledScene, *, position: Sequence[float], 
     if ss < 1:
         raise ValueError("supersample must be >= 1")
     az, el = ray_grid(geometry, heading, supersample=ss)
+    pix = max(geometry.rad_per_column, geometry.rad_per_row) / ss
+    out = render_ray_grid(cs, position=position, azimuths=az, elevations=el, pixel_angle=pix, sky=sky,
+                          shadows=shadows, threads=threads)
+    C = out.shape[2]
+    if ss > 1:
+        out = out.reshape(geometry.height, ss, geometry.width, ss, C).mean(axis=(1, 3))
+    out *= exposure
+    if clip:
+        np.clip(out, 0.0, 1.0, out=out)
+    return out.astype(np.float32)
+
+
+def render_ray_grid(scene: Scene | CompiledScene, *, position: Sequence[float], azimuths: np.ndarray,
+                    elevations: np.ndarray, pixel_angle: float, sky=None, shadows: bool = True,
+                    threads: int | None = 1) -> np.ndarray:
+    """Radiance along a separable grid of rays (any azimuths x any elevations).
+
+    The building block of :func:`render_panorama` (evenly spaced rows) and of
+    the catadioptric raw-frame renderer (:mod:`bionav.world.catadioptric`),
+    whose rows are the elevations of evenly spaced mirror radii.
+
+    Parameters
+    ----------
+    scene : Scene or CompiledScene
+    position : sequence of 3 float
+        Ray origin ``(x, y, z)`` in metres, world frame.
+    azimuths : ndarray, shape (W,)
+        World azimuths in radians, counter-clockwise from world ``+x``.
+    elevations : ndarray, shape (H,)
+        Elevations in radians above the horizon.
+    pixel_angle : float
+        Angular footprint of one ray in radians (selects the texture mip level).
+    sky : callable, optional
+        ``sky(directions (N, 3)) -> (N, C)`` for rays that hit nothing (black if None;
+        a :class:`Scene`'s own sky is *not* used here, pass it explicitly).
+    shadows, threads
+        As in :func:`render_panorama`.
+
+    Returns
+    -------
+    ndarray, shape (H, W, C), float64
+        Radiance (no exposure, no clipping).
+    """
+    cs = _compiled(scene)
+    az = np.ascontiguousarray(azimuths, dtype=np.float64)
+    el = np.ascontiguousarray(elevations, dtype=np.float64)
     ox, oy, oz = (float(v) for v in position)
     C = cs.mat_albedo.shape[1]
     out = np.empty((el.size, az.size, C), np.float64)
     depth = np.empty((el.size, az.size))
     sky_mask = np.zeros((el.size, az.size), np.bool_)
-    pix = max(geometry.rad_per_column, geometry.rad_per_row) / ss
-    _run_threads(threads, render_kernel, ox, oy, oz, az, el, pix,
+    _run_threads(threads, render_kernel, ox, oy, oz, az, el, float(pixel_angle),
                   cs.boxes, cs.box_mats, cs.frusta, cs.frustum_mats, cs.ellipsoids, cs.ellipsoid_mats,
                   cs.prim_kind, cs.prim_idx, cs.spheres, cs.shadow_grids, cs.shadow_starts, cs.shadow_items,
                   cs.mat_tex, cs.mat_fit, cs.mat_scale, cs.mat_albedo, cs.mat_emission, cs.tex_data,
@@ -139,12 +184,7 @@ def render_panorama(scene: Scene | CompiledScene, *, position: Sequence[float], 
         dirs = np.stack([ce * np.cos(az[jj]), ce * np.sin(az[jj]), np.sin(el[rr])], axis=1)
         rad = np.asarray(sky(dirs), np.float64).reshape(len(rr), -1)
         out[rr, jj, :] = rad
-    if ss > 1:
-        out = out.reshape(geometry.height, ss, geometry.width, ss, C).mean(axis=(1, 3))
-    out *= exposure
-    if clip:
-        np.clip(out, 0.0, 1.0, out=out)
-    return out.astype(np.float32)
+    return out
 
 
 def render_depth(scene: Scene | CompiledScene, *, position: Sequence[float], heading: float = 0.0,
