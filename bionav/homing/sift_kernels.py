@@ -101,6 +101,41 @@ def _dot8x2(da, g0, db, j):
             np.int32(c6), np.int32(c7))
 
 
+@nb.njit(nogil=True, cache=True, fastmath={"reassoc", "contract"})
+def _dot4x4(da, g0, db, j):
+    """Products of a-descriptors ``g0 .. g0 + 3`` with b-descriptors ``j .. j + 3`` (b-major), exact likewise."""
+    a0 = a1 = a2 = a3 = b0 = b1 = b2 = b3 = np.float32(0.0)
+    c0 = c1 = c2 = c3 = d0 = d1 = d2 = d3 = np.float32(0.0)
+    for k in range(da.shape[1]):
+        x0 = da[g0, k]
+        x1 = da[g0 + 1, k]
+        x2 = da[g0 + 2, k]
+        x3 = da[g0 + 3, k]
+        p = db[j, k]
+        q = db[j + 1, k]
+        r = db[j + 2, k]
+        s = db[j + 3, k]
+        a0 += x0 * p
+        a1 += x1 * p
+        a2 += x2 * p
+        a3 += x3 * p
+        b0 += x0 * q
+        b1 += x1 * q
+        b2 += x2 * q
+        b3 += x3 * q
+        c0 += x0 * r
+        c1 += x1 * r
+        c2 += x2 * r
+        c3 += x3 * r
+        d0 += x0 * s
+        d1 += x1 * s
+        d2 += x2 * s
+        d3 += x3 * s
+    return (np.int32(a0), np.int32(a1), np.int32(a2), np.int32(a3), np.int32(b0), np.int32(b1), np.int32(b2),
+            np.int32(b3), np.int32(c0), np.int32(c1), np.int32(c2), np.int32(c3), np.int32(d0), np.int32(d1),
+            np.int32(d2), np.int32(d3))
+
+
 @nb.njit(nogil=True, cache=True)
 def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, key_b, symmetric):
     """Best neighbourhood matches between two column-sorted keypoint sets.
@@ -164,7 +199,14 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
             start = s0 if seg == 0 else s1
             stop = e0 if seg == 0 else e1
             j = start
-            while j + 1 < stop:  # two candidates at a time: each a-row load serves two b-rows
+            while j + 3 < stop:  # 4 x 4 tiles: each row load serves four products
+                for h in range(0, GROUP, 4):
+                    t16 = _dot4x4(da, g0 + h, db, j)
+                    for u in range(4):
+                        for t in range(4):
+                            buf[h + t, j + u] = t16[4 * u + t]
+                j += 4
+            while j + 1 < stop:
                 t16 = _dot8x2(da, g0, db, j)
                 for t in range(GROUP):
                     buf[t, j] = t16[t]
