@@ -46,9 +46,11 @@ def test_bench_sift_times_a_small_grid_per_variant(capsys):
     argv = ["--method", "sift", "--json", "--images", "4", "--sift-size", "281", "41", "--threads", "2"]
     assert main(argv) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert [r["variant"] for r in rows] == ["plain", "histeq"]
+    assert [(r["variant"], r["threads"]) for r in rows] == [("plain", 1), ("plain", 2), ("histeq", 1), ("histeq", 2)]
+    rows = rows[1::2]  # --threads 2 (each variant also timed with 1 worker, alternately)
     for r in rows:
         assert r["method"] == "sift" and r["threads"] == 2 and r["image"] == "281x41" and r["db"] == "sim_original"
+        assert r["workers_speedup"] > 0
         assert r["n_images"] == 4 and r["n_pairs"] == 12 and r["rounds"] == 1
         assert 0 < r["keypoints_per_image"]["min"] <= r["keypoints_per_image"]["mean"] <= r["keypoints_per_image"]["max"]
         assert r["pairs_cpu_s"] > 0 and r["grid_wall_s"] >= r["pairs_wall_s"] > 0
