@@ -18,6 +18,15 @@ the rounds, and the 1-minute load average of the machine.
 ``--background-load N`` starts ``N`` busy processes for the duration of the
 run (to check that parallel work is not slower than serial on a loaded
 machine); they are stopped at the end.
+
+``--method sift`` times SIFT homing over a whole grid instead (thesis 5.1,
+table 5.3: the stand-in ``--db`` rendered at ``--sift-size``, 1122 x 162 by
+default, all pairs, the average-vector combiner): per variant (``plain``,
+``histeq`` = histogram equalisation before SIFT) the per-image work (SIFT
+features, no cache) and the all-pairs home vectors (the grid runner's batch
+path on ``--threads`` worker threads) are timed in CPU and wall time; the
+rendering or loading of the database is reported separately (cached on disk
+after the first run). It is not part of ``--method all``.
 """
 
 from __future__ import annotations
@@ -34,6 +43,9 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 METHODS = ("minwarping", "warping2d", "warping1d", "hiss")
+#: timed over a whole grid (``--method sift``), not per pair of the pillar room; not part of ``all``
+GRID_METHODS = ("sift",)
+SIFT_VARIANTS = ("plain", "histeq")
 
 #: min-warping variants: (name, plugin options)
 MINWARPING_VARIANTS = (
@@ -107,8 +119,8 @@ def main(argv=None) -> int:
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + ("all",), default="minwarping",
-                        help="method to time (default: minwarping)")
+    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all",), default="minwarping",
+                        help="method to time (default: minwarping; all = the pair methods, not sift)")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -119,17 +131,28 @@ def main(argv=None) -> int:
                         help="alpha and psi steps of min-warping and 2D-warping (default: 96)")
     parser.add_argument("--compass-fraction", type=float, default=0.3,
                         help="fraction of psi searched with compass acceleration (default: 0.3)")
-    parser.add_argument("--repeat", type=int, default=15,
-                        help="interleaved rounds (default: 15)")
+    parser.add_argument("--repeat", type=int, default=None,
+                        help="interleaved rounds (default: 15; 1 whole grid for --method sift)")
     parser.add_argument("--batch", type=int, default=None,
                         help="home vectors per round and variant (default: 6 per thread)")
     parser.add_argument("--background-load", type=int, default=0, metavar="N",
                         help="start N busy processes while measuring (default: 0)")
     parser.add_argument("--render-size", type=int, nargs=2, default=[576, 100], metavar=("W", "H"),
                         help="size of the rendered input panoramas (default: 576 100)")
+    sift = parser.add_argument_group("--method sift (whole grid)")
+    sift.add_argument("--db", default="sim_original",
+                      help="stand-in database for --method sift (default: sim_original)")
+    sift.add_argument("--sift-size", type=int, nargs=2, default=[1122, 162], metavar=("W", "H"),
+                      help="image size the database is rendered at (default: 1122 162, the thesis')")
+    sift.add_argument("--variants", default="plain,histeq",
+                      help="comma-separated SIFT variants: plain, histeq (default: both)")
+    sift.add_argument("--images", type=int, default=None, metavar="N",
+                      help="use the first N images of the grid (default: all)")
     args = parser.parse_args(argv)
     if args.threads < 1 or args.threads > 64:
         parser.error("--threads must lie in 1..64")
+    if args.repeat is None:
+        args.repeat = 1 if args.method in GRID_METHODS else 15
     if args.repeat < 1:
         parser.error("--repeat must be >= 1")
     if not (0.0 < args.compass_fraction <= 1.0):
@@ -139,6 +162,17 @@ def main(argv=None) -> int:
     batch = args.batch if args.batch is not None else 6 * args.threads
     if batch < 1:
         parser.error("--batch must be >= 1")
+
+    if args.method == "sift":
+        variants = [v.strip() for v in args.variants.split(",") if v.strip()]
+        bad = [v for v in variants if v not in SIFT_VARIANTS]
+        if bad or not variants:
+            parser.error(f"--variants must be a comma-separated list of {', '.join(SIFT_VARIANTS)}, not {args.variants!r}")
+        if not (8 <= args.sift_size[0] <= 8192 and 8 <= args.sift_size[1] <= 8192):
+            parser.error("--sift-size W H must lie in 8..8192")
+        if args.images is not None and args.images < 2:
+            parser.error("--images must be >= 2")
+        return _print_sift(_sift_rows(args, variants), args)
 
     from bionav.testing.pillar_scene import render_pillar_panorama
 
@@ -211,6 +245,105 @@ def main(argv=None) -> int:
         print(line(c))
     print(f"load average (1 min) {rows[0]['loadavg_1min'][0]} -> {rows[0]['loadavg_1min'][1]}, "
           f"background load {args.background_load}, {rows[0]['machine']}")
+    return 0
+
+
+def _sift_rows(args, variants) -> list[dict]:
+    """Time SIFT homing over a grid per variant: per-image work and all pairs, CPU and wall time."""
+    from bionav.config import compose
+    from bionav.errors import UserError
+    from bionav.evaluation.pairs import home_vector_matrix, prepare_images
+    from bionav.experiments.common import load_configured_database
+    from bionav.plugins.homing.sift import SiftConfig, SiftHoming
+
+    w, h = args.sift_size
+    rows = []
+    load = _start_load(args.background_load)
+    try:
+        for variant in variants:
+            overrides = ["experiment=grid_homing", "homing=sift", f"db={args.db}", f"db.image_size=[{w},{h}]",
+                         f"preprocess={'he' if variant == 'histeq' else 'none'}"]
+            try:
+                cfg = compose(overrides)
+            except Exception as exc:  # an unknown database name
+                raise SystemExit(f"python -m bionav.bench: error: --db {args.db!r}: {exc}") from None
+            t0 = time.perf_counter()
+            try:
+                db = load_configured_database(cfg)
+            except UserError as exc:
+                raise SystemExit(f"python -m bionav.bench: error: {exc}") from None
+            load_s = time.perf_counter() - t0
+            if args.images is not None:
+                db = db.subset(range(min(args.images, len(db))))
+            method = SiftHoming(SiftConfig(), geometry=db.geometry)
+            loadavg = [os.getloadavg()[0]]
+            c0, t0 = time.process_time(), time.perf_counter()
+            prepared = prepare_images(method, list(db.images), workers=args.threads)
+            prep_cpu, prep_wall = time.process_time() - c0, time.perf_counter() - t0
+            keypoints = np.array([len(p.xy) for p in prepared])
+            home_vector_matrix(method, db, workers=args.threads, prepared=(prepared, prepared),
+                               snapshot_index=[0, 1])  # warm-up: compiled kernels
+            cpu, wall = [], []
+            for _ in range(args.repeat):
+                c0, t0 = time.process_time(), time.perf_counter()
+                hv = home_vector_matrix(method, db, workers=args.threads, prepared=(prepared, prepared))
+                cpu.append(time.process_time() - c0)
+                wall.append(time.perf_counter() - t0)
+            loadavg.append(os.getloadavg()[0])
+            n = hv.n_pairs
+            rows.append({
+                "method": "sift",
+                "variant": variant,
+                "threads": args.threads,
+                "cpu_ms_per_home_vector": round(1e3 * float(np.median(cpu)) / n, 4),
+                "wall_ms_per_home_vector": round(1e3 * float(np.median(wall)) / n, 4),
+                "cpu_ms_min": round(1e3 * float(np.min(cpu)) / n, 4),
+                "wall_ms_min": round(1e3 * float(np.min(wall)) / n, 4),
+                "pairs_cpu_s": round(float(np.median(cpu)), 3),
+                "pairs_wall_s": round(float(np.median(wall)), 3),
+                "prepare_cpu_ms_per_image": round(1e3 * prep_cpu / len(db), 3),
+                "prepare_wall_s": round(prep_wall, 3),
+                "grid_cpu_s": round(prep_cpu + float(np.median(cpu)), 3),
+                "grid_wall_s": round(prep_wall + float(np.median(wall)), 3),
+                "db_load_s": round(load_s, 3),
+                "db": args.db,
+                "image": f"{w}x{h}",
+                "n_images": len(db),
+                "n_pairs": n,
+                "keypoints_per_image": {"mean": round(float(keypoints.mean()), 1), "min": int(keypoints.min()),
+                                        "max": int(keypoints.max())},
+                "search_radius": method.config.search_radius,
+                "combine": method.config.combine,
+                "rounds": args.repeat,
+                "background_load": args.background_load,
+                "loadavg_1min": [round(v, 2) for v in loadavg],
+                "machine": f"{platform.machine()} {os.cpu_count()} cpus",
+            })
+    finally:
+        _stop_load(load)
+    return rows
+
+
+def _print_sift(rows: list[dict], args) -> int:
+    if args.json:
+        for row in rows:
+            print(json.dumps(row))
+        return 0
+    header = ("variant", "image", "images", "keypoints/image", "threads", "grid wall s", "grid CPU s",
+              "SIFT CPU ms/image", "pairs wall s", "pairs CPU s", "CPU ms/hv", "db load s")
+    cells = [(r["variant"], r["image"], str(r["n_images"]), f"{r['keypoints_per_image']['mean']:.0f}",
+              str(r["threads"]), f"{r['grid_wall_s']:.1f}", f"{r['grid_cpu_s']:.1f}",
+              f"{r['prepare_cpu_ms_per_image']:.1f}", f"{r['pairs_wall_s']:.1f}", f"{r['pairs_cpu_s']:.1f}",
+              f"{r['cpu_ms_per_home_vector']:.3f}", f"{r['db_load_s']:.1f}") for r in rows]
+    widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
+    line = lambda cs: "| " + " | ".join(c.ljust(w) for c, w in zip(cs, widths)) + " |"  # noqa: E731
+    print(line(header))
+    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+    for c in cells:
+        print(line(c))
+    print(f"sift on {rows[0]['db']}: {rows[0]['n_pairs']} home vectors per grid; load average (1 min) "
+          f"{rows[0]['loadavg_1min'][0]} -> {rows[-1]['loadavg_1min'][-1]}, background load {args.background_load}, "
+          f"{rows[0]['machine']}")
     return 0
 
 
