@@ -40,3 +40,25 @@ def test_bench_rejects_bad_arguments(capsys, argv, message):
         main(argv)
     assert exc.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_bench_grid_mode_times_the_grid_runner_with_1_and_2_workers(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("BIONAV_CACHE", str(tmp_path))
+    argv = ["--json", "--grid", "sim_original", "--grid-snapshots", "2", "--grid-rounds", "1", "--threads", "2",
+            "--steps", "12", "--size", "36", "8"]
+    assert main(argv) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(r["variant"], r["threads"]) for r in rows] == [
+        (v, w) for v in ("single", "double_fine", "compass", "compass_double_fine") for w in (1, 2)]
+    for r in rows:
+        assert r["experiment"] == "grid_homing" and r["db"] == "sim_original" and r["snapshots"] == 2
+        assert r["home_vectors_per_round"] == 2 * (170 - 1)  # every cell but the snapshot's own
+        assert r["cpu_ms_per_home_vector"] > 0 and r["wall_ms_per_home_vector"] > 0
+        assert r["workers_speedup"] > 0 and (r["threads"] == 2 or r["workers_speedup"] == 1.0)
+
+
+def test_bench_grid_mode_names_an_unknown_database(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--grid", "no_such_db"])
+    assert exc.value.code == 2
+    assert "--grid no_such_db" in capsys.readouterr().err

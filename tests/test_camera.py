@@ -169,7 +169,7 @@ def test_camera_images_are_rendered_at_the_perturbed_poses():
     positions = np.argwhere(world.cells)[:2]
     geometry = spec.geometry(96, 14)
     cam = CameraConfig(**CLEAN)
-    pe = pose_error_config_for("odometry", position_sigma_m=0.0, heading_sigma_deg=0.0)
+    pe = pose_error_config_for("odometry", position_sigma_m=0.0, heading_sigma_deg=0.0, tilt_sigma_deg=0.0)
     exact, _, poses = camera_images(world, positions, geometry, camera=cam, pose_error=pe, seed=0)
     assert np.all(poses["offsets_m"] == 0) and np.all(poses["heading_errors"] == 0)
     # with errors, image k equals the error-free render at the perturbed pose (re-rendered by hand)

@@ -77,3 +77,64 @@ def test_agent_uses_nearest_existing_cell_when_cells_are_missing():
     result, paths = run_agents(np.array([np.nan, np.pi]), pos, s, pos[1:], grid_shape=(4, 1), record_paths=True)
     assert not result.success[0]
     np.testing.assert_allclose(paths[0][-1], [1.5, 0.0], atol=1e-12)
+
+
+def _grid_cells(rng, nx, ny, missing):
+    cells = np.array([(x, y) for x in range(nx) for y in range(ny)], dtype=float)
+    cells = cells[rng.random(len(cells)) >= missing]
+    return cells[rng.permutation(len(cells))]  # image order unrelated to the grid order
+
+
+def test_nearest_cell_ties_go_to_the_lower_index():
+    from bionav.evaluation.agent import nearest_cell_index
+
+    cells = np.array([[3.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 1.0]])
+    # (1.5, 0) is half-way between cells 1 and 2; (2.5, 0) between 0 and 2; (2, 0.5) between 2 and 3
+    got = nearest_cell_index(np.array([[1.5, 0.0], [2.5, 0.0], [2.0, 0.5], [2.6, 0.9], [-4.0, 0.2]]), cells)
+    assert list(got) == [1, 0, 2, 3, 1]
+
+
+@pytest.mark.parametrize("missing", [0.0, 0.2])
+def test_compiled_agent_batch_equals_plain_trials(missing):
+    """agent_success gives exactly run_agents' outcome for every trial: ideal-ish, noisy, random and
+    axis-aligned fields (ties between cells), NaN directions, missing cells, agents leaving the grid."""
+    from bionav.evaluation.agent import agent_success
+    from bionav.evaluation.measures import ideal_home_angles
+
+    rng = np.random.default_rng(3)
+    nx, ny = 7, 9
+    cells = _grid_cells(rng, nx, ny, missing)
+    n = len(cells)
+    ideal = np.nan_to_num(ideal_home_angles(cells, cells))
+    fields = np.stack([
+        ideal + rng.normal(0, 0.3, (n, n)),
+        ideal + rng.normal(0, 1.5, (n, n)),
+        rng.uniform(-np.pi, np.pi, (n, n)),
+        rng.integers(-4, 4, (n, n)) * (np.pi / 2),
+        np.where(rng.random((n, n)) < 0.2, np.nan, ideal + rng.normal(0, 0.8, (n, n))),
+    ])  # fmt: skip
+    fast = agent_success(fields, cells, cells, grid_shape=(nx, ny), step_length=0.5, success_radius=1.0)
+    assert fast.shape == fields.shape
+    for lv in range(len(fields)):
+        for s in range(n):
+            ref, _ = run_agents(fields[lv, s], cells, cells[s], cells, grid_shape=(nx, ny))
+            np.testing.assert_array_equal(fast[lv, s], ref.success, err_msg=f"field {lv} snapshot {s}")
+    assert 0.0 < fast.mean() < 1.0
+    # snapshots that are not the current views' cells, other step and radius
+    snaps = cells[:4] + 0.25
+    fast = agent_success(fields[1, :4], cells, snaps, grid_shape=(nx, ny), step_length=0.3, success_radius=0.7)
+    for s in range(4):
+        ref, _ = run_agents(fields[1, s], cells, snaps[s], cells, grid_shape=(nx, ny), step_length=0.3,
+                            success_radius=0.7)
+        np.testing.assert_array_equal(fast[s], ref.success)
+
+
+def test_agent_batch_off_the_lattice_uses_the_plain_trials():
+    from bionav.evaluation.agent import agent_success
+
+    rng = np.random.default_rng(5)
+    cells = rng.uniform(0, 5, (12, 2))
+    angles = rng.uniform(-np.pi, np.pi, (12, 12))
+    fast = agent_success(angles, cells, cells, grid_shape=(5, 5))
+    for s in range(12):
+        np.testing.assert_array_equal(fast[s], run_agents(angles[s], cells, cells[s], cells, grid_shape=(5, 5))[0].success)

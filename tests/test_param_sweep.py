@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -211,3 +212,82 @@ def test_thesis_tables_attached_to_thesis_databases():
     assert table[0]["thesis_rank"] == 10
     assert "thesis_rr" in ranking.ranking_markdown(table, db="sim_original")
     assert "thesis_rank" not in ranking.ranking_table([_row("scene", "fc", 0.5, 0.9, k=4)])[0]
+
+
+@pytest.fixture(scope="module")
+def rotated_db(small_db):
+    """``small_db`` with every current view rolled by a random number of columns (headings set)."""
+    rolls = np.random.default_rng(11).integers(0, GEOM.width, len(small_db))
+    return ImageDatabase(
+        name="rotated", images=np.stack([np.roll(im, m, axis=1) for im, m in zip(small_db.images, rolls)]),
+        positions=small_db.positions, grid_shape=small_db.grid_shape, geometry=GEOM,
+        headings=-2 * np.pi * rolls / GEOM.width,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("name", SIGNATURE_NAMES)
+def test_shared_batch_path_equals_per_configuration_path(small_db, rotated_db, name):
+    """evaluate_levels (per-image work shared across R / K, partial sums over the coefficients, one
+    compiled agent batch) gives the RR*, AAE*, MAE* and per-snapshot values of evaluate_configuration
+    (one configuration at a time, agents trial by trial) for every signature."""
+    cls = builtin_signature_class(name)
+    levels = param_sweep.sweep_levels(cls, rings=[1, 3, 6], n_coeffs=[1, 2, 5, 11])
+    cfg = cls.Config(bins=8) if "bins" in {f.name for f in dataclasses.fields(cls.Config)} else cls.Config()
+    for db in (small_db, rotated_db):
+        homings, fast, _ = param_sweep.evaluate_levels(ParameterHoming, Config(signature=name), cls, cfg, levels, db)
+        assert len(fast) == len(levels)
+        for level, homing, q in zip(levels, homings, fast):
+            assert all(getattr(homing.signature.config, k) == v for k, v in level.items())
+            ref, _ = param_sweep.evaluate_configuration(homing, db)
+            assert q.rr == ref.rr, (name, level)
+            np.testing.assert_allclose([q.aae, q.mae], [ref.aae, ref.mae], rtol=0, atol=1e-12)
+            np.testing.assert_array_equal(q.rr_s, ref.rr_s)
+            np.testing.assert_allclose(q.aae_s, ref.aae_s, rtol=0, atol=1e-12)
+
+
+def test_dft_signatures_nest_over_the_number_of_coefficients():
+    """The signature with K coefficients is the one with more coefficients restricted to k < K (same
+    order), and the partial-sum potentials equal the potentials of the restricted signatures."""
+    from bionav.homing.parameter import potential_matrices_by_coefficients, potential_matrix
+
+    images = np.random.default_rng(2).random((6, 10, 32))
+    for name in SIGNATURE_NAMES:
+        cls = builtin_signature_class(name)
+        if not hasattr(cls, "coefficient_index"):
+            continue
+        big = cls(cls.Config(n_coeffs=12))
+        kidx = big.coefficient_index(images[0].shape)
+        f = np.stack([big.compute(im) for im in images])
+        assert kidx.shape == (f.shape[1],)
+        pots = potential_matrices_by_coefficients(f, f, kidx, [1, 4, 12])
+        for k, pot in zip((1, 4, 12), pots):
+            fk = np.stack([cls(cls.Config(n_coeffs=k)).compute(im) for im in images])
+            np.testing.assert_array_equal(fk, f[:, kidx < k])
+            np.testing.assert_allclose(pot, potential_matrix(fk, fk), rtol=1e-12, atol=1e-12)
+
+
+def test_grid_run_equals_the_multirun_jobs(tmp_path):
+    """``experiment=param_sweep_grid`` (the whole grid in one run on 2 worker processes) writes the
+    same configuration records as the multirun of ``experiment=param_sweep`` (one job per
+    signature x image size x preprocessing), and the ranking tables."""
+    from helpers import run_bionav, write_tiny_folder
+
+    folder = write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
+    grid = ["experiment.grid=ci", "experiment.grids.ci.signature='mean,fc,mffc_abs'",
+            "experiment.grids.ci.image_size='[32,8],[64,16]'", "experiment.grids.ci.preprocess='none,bw1'",
+            "experiment.rings=[1,2]", "experiment.n_coeffs=[1,3,6]", "db=folder", f"db.path={folder}"]
+    one = run_bionav("experiment=param_sweep_grid", *grid, "workers=2", f"hydra.run.dir={tmp_path / 'grid'}",
+                     cwd=tmp_path)
+    assert one.returncode == 0, one.stderr[-2000:]
+    jobs = run_bionav("-m", "experiment=param_sweep", *grid, f"hydra.sweep.dir={tmp_path / 'jobs'}", cwd=tmp_path)
+    assert jobs.returncode == 0, jobs.stderr[-2000:]
+    key = ("signature", "image_size", "preprocess", "rings", "n_coeffs")
+    grid_rows = {tuple(r[k] for k in key): r for r in ranking.load_sweep_rows(tmp_path / "grid")}
+    job_rows = {tuple(r[k] for k in key): r for r in ranking.load_sweep_rows(tmp_path / "jobs")}
+    assert len(job_rows) == 2 * 2 * (2 + 3 + 3) and set(grid_rows) == set(job_rows)
+    for k, row in job_rows.items():
+        assert grid_rows[k]["rr"] == row["rr"] and grid_rows[k]["rr_s"] == row["rr_s"], k
+        np.testing.assert_allclose([grid_rows[k]["aae"], grid_rows[k]["mae"]], [row["aae"], row["mae"]], atol=1e-12)
+    metrics = json.loads((tmp_path / "grid" / "metrics.json").read_text())
+    assert metrics["n_configs"] == len(job_rows) and metrics["workers"] == 2
+    assert list((tmp_path / "grid").glob("ranking_*.md"))

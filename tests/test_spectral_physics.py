@@ -1,5 +1,7 @@
 """Physics of the five-channel sensor model against closed forms and known facts."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -7,9 +9,13 @@ from bionav.geometry import direction_from_angles
 from bionav.light.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import (
+    GROUND_ALBEDO,
     SkyState,
     clear_sky_radiance,
+    diffuse_irradiance_bird,
+    gas_transmittance,
     illumination,
+    ozone_air_mass,
     rayleigh_optical_depth,
     relative_air_mass,
     sky_radiance,
@@ -73,13 +79,62 @@ def test_clear_sky_is_blue_and_clouds_flatten_it():
 
 
 def test_single_scattering_thin_limit():
-    """Optically thin limit: L = E0 tau P(gamma) / (4 pi) m_v exp(-tau m_s) (m_v ~ m_s)."""
+    """Optically thin limit, sun and view at the zenith, no aerosol, no gas absorption at 800 nm.
+
+    Single scattering (both layers together): ``E0 tau P(0) / (4 pi) exp(-tau)`` with ``P(0) = 1.5``.
+    """
     wl = np.array([800.0])
-    state = SkyState(np.deg2rad(90.0), turbidity=1e-9)
+    state = SkyState(np.deg2rad(90.0), turbidity=1e-9, precipitable_water_cm=0.0)
     tau = rayleigh_optical_depth(wl)
     d = direction_from_angles(0.0, np.deg2rad(89.999))
-    expected = solar_spectrum(wl) * tau * 0.75 * 2 / (4 * np.pi) * np.exp(-tau)
-    assert clear_sky_radiance(state, d, wl)[0] == pytest.approx(expected[0], rel=0.01)
+    expected = solar_spectrum(wl) * tau * np.exp(-tau) * 1.5 / (4 * np.pi)
+    assert clear_sky_radiance(state, d, wl, multiple_scattering=False)[0] == pytest.approx(expected[0], rel=0.01)
+
+
+def test_sky_integrates_to_the_bird_riordan_diffuse_budget():
+    """Where single scattering falls short (UV/blue, low sun) the sky's hemispheric integral is Bird & Riordan's."""
+    wl = np.array([350.0, 440.0, 500.0])
+    for el in (50.0, 12.0, 6.0):
+        state = SkyState(np.deg2rad(el), np.deg2rad(37.0), turbidity=0.1)
+        budget = diffuse_irradiance_bird(state, wl)
+        got = illumination(state, wl).diffuse_horizontal
+        single = illumination(replace(state), wl, n_elevation=8)  # same state: consistency of the cache
+        np.testing.assert_allclose(got, single.diffuse_horizontal)
+        np.testing.assert_allclose(got, budget, rtol=0.03)
+    # Bird & Riordan without aerosol and gases, sun at the zenith: I_r = 0.5 E0 (1 - T_r^0.95) (half of the
+    # scattered light) plus the ground-sky reflections (E0 T_r + I_r) r_s a_g / (1 - r_s a_g), r_s = 0.5 (1 - T_r(1.8))
+    thin = SkyState(np.deg2rad(90.0), turbidity=1e-9, ozone_atm_cm=0.0, precipitable_water_cm=0.0)
+    e = diffuse_irradiance_bird(thin, np.array([800.0]))[0]
+    tau = rayleigh_optical_depth([800.0])[0]
+    e0 = solar_spectrum([800.0])[0]
+    i_r = 0.5 * e0 * (1 - np.exp(-0.95 * tau))
+    r_s = 0.5 * (1 - np.exp(-1.8 * tau))
+    i_g = (e0 * np.exp(-tau) + i_r) * r_s * GROUND_ALBEDO / (1 - r_s * GROUND_ALBEDO)
+    assert e == pytest.approx(i_r + i_g, rel=1e-3)
+
+
+def test_ozone_filters_the_low_sun_in_the_chappuis_band():
+    """Direct beam ratio with/without ozone = exp(-a_o(600) * column * m_oz), a_o(600 nm) ~ 0.12 /cm."""
+    wl = np.array([440.0, 600.0])
+    low = SkyState(np.deg2rad(5.0), turbidity=0.05)
+    none = SkyState(np.deg2rad(5.0), turbidity=0.05, ozone_atm_cm=0.0)
+    ratio = illumination(low, wl).direct_normal / illumination(none, wl).direct_normal
+    m_oz = ozone_air_mass(np.deg2rad(5.0))
+    assert ratio[1] == pytest.approx(np.exp(-0.3 * np.interp(600.0, [593.0, 610.0], [0.119, 0.12]) * m_oz), rel=1e-3)
+    assert ratio[0] == pytest.approx(1.0)  # no ozone absorption at 440 nm
+    # the ozone-layer air mass at the horizon is finite (spherical shell), at the zenith 1
+    assert ozone_air_mass(np.pi / 2) == pytest.approx(1.0, abs=1e-3)
+    assert 10 < ozone_air_mass(0.0) < 20
+
+
+def test_water_vapour_and_oxygen_bands_in_the_ir():
+    """Bird & Riordan's transmittance laws at the zenith: 940 nm water band, 760 nm oxygen A band."""
+    state = SkyState(np.deg2rad(90.0), precipitable_water_cm=2.0, ozone_atm_cm=0.0)
+    t = gas_transmittance(state, np.array([660.0, 762.5, 937.0]), np.pi / 2)
+    aw = 55.0 * 2.0  # a_w(937 nm) = 55 /cm
+    assert t[2] == pytest.approx(np.exp(-0.2385 * aw / (1 + 20.07 * aw) ** 0.45), rel=1e-3)
+    assert t[1] == pytest.approx(np.exp(-1.41 * 4.0 / (1 + 118.93 * 4.0) ** 0.45), rel=1e-3)
+    assert t[0] > 0.99
 
 
 def test_cloud_field_cover_fraction_and_motion():
@@ -119,9 +174,15 @@ def test_sensor_chain():
 
 
 def test_vegetation_red_edge_and_low_uv():
+    """Vegetation uses the measured green leaf: chlorophyll trough at 680 nm, red edge, UV a few per cent."""
+    from bionav.light.bands import WAVELENGTHS_NM
+
+    at = {w: int(np.argmin(np.abs(WAVELENGTHS_NM - w))) for w in (350, 550, 680, 800)}
     for name in ("grass", "shrub", "tree"):
+        spec = MATERIALS[name].mean_spectrum()
+        assert spec[at[800]] > 3 * spec[at[680]] and spec[at[680]] < spec[at[550]] and spec[at[350]] < 0.06
         uv, b, g, r, ir = MATERIALS[name].reflectance
-        assert ir > 5 * r and r < g and uv < 0.05
+        assert ir > 2 * r and uv < b < g  # band means (the R band's Gaussian reaches into the red edge)
     for name in ("paint_white", "plastic_white"):
         assert MATERIALS[name].reflectance[0] < 0.1 < MATERIALS[name].reflectance[1]
     assert len(CHANNELS) == 5

@@ -21,8 +21,8 @@ def test_sim_sizes_kinds_and_shared_sky(natural):
     art = sim_artificial(seed=1, n_objects=20, n_sky=50)
     # the thesis reuses its sky readings: same seed -> same sky samples
     np.testing.assert_array_equal(art.counts[art.is_sky], natural.counts[natural.is_sky])
-    assert set(natural.kind[~natural.is_sky]) <= {"grass", "shrub", "tree", "conifer", "dead_leaves", "dead_wood",
-                                                  "tar", "rock", "gravel", "sand", "soil"}
+    assert set(natural.kind[~natural.is_sky]) <= {"grass", "shrub", "flowers", "tree", "conifer", "dead_leaves",
+                                                  "dead_wood", "tar", "rock", "gravel", "sand", "soil"}
     assert all(k.startswith(("paint", "plastic", "lacquered", "metal")) for k in art.kind[~art.is_sky])
     assert all(t.startswith("2006-0") for t in natural.time)
     # deterministic in the seed

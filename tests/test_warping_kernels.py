@@ -42,12 +42,11 @@ def test_diagonal_distances_match_reference_matrix():
     ref = column_distance_matrix(snap, cur)
     for step in (1, 2, 3):
         fast = diagonal_distances(snap, cur, step=step)
-        n = W // step
+        assert fast.shape == (len(SCALES), W, step, W // step)  # every distance once
         for i in range(W):
             for d in range(W):
                 want = ref[:, i, (i + d) % W]
                 np.testing.assert_allclose(fast[:, d, i % step, i // step], want, rtol=1e-5, atol=1e-6)
-                np.testing.assert_allclose(fast[:, d, i % step, i // step + n], want, rtol=1e-5, atol=1e-6)
 
 
 def test_nsad_of_identical_and_zero_columns():
@@ -189,15 +188,13 @@ def test_quantised_distances_are_rounded_nsad(step):
     ref = column_distance_matrix(snap, cur)
     q, _ = distance_quantum(W)
     fast = diagonal_distances(snap, cur, step=step, quantised=True)
-    assert fast.dtype == np.uint8
-    n = W // step
+    assert fast.dtype == np.uint8 and fast.shape == (len(SCALES), W, step, W // step)
     for i in range(W):
         for d in range(W):
             want = ref[:, i, (i + d) % W] * q
             got = fast[:, d, i % step, i // step].astype(np.float64)
             # rounding (0.5) plus the 16-bit quantisation of the edge images
             assert np.abs(got - want).max() <= 0.5 + 0.02 * q, (i, d)
-            np.testing.assert_array_equal(fast[:, d, i % step, i // step + n], fast[:, d, i % step, i // step])
 
 
 def test_distance_quantum_keeps_sums_in_16_bits():
@@ -287,7 +284,7 @@ def test_quantised_kernels_compile_to_packed_byte_and_word_instructions():
 
     w, step = 48, 3
     n = w // step
-    levels = np.zeros((2, 3, w, step, 2 * n), np.uint8)
+    levels = np.zeros((2, 3, w, step, n), np.uint8)
     windows = minwarp_windows(minwarp_template(w, default_scales(3), default_thresholds(default_scales(3))), max_level=1)
     asm = _asm(minwarp_scores, levels, n, np.arange(4, dtype=np.int64), *windows, np.uint8(255),
                np.zeros((4, n), np.uint16))
@@ -295,8 +292,67 @@ def test_quantised_kernels_compile_to_packed_byte_and_word_instructions():
     assert re.search(r"\b(v?pminub|vpcmp\w*ub)\b", asm)
     assert re.search(r"\bv?paddw\b", asm)
     sq = np.zeros((3, 9, w), np.int16)
-    asm = _asm(_diagonal_distances_q, sq, np.zeros((3, 9, 2 * w), np.int16), np.zeros((3, w), np.int32),
-               np.zeros((3, 2 * w), np.int32), step, 227, np.zeros((3, w, step, 2 * n), np.uint8))
-    # |a - b| of 16-bit values as packed max - min, summed in packed 16-bit adds
-    assert re.search(r"\bv?pmaxsw\b", asm) and re.search(r"\bv?pminsw\b", asm)
+    asm = _asm(_diagonal_distances_q, sq, np.zeros((3, 9, 2 * w + 1), np.int16), np.zeros((3, w), np.int32),
+               np.zeros((3, 2 * w + 1), np.int32), step, 227, np.zeros((3, w, step, n), np.uint8))
+    # |a - b| of 16-bit values as packed subtract and absolute value, summed in packed 16-bit adds
+    assert re.search(r"\bv?psubw\b", asm) and re.search(r"\bv?pabsw\b", asm)
     assert re.search(r"\bv?paddw\b", asm)
+
+
+@pytest.mark.parametrize("step", [1, 3])
+@pytest.mark.parametrize("quantised", [False, True])
+def test_runs_of_directions_equal_single_hypotheses(step, quantised):
+    # the fine search's block kernel: runs of consecutive directions (any start,
+    # wrapping past column W - 1) per rotation, against the reference loops
+    from bionav.homing.warping.kernels import minwarp_scores_at, minwarp_scores_runs
+    from bionav.homing.warping.search import _window_minima
+
+    snap, cur = _pair(43)
+    tau = default_thresholds(SCALES)
+    windows = minwarp_windows(minwarp_template(W, SCALES, tau), max_level=2)
+    levels = _window_minima(snap, cur, step, windows, quantised).copy()
+    a_first = np.array([0, W - 2, 5, 17], np.int64)
+    p_cols = np.array([3, 0, W - 1, 40], np.int64)  # 40: taken modulo W
+    runs = minwarp_scores_runs(levels, a_first, 5, p_cols, *windows)
+    assert runs.shape == (4, 5)
+    a_all = ((a_first[:, None] + np.arange(5)) % W).ravel()
+    p_all = np.repeat(p_cols, 5)
+    np.testing.assert_array_equal(runs.ravel(), minwarp_scores_at(levels, a_all, p_all, *windows))
+    if not quantised:
+        for t in (0, 7, 19):
+            ref = minwarping_scores_reference(snap, cur, a_cols=[a_all[t]], p_cols=[p_all[t] % W], thresholds=tau)
+            assert runs.ravel()[t] == pytest.approx(ref[0, 0], rel=1e-5)
+
+
+@pytest.mark.parametrize("step", [1, 2, 3])
+def test_compass_measure_is_the_best_plane_distance_along_each_rotation(step):
+    from bionav.homing.warping.kernels import compass_measure
+
+    snap, cur = _pair(44)
+    p_cols = np.array([0, 1, 5, W - 1], np.int64)
+    ref_d = column_distance_matrix(snap, cur)  # (K, i, j)
+    want = [sum(ref_d[:, i, (i - p) % W].min() for i in range(W)) for p in p_cols]
+    got = compass_measure(diagonal_distances(snap, cur, step=step), p_cols)
+    np.testing.assert_allclose(got, want, rtol=1e-5)
+    q, _ = distance_quantum(W)
+    dq = diagonal_distances(snap, cur, step=step, quantised=True)
+    want_q = [sum(int(min(dq[k, (-p) % W, i % step, i // step] for k in range(len(SCALES)))) for i in range(W))
+              for p in p_cols]
+    np.testing.assert_array_equal(compass_measure(dq, p_cols), want_q)
+    assert np.abs(compass_measure(dq, p_cols) / q - want).max() <= W * (0.5 + 0.02 * q) / q
+
+
+@pytest.mark.parametrize("width, step", [(25, 1), (25, 5), (21, 3)])
+def test_quantised_distances_of_odd_widths(width, step):
+    # two diagonals per pass: an odd width ends with a half pair
+    rng = np.random.default_rng(width)
+    geometry = PanoramaGeometry.square_pixels(width, H)
+    snap, cur = (scale_plane_stack(rng.random((H, width)).astype(np.float32), geometry=geometry, scales=SCALES)
+                 for _ in range(2))
+    ref = column_distance_matrix(snap, cur)
+    q, _ = distance_quantum(width)
+    fast = diagonal_distances(snap, cur, step=step, quantised=True)
+    for i in range(width):
+        for d in range(width):
+            got = fast[:, d, i % step, i // step].astype(np.float64)
+            assert np.abs(got - ref[:, i, (i + d) % width] * q).max() <= 0.5 + 0.02 * q, (i, d)

@@ -32,6 +32,7 @@ size: a larger ``db.image_size`` unfolds the same raw pixels, as in the thesis.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Callable, Iterable
@@ -132,6 +133,53 @@ def noise_rng(seed: int, cell) -> np.random.Generator:
                                                          int(cell[1])]))
 
 
+def tilt_offsets(cells, *, tilt_sigma_deg: float, seed: int, db_seed: int = 0) -> np.ndarray:
+    """Gaussian camera tilts of the captures at grid ``cells`` (N, 2) (uneven floor, mast sway;
+    :attr:`World.floor_tilt_deg`).
+
+    Drawn per cell from their own random stream, so the position and heading
+    errors of :func:`pose_offsets` do not depend on them, nor a cell's tilt on
+    the other cells rendered.
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+        ``(t_a, t_b)`` in radians: a view at panorama azimuth ``phi`` (column
+        angle) is raised by ``t_a cos(phi) + t_b sin(phi)`` (small-angle tilt).
+    """
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    draw = np.empty((len(cells), 2))
+    for k, (i, j) in enumerate(cells):
+        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF,
+                                                            0x74696C74, int(i), int(j)]))
+        draw[k] = rng.standard_normal(2)
+    return draw * math.radians(float(tilt_sigma_deg))
+
+
+def resolve_pose_error(pose_error: PoseErrorConfig, world) -> PoseErrorConfig:
+    """``pose_error`` with ``tilt_sigma_deg=None`` replaced by the world's floor (``World.floor_tilt_deg``)."""
+    if pose_error.tilt_sigma_deg is not None:
+        return pose_error
+    return dataclasses.replace(pose_error, tilt_sigma_deg=float(getattr(world, "floor_tilt_deg", 0.0)))
+
+
+def tilted_row_radii(setup: "CameraSetup", geometry: PanoramaGeometry, tilt) -> np.ndarray:
+    """Raw radius of every panorama pixel ``(H, W)`` for a camera tilted by ``tilt = (t_a, t_b)`` radians.
+
+    A tilted camera, unfolded as if upright, shows at row ``r`` and column
+    ``j`` the world direction at elevation ``e_r + t_a cos(phi_j) + t_b
+    sin(phi_j)`` (first order in the tilt; the azimuth change is of second
+    order near the horizon), which the upright raw frame holds at
+    ``radius_from_elevation`` of that elevation. Elevations beyond the mirror
+    rim fall outside the frame (read 0).
+    """
+    phi = 2.0 * np.pi * np.arange(geometry.width) / geometry.width
+    el = geometry.row_elevations()[:, None] + float(tilt[0]) * np.cos(phi)[None, :] + float(tilt[1]) * np.sin(phi)[None, :]
+    proj = setup.projection
+    inside = el < proj.rim_elevation
+    return np.where(inside, proj.radius_from_elevation(np.where(inside, el, 0.0)), 1e6)
+
+
 @dataclass(frozen=True)
 class CameraSetup:
     """A camera prepared for one output geometry (see :func:`camera_setup`)."""
@@ -147,7 +195,8 @@ class CameraSetup:
     read_noise: float
 
 
-def camera_setup(camera: CameraConfig, geometry: PanoramaGeometry, *, native_size=(561, 81)) -> CameraSetup:
+def camera_setup(camera: CameraConfig, geometry: PanoramaGeometry, *, native_size=(561, 81),
+                 tilt_margin: float = 0.0) -> CameraSetup:
     """Mirror projection, ray layout and sensor constants for unfolding to ``geometry``.
 
     Parameters
@@ -158,6 +207,9 @@ def camera_setup(camera: CameraConfig, geometry: PanoramaGeometry, *, native_siz
     native_size : (int, int)
         The stand-in's native panorama size; smaller outputs bin the raw frame by
         ``scale = max(W / W_native, H / H_native)`` (at most 1).
+    tilt_margin : float
+        Largest camera tilt in radians the rendered annulus must allow for
+        (:func:`tilted_row_radii`); widens the annulus accordingly.
 
     Returns
     -------
@@ -179,6 +231,11 @@ def camera_setup(camera: CameraConfig, geometry: PanoramaGeometry, *, native_siz
     band = (float(proj.radius_from_elevation(bottom)), float(proj.radius_from_elevation(top)))
     psf = float(camera.psf_sigma_px) * scale
     margin = 3.0 * psf + 2.0
+    if tilt_margin > 0:  # a tilted camera shows elevations up to tilt_margin beyond the panorama's rows
+        low = max(bottom - float(tilt_margin), -0.5 * math.pi + 1e-3)
+        high = min(top + float(tilt_margin), proj.rim_elevation)
+        margin += max(abs(band[0] - float(proj.radius_from_elevation(low))),
+                      abs(float(proj.radius_from_elevation(high)) - band[1]))
     layout = raw_frame_layout(proj, raw_size=(w_eff, h_eff),
                               radius_range=(band[0] - margin, min(band[1] + margin, proj.rim_radius)))
     return CameraSetup(camera, layout, proj, scale, band, proj.radius_from_elevation(geometry.row_elevations()),
@@ -234,10 +291,15 @@ def sensor_frame(radiance: np.ndarray, setup: CameraSetup, *, rng: np.random.Gen
     return out
 
 
-def unfold_frame(raw_u8: np.ndarray, setup: CameraSetup, geometry: PanoramaGeometry) -> np.ndarray:
-    """Unfold an 8-bit raw frame ``(h, w, C)`` into the 8-bit canonical panorama ``(H, W, C)``."""
+def unfold_frame(raw_u8: np.ndarray, setup: CameraSetup, geometry: PanoramaGeometry, *, tilt=None) -> np.ndarray:
+    """Unfold an 8-bit raw frame ``(h, w, C)`` into the 8-bit canonical panorama ``(H, W, C)``.
+
+    ``tilt = (t_a, t_b)`` radians: the frame of an upright camera unfolded as the
+    frame of a camera tilted by that much would be (:func:`tilted_row_radii`).
+    """
     raw = np.asarray(raw_u8, dtype=np.float64) / 255.0
-    chans = [unfold_panorama(raw[:, :, c], center=setup.projection.center, radii=setup.row_radii,
+    radii = setup.row_radii if tilt is None or not np.any(tilt) else tilted_row_radii(setup, geometry, tilt)
+    chans = [unfold_panorama(raw[:, :, c], center=setup.projection.center, radii=radii,
                              size=(geometry.width, geometry.height)) for c in range(raw.shape[2])]
     return np.clip(np.rint(np.stack(chans, axis=-1).astype(np.float64) * 255.0), 0, 255).astype(np.uint8)
 
@@ -275,13 +337,18 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     images : ndarray, shape (N, H, W, C), uint8
     raw : ndarray, shape (N, h, w, C), uint8, or None
     poses : dict
-        ``offsets_m`` (N, 2) and ``heading_errors`` (N,) radians actually used.
+        ``offsets_m`` (N, 2), ``heading_errors`` (N,) and ``tilts`` (N, 2)
+        radians actually used (:func:`tilt_offsets`).
     """
-    setup = camera_setup(camera, geometry, native_size=native_size)
+    pose_error = resolve_pose_error(pose_error, world)
     n = len(positions)
     offsets, dheads = pose_offsets(positions, position_sigma_m=float(pose_error.position_sigma_m),
                                    heading_sigma_deg=float(pose_error.heading_sigma_deg),
                                    seed=int(pose_error.seed), db_seed=int(seed))
+    tilts = tilt_offsets(positions, tilt_sigma_deg=float(pose_error.tilt_sigma_deg), seed=int(pose_error.seed),
+                         db_seed=int(seed))
+    setup = camera_setup(camera, geometry, native_size=native_size,
+                         tilt_margin=float(np.abs(tilts).sum(axis=1).max(initial=0.0)))
     out = np.empty((n, geometry.height, geometry.width, world.scene.n_channels), np.uint8)
     w, h = setup.layout.raw_size
     raws = np.empty((n, h, w, world.scene.n_channels), np.uint8) if keep_raw else None
@@ -294,7 +361,7 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
         radiance = render_raw_frame(world.scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
                                     heading=float(dheads[k]), layout=setup.layout, threads=threads)
         raw = sensor_frame(radiance, setup, rng=noise_rng(seed, (i, j)))
-        out[k] = unfold_frame(raw, setup, geometry)
+        out[k] = unfold_frame(raw, setup, geometry, tilt=tilts[k])
         if raws is not None:
             raws[k] = raw
-    return out, raws, {"offsets_m": offsets, "heading_errors": dheads}
+    return out, raws, {"offsets_m": offsets, "heading_errors": dheads, "tilts": tilts}

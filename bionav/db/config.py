@@ -64,13 +64,16 @@ class PoseErrorConfig:
 
     Each image is rendered at its grid position plus a Gaussian offset (std
     ``position_sigma_m`` per axis, metres) and with a Gaussian heading error
-    (std ``heading_sigma_deg``); the database still reports the nominal grid
-    (the ground truth of the real databases is the nominal grid too). Drawn from
-    ``seed`` (together with ``db.seed``).
+    (std ``heading_sigma_deg``) and tilt (std ``tilt_sigma_deg`` about each
+    horizontal axis; ``null``: the world's floor, ``World.floor_tilt_deg``); the
+    database still reports the nominal grid (the ground truth of the real
+    databases is the nominal grid too). Drawn from ``seed`` (together with
+    ``db.seed``).
     """
 
     position_sigma_m: float = bounded(0.02, ge=0.0, le=10.0)
     heading_sigma_deg: float = bounded(1.5, ge=0.0, le=180.0)
+    tilt_sigma_deg: Optional[float] = bounded(None, ge=0.0, le=20.0)
     seed: int = bounded(0, ge=0, le=2**32 - 1)
 
 

@@ -322,7 +322,10 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "scene": compiled_digest,
     }
     if realism == "camera":
+        from bionav.db.camera import resolve_pose_error
+
         camera, pose_error = _camera_configs(spec, camera, pose_error, geometry)
+        pose_error = resolve_pose_error(pose_error, world)  # tilt_sigma_deg=None: the world's floor
         del params["noise"]
         params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
                       pose_error=dataclasses.asdict(pose_error), native_size=list(spec.native_size))

@@ -68,9 +68,10 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = Non
         Radii in pixels of the bottom and top rows of the panorama (linear in between).
     size : sequence of 2 int
         Output ``(W, H)``.
-    radii : array_like, shape (H,), optional
-        Radius in pixels of every row (row 0 on top); replaces ``inner_radius``
-        and ``outer_radius``.
+    radii : array_like, shape (H,) or (H, W), optional
+        Radius in pixels of every row (row 0 on top), or of every pixel (a
+        tilted camera unfolded as if upright: :func:`bionav.db.camera.unfold_frame`);
+        replaces ``inner_radius`` and ``outer_radius``.
 
     Returns
     -------
@@ -85,11 +86,16 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = Non
         map_x, map_y = _unfold_maps((float(center[0]), float(center[1])), float(inner_radius),
                                     float(outer_radius), (width, height))
     else:
-        radius = np.asarray(radii, dtype=np.float64).reshape(-1)
-        if radius.size != height:
-            raise ValueError(f"radii must give one radius per row ({height}), got {radius.size}")
+        radius = np.asarray(radii, dtype=np.float64)
+        if radius.shape == (height, width):
+            pass
+        elif radius.size == height:
+            radius = radius.reshape(height, 1)
+        else:
+            raise ValueError(f"radii must give one radius per row ({height}) or per pixel ({height} x {width}), "
+                             f"got shape {radius.shape}")
         phi = 2.0 * np.pi * np.arange(width) / width
-        map_x = float(center[0]) + radius[:, None] * np.cos(phi)[None, :]
-        map_y = float(center[1]) + radius[:, None] * np.sin(phi)[None, :]
+        map_x = float(center[0]) + radius * np.cos(phi)[None, :]
+        map_y = float(center[1]) + radius * np.sin(phi)[None, :]
     src = np.asarray(raw, dtype=np.float64)
     return _bilinear(src, map_x, map_y).astype(np.float32)

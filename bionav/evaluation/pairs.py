@@ -165,7 +165,10 @@ def home_vector_matrix(
     n_pairs = int(np.sum(~np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)))
     all_pairs = None
     if batch and same:
-        all_pairs = method.all_pairs_angles(cur_prep, headings=currents.headings, neighbours=neighbour_table(currents))
+        all_pairs = method.all_pairs_angles(
+            cur_prep, headings=currents.headings, neighbours=neighbour_table(currents),
+            **_batch_options(method, snapshot_index=s_idx, workers=workers, progress=progress),
+        )
     if all_pairs is not None:
         angles = np.array(all_pairs, dtype=np.float64)[s_idx]
         angles[np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)] = np.nan
@@ -225,6 +228,14 @@ def home_vector_matrix(
         n_pairs=n_pairs,
         prepared_stats=_prepared_stats(method, cur_prep),
     )
+
+
+def _batch_options(method: HomingMethod, **options: Any) -> dict[str, Any]:
+    """The ``options`` that ``method.all_pairs_angles`` accepts as keywords (``snapshot_index``, ``workers``, ...)."""
+    import inspect
+
+    accepted = inspect.signature(method.all_pairs_angles).parameters
+    return {k: v for k, v in options.items() if k in accepted}
 
 
 def _prepared_stats(method: HomingMethod, prepared: Sequence[Any]) -> dict[str, float]:

@@ -176,76 +176,166 @@ def true_lane_distances(episode, fixes: list, captures_true: dict[int, tuple]) -
     return np.array(out)
 
 
-def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_controller, homing) -> list[RunResult]:
-    """Run ``cfg.experiment.runs`` simulated cleaning runs, logging each to ``ctx.log``."""
+def _simulate_run(cfg: DictConfig, world: CleaningWorld, plan: LanePlan, make_controller, homing, k: int,
+                  seeds, error: tuple[float, float], log, offset_ns: int) -> tuple[RunResult, int]:
+    """Run ``k`` of :func:`simulate`, its ticks written to ``log`` from ``offset_ns`` on.
+
+    Returns the result and the log time of its last tick.
+    """
     from bionav.robot.coverage import Raster, coverage_fractions, sweep_counts
     from bionav.robot.kinematics import DriveModel
     from bionav.robot.lanes import to_plan_frame
-    from bionav.robot.recording import RESULT_TOPIC, EpisodeRecorder
+    from bionav.robot.recording import EpisodeRecorder
     from bionav.robot.simulator import SimulatedRobot, run_episode
+
+    ex = experiment_config(cfg, "cleaning")
+    lo, hi = plan.target_rectangle()
+    raster = Raster.around(lo, hi, cell=float(ex.raster_cell), margin=float(ex.raster_margin))
+    target = raster.rectangle_mask(lo, hi)
+    dt = float(ex.dt)
+    controller = make_controller()
+    speed = float(getattr(controller.config, "speed", 0.1))
+    max_time = float(ex.time_limit_factor) * plan.ideal_path_length / speed + 600.0
+    controller_seed, camera_seed, sim_seed = (int(s) for s in seeds)
+    sim_rng = np.random.default_rng(sim_seed)
+    start = world.start.compose(Pose(
+        float(ex.start_position_std) * float(sim_rng.standard_normal()),
+        float(ex.start_position_std) * float(sim_rng.standard_normal()),
+        float(np.radians(float(ex.start_heading_std_deg)) * sim_rng.standard_normal())))
+    confine = (lo, hi, world.start) if controller.confined else None
+    camera = world.camera_factory(camera_seed) if controller.uses_camera else None
+    robot = SimulatedRobot(
+        DriveModel(track_width=float(ex.track_width), wheel_error=error), start, floor=world.floor,
+        radius=float(ex.robot_radius), confine=confine, camera=camera, rng=sim_rng)
+    controller.reset(plan, homing=homing if controller.uses_camera else None,
+                     rng=np.random.default_rng(controller_seed))
+    recorder = EpisodeRecorder(log, k, time_offset_ns=offset_ns, log_images=bool(ex.log_images))
+    recorder.start({
+        "controller": str(cfg.controller.name),
+        "controller_config": asdict(controller.config),
+        "plan": asdict(plan),
+        "controller_seed": controller_seed, "camera_seed": camera_seed,
+        "camera": camera is not None,
+        "wheel_error": list(error), "start": list(start.as_tuple()),
+        "nominal_start": list(world.start.as_tuple()),
+    })
+    captures_true: dict[int, tuple] = {}
+
+    def on_tick(tick, obs, cmd, robot):
+        recorder.on_tick(tick, obs, cmd, robot)
+        snap = cmd.info.get("snapshot") if cmd.info else None
+        if snap is not None:
+            captures_true[snap["id"]] = robot.pose.as_tuple()
+
+    t0 = time.perf_counter()
+    episode = run_episode(controller, robot, dt=dt, max_time=max_time, on_tick=on_tick)
+    seconds = time.perf_counter() - t0
+    counts = sweep_counts(to_plan_frame(episode.true_pose, world.start), raster, width=plan.unit_width)
+    fractions = coverage_fractions(counts, target)
+    fixes = [(t, i["fix"]) for t, i in episode.info if "fix" in i]
+    accepted = [(t, f) for t, f in fixes if f.get("accepted")]
+    truth = true_lane_distances(episode, accepted, captures_true) if accepted else np.zeros(0)
+    return RunResult(k, error, episode, counts, fractions, fixes, truth, seconds), recorder.last_time_ns
+
+
+class _BufferLog:
+    """Collects a worker's log messages; :meth:`replay` writes them to the run log shifted in time."""
+
+    def __init__(self) -> None:
+        self.messages: list[tuple[str, dict, dict]] = []
+
+    def write(self, topic: str, message: dict, **kwargs: Any) -> None:
+        self.messages.append((topic, message, kwargs))
+
+    @staticmethod
+    def replay(messages, log, offset_ns: int) -> None:
+        """Write ``messages`` to ``log`` with ``offset_ns`` added to log times and ``timestamp`` fields."""
+        for topic, message, kwargs in messages:
+            kwargs = dict(kwargs)
+            kwargs["log_time_ns"] = int(kwargs.get("log_time_ns") or 0) + offset_ns
+            stamp = message.get("timestamp")
+            if isinstance(stamp, dict) and set(stamp) == {"sec", "nsec"}:
+                ns = int(stamp["sec"]) * 1_000_000_000 + int(stamp["nsec"]) + offset_ns
+                message = {**message, "timestamp": {"sec": ns // 1_000_000_000, "nsec": ns % 1_000_000_000}}
+            log.write(topic, message, **kwargs)
+
+
+#: a worker process' world, plan, controller factory and homing method (built once by :func:`_init_worker`)
+_WORKER: dict[str, Any] = {}
+
+
+def _init_worker(cfg_container: dict) -> None:
+    from bionav.config import plugin_config
+
+    cfg = OmegaConf.create(cfg_container)
+    plan = plan_from_layout(cfg.layout)
+    world = make_world(cfg, plan)
+    cls, config = plugin_config("controller", cfg.controller)
+    homing = make_vision_homing(cfg, world) if cls.uses_camera else None
+    _WORKER.update(cfg=cfg, plan=plan, world=world, make_controller=lambda: cls(config), homing=homing)
+
+
+def _worker_run(job: tuple[int, tuple, tuple]) -> tuple[RunResult, list, int]:
+    k, seeds, error = job
+    w = _WORKER
+    log = _BufferLog()
+    result, last_ns = _simulate_run(w["cfg"], w["world"], w["plan"], w["make_controller"], w["homing"], k, seeds,
+                                    error, log, 0)
+    return result, log.messages, last_ns
+
+
+def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_controller, homing,
+             *, workers: int = 1) -> list[RunResult]:
+    """Run ``cfg.experiment.runs`` simulated cleaning runs, logging each to ``ctx.log``.
+
+    With ``workers > 1`` the runs are simulated in that many processes (each
+    builds the world once); every run has its own seeds, drawn before any
+    run starts, so results and log are the same as with one worker (the
+    workers' messages are written in run order, laid end to end in time).
+    """
+    from bionav.robot.recording import RESULT_TOPIC
 
     ex = experiment_config(cfg, "cleaning")
     runs = int(ex.runs)
     if runs < 1:
         raise UserError(f"runs must be at least 1, got {runs}; set runs=10 as in the thesis.")
-    lo, hi = plan.target_rectangle()
-    raster = Raster.around(lo, hi, cell=float(ex.raster_cell), margin=float(ex.raster_margin))
-    target = raster.rectangle_mask(lo, hi)
-    dt = float(ex.dt)
-    speed = float(getattr(make_controller().config, "speed", 0.1))
-    max_time = float(ex.time_limit_factor) * plan.ideal_path_length / speed + 600.0
     errors = wheel_errors(runs, float(ex.wheel_error))
     seeds = ctx.rng.integers(0, 2**31 - 1, size=(runs, 3))
     results = []
     # log times: the log's wall-clock start plus simulated time (Foxglove shows real dates, not 1970)
     offset_ns = int(getattr(ctx.log, "start_ns", None) or time.time_ns())
-    for k in ctx.progress(range(runs), desc="cleaning runs", total=runs):
-        controller = make_controller()
-        controller_seed, camera_seed, sim_seed = (int(s) for s in seeds[k])
-        sim_rng = np.random.default_rng(sim_seed)
-        start = world.start.compose(Pose(
-            float(ex.start_position_std) * float(sim_rng.standard_normal()),
-            float(ex.start_position_std) * float(sim_rng.standard_normal()),
-            float(np.radians(float(ex.start_heading_std_deg)) * sim_rng.standard_normal())))
-        confine = (lo, hi, world.start) if controller.confined else None
-        camera = world.camera_factory(camera_seed) if controller.uses_camera else None
-        robot = SimulatedRobot(
-            DriveModel(track_width=float(ex.track_width), wheel_error=errors[k]), start, floor=world.floor,
-            radius=float(ex.robot_radius), confine=confine, camera=camera, rng=sim_rng)
-        controller.reset(plan, homing=homing if controller.uses_camera else None,
-                         rng=np.random.default_rng(controller_seed))
-        recorder = EpisodeRecorder(ctx.log, k, time_offset_ns=offset_ns, log_images=bool(ex.log_images))
-        recorder.start({
-            "controller": str(cfg.controller.name),
-            "controller_config": asdict(controller.config),
-            "plan": asdict(plan),
-            "controller_seed": controller_seed, "camera_seed": camera_seed,
-            "camera": camera is not None,
-            "wheel_error": list(errors[k]), "start": list(start.as_tuple()),
-            "nominal_start": list(world.start.as_tuple()),
-        })
-        captures_true: dict[int, tuple] = {}
+    workers = max(1, min(int(workers), runs))
 
-        def on_tick(tick, obs, cmd, robot, recorder=recorder, captures_true=captures_true):
-            recorder.on_tick(tick, obs, cmd, robot)
-            snap = cmd.info.get("snapshot") if cmd.info else None
-            if snap is not None:
-                captures_true[snap["id"]] = robot.pose.as_tuple()
+    def finish(result: RunResult, last_ns: int) -> None:
+        nonlocal offset_ns
+        fixes = result.fixes
+        accepted = [f for _, f in fixes if f.get("accepted")]
+        ctx.log.write(RESULT_TOPIC, {"run": result.run, "wheel_error": list(result.wheel_error), **result.fractions,
+                                     "finished": bool(result.episode.finished),
+                                     "ticks": int(len(result.episode.time)), "fixes": len(fixes),
+                                     "accepted_fixes": len(accepted), "seconds": result.seconds},
+                      schema_name="bionav.CleaningResult", log_time_ns=last_ns)
+        results.append(result)
+        offset_ns = last_ns + RUN_GAP_NS
 
-        t0 = time.perf_counter()
-        episode = run_episode(controller, robot, dt=dt, max_time=max_time, on_tick=on_tick)
-        seconds = time.perf_counter() - t0
-        counts = sweep_counts(to_plan_frame(episode.true_pose, world.start), raster, width=plan.unit_width)
-        fractions = coverage_fractions(counts, target)
-        fixes = [(t, i["fix"]) for t, i in episode.info if "fix" in i]
-        accepted = [(t, f) for t, f in fixes if f.get("accepted")]
-        truth = true_lane_distances(episode, accepted, captures_true) if accepted else np.zeros(0)
-        ctx.log.write(RESULT_TOPIC, {"run": k, "wheel_error": list(errors[k]), **fractions,
-                                     "finished": bool(episode.finished), "ticks": int(len(episode.time)),
-                                     "fixes": len(fixes), "accepted_fixes": len(accepted), "seconds": seconds},
-                      schema_name="bionav.CleaningResult", log_time_ns=recorder.last_time_ns)
-        results.append(RunResult(k, errors[k], episode, counts, fractions, fixes, truth, seconds))
-        offset_ns = recorder.last_time_ns + RUN_GAP_NS
+    if workers == 1:
+        for k in ctx.progress(range(runs), desc="cleaning runs", total=runs):
+            result, last_ns = _simulate_run(cfg, world, plan, make_controller, homing, k, seeds[k], errors[k],
+                                            ctx.log, offset_ns)
+            finish(result, last_ns)
+        return results
+
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    jobs = [(k, tuple(int(v) for v in seeds[k]), errors[k]) for k in range(runs)]
+    container = OmegaConf.to_container(cfg, resolve=True)
+    with ProcessPoolExecutor(workers, mp_context=get_context("spawn"), initializer=_init_worker,
+                             initargs=(container,)) as pool:
+        for result, messages, last_ns in ctx.progress(pool.map(_worker_run, jobs), desc="cleaning runs",
+                                                      total=runs):
+            _BufferLog.replay(messages, ctx.log, offset_ns)
+            finish(result, last_ns + offset_ns)
     return results
 
 
@@ -385,7 +475,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     if cls.uses_camera:
         homing = make_homing(cfg, ctx, world.geometry) if vision == "render" else make_oracle_homing(cfg)
 
-    results = simulate(cfg, ctx, world, plan, make_controller, homing)
+    results = simulate(cfg, ctx, world, plan, make_controller, homing, workers=int(cfg.get("workers") or 1))
 
     lo, hi = plan.target_rectangle()
     raster = Raster.around(lo, hi, cell=float(ex.raster_cell), margin=float(ex.raster_margin))

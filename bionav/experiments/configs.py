@@ -69,9 +69,13 @@ class ParamSweepConfig:
         ``rings``, ``n_coeffs`` (evaluated inside each job); the preset ``conf/experiment/param_sweep.yaml``
         holds ``full`` (the thesis') and ``ci`` next to the sweeper parameters that use them.
     rings, n_coeffs : the values each job evaluates (from the selected grid unless overridden).
+    scope : ``job`` -- one signature x image size x preprocessing per run (the multirun's jobs);
+        ``grid`` -- every signature x image size x preprocessing of the grid in one run on
+        ``workers`` processes (``experiment=param_sweep_grid``).
     """
 
     name: str = "param_sweep"
+    scope: str = bounded("job", choices=("job", "grid"))
     grid: str = "full"
     grids: dict[str, Any] = field(default_factory=dict)
     rings: list[int] = bounded(II("experiment.grids.${experiment.grid}.rings"), length=(1, 1000),

@@ -136,6 +136,11 @@ class HomingMethod:
             (0, +1), (0, -1)`` (-1 where missing), see
             :func:`bionav.evaluation.pairs.neighbour_table`.
 
+        A method may also accept the keywords ``snapshot_index`` (sequence of
+        int: only these rows are needed), ``workers`` (int: threads it may use)
+        and ``progress`` (a ``progress(iterable, desc=..., total=...)``
+        wrapper); the runner passes those its signature names.
+
         Returns
         -------
         ndarray, shape (N, N), or None

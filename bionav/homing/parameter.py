@@ -190,15 +190,16 @@ def gradient_matrix_from_test_steps(potentials: np.ndarray, neighbours: np.ndarr
 
     Parameters
     ----------
-    potentials : ndarray, shape (S, C)
-        :func:`potential_matrix` of the snapshots against *all* current views.
+    potentials : ndarray, shape (..., S, C)
+        :func:`potential_matrix` of the snapshots against *all* current views
+        (leading axes: independent potentials, e.g. several configurations).
     neighbours : ndarray of int, shape (C, 4)
         Index (into the current views) of the neighbours at offsets
         ``(+1, 0), (-1, 0), (0, +1), (0, -1)``; -1 where missing.
 
     Returns
     -------
-    ndarray, shape (S, C, 2)
+    ndarray, shape (..., S, C, 2)
         ``(dp/dx, dp/dy)`` per grid unit.
     """
     p = np.asarray(potentials, dtype=np.float64)
@@ -207,11 +208,11 @@ def gradient_matrix_from_test_steps(potentials: np.ndarray, neighbours: np.ndarr
     for axis, (plus, minus) in enumerate(((0, 1), (2, 3))):
         ip, im = nb[:, plus], nb[:, minus]
         has_p, has_m = ip >= 0, im >= 0
-        pp = p[:, np.where(has_p, ip, 0)]
-        pm = p[:, np.where(has_m, im, 0)]
+        pp = p[..., np.where(has_p, ip, 0)]
+        pm = p[..., np.where(has_m, im, 0)]
         g = np.where(has_p & has_m, (pp - pm) / 2.0, np.where(has_p, pp - p, np.where(has_m, p - pm, 0.0)))
         grad[..., axis] = g
-    grad[:, ~np.any(nb >= 0, axis=1)] = np.nan
+    grad[..., ~np.any(nb >= 0, axis=1), :] = np.nan
     return grad
 
 
@@ -236,4 +237,105 @@ def matched_filter_gradient_matrix(
     for axis, d in enumerate((df_dx, df_dy)):
         d = np.asarray(d, dtype=np.float64)
         out[..., axis] = np.einsum("cl,cl->c", fc, d)[None, :] - fs @ d.T
+    return out
+
+
+# --- all numbers of Fourier coefficients at once (parameter sweep) -----------------------------
+
+
+def _levels_index(n_coeffs, coeff_index: np.ndarray) -> np.ndarray:
+    ks = np.asarray(n_coeffs, dtype=np.int64).ravel()
+    k_max = int(coeff_index.max()) + 1 if coeff_index.size else 0
+    if ks.size == 0 or ks.min() < 1 or ks.max() > k_max:
+        raise ValueError(f"n_coeffs must lie in 1..{k_max} (the coefficients present), got {ks.tolist()}")
+    return ks - 1
+
+
+def _coefficient_blocks(coeff_index: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Column order grouping the entries by coefficient (stable) and the bounds of coefficients ``0 .. n-1``."""
+    order = np.argsort(coeff_index, kind="stable")
+    bounds = np.searchsorted(coeff_index[order], np.arange(n + 1), side="left")
+    return order, bounds
+
+
+def potential_matrices_by_coefficients(
+    f_snapshots: np.ndarray, f_currents: np.ndarray, coeff_index: np.ndarray, n_coeffs
+) -> np.ndarray:
+    """:func:`potential_matrix` for several numbers ``K`` of Fourier coefficients from one signature.
+
+    The potential of the first ``K`` coefficients is a partial sum over ``k``
+    (eq. 5.17 / C.2): the squared distances of each coefficient's entries are
+    computed once and summed cumulatively, so all ``K`` cost one potential.
+
+    Parameters
+    ----------
+    f_snapshots : ndarray, shape (S, L)
+    f_currents : ndarray, shape (C, L)
+        Signatures with the largest ``K``.
+    coeff_index : ndarray of int, shape (L,)
+        Coefficient ``k`` of every signature entry (e.g.
+        :meth:`bionav.plugins.signatures.fourier.FcAbs.coefficient_index`).
+    n_coeffs : sequence of int, shape (N,)
+        The numbers of coefficients ``K`` (entries with ``k < K`` are kept).
+
+    Returns
+    -------
+    ndarray, shape (N, S, C)
+        Equal to :func:`potential_matrix` of the signatures restricted to
+        ``k < K`` up to the order of summation (float rounding).
+    """
+    from scipy.spatial.distance import cdist
+
+    kidx = np.asarray(coeff_index, dtype=np.int64)
+    levels = _levels_index(n_coeffs, kidx)
+    order, bounds = _coefficient_blocks(kidx, int(levels.max()) + 1)
+    fs = np.ascontiguousarray(np.asarray(f_snapshots, dtype=np.float64)[:, order])
+    fc = fs if f_currents is f_snapshots else np.ascontiguousarray(np.asarray(f_currents, dtype=np.float64)[:, order])
+    total = np.zeros((len(fs), len(fc)))
+    out = np.empty((len(levels), len(fs), len(fc)))
+    for k in range(len(bounds) - 1):
+        lo, hi = bounds[k], bounds[k + 1]
+        if hi > lo:
+            total += cdist(fs[:, lo:hi], fc[:, lo:hi], "sqeuclidean")
+        out[levels == k] = total
+    return out
+
+
+def matched_filter_gradient_matrices_by_coefficients(
+    f_snapshots: np.ndarray,
+    f_currents: np.ndarray,
+    df_dx: np.ndarray,
+    df_dy: np.ndarray,
+    coeff_index: np.ndarray,
+    n_coeffs,
+) -> np.ndarray:
+    """:func:`matched_filter_gradient_matrix` for several numbers ``K`` of Fourier coefficients.
+
+    The gradient is a sum over the signature entries, so that of the first
+    ``K`` coefficients is a partial sum over ``k`` (eqs. C.9, C.11).
+
+    Parameters
+    ----------
+    f_snapshots : ndarray, shape (S, L)
+    f_currents, df_dx, df_dy : ndarray, shape (C, L)
+        Signatures and derivatives with the largest ``K``.
+    coeff_index : ndarray of int, shape (L,)
+    n_coeffs : sequence of int, shape (N,)
+
+    Returns
+    -------
+    ndarray, shape (N, S, C, 2)
+    """
+    kidx = np.asarray(coeff_index, dtype=np.int64)
+    levels = _levels_index(n_coeffs, kidx)
+    order, bounds = _coefficient_blocks(kidx, int(levels.max()) + 1)
+    fs, fc, dx, dy = (np.ascontiguousarray(np.asarray(a, dtype=np.float64)[:, order])
+                      for a in (f_snapshots, f_currents, df_dx, df_dy))
+    total = np.zeros((len(fs), len(fc), 2))
+    out = np.empty((len(levels), len(fs), len(fc), 2))
+    for k in range(len(bounds) - 1):
+        lo, hi = bounds[k], bounds[k + 1]
+        if hi > lo:
+            total += matched_filter_gradient_matrix(fs[:, lo:hi], fc[:, lo:hi], dx[:, lo:hi], dy[:, lo:hi])
+        out[levels == k] = total
     return out

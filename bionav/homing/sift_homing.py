@@ -16,6 +16,8 @@ keypoints. IJCV 60(2), 91-110. doi:10.1023/B:VISI.0000029664.99615.94
 
 from __future__ import annotations
 
+from typing import Any, Callable, Iterable, NamedTuple, Sequence
+
 import numpy as np
 
 from bionav.geometry import TWO_PI, PanoramaGeometry, wrap_angle
@@ -23,6 +25,60 @@ from bionav.homing.features import SiftFeatures
 
 #: keypoints whose snapshot elevation is at most this (radians) are ignored (thesis 5.1.2)
 MIN_ELEVATION = 0.01
+#: bins of the home-angle histogram over 360 degrees (1-degree bins, thesis 5.1.3)
+N_BINS = 360
+
+
+class ColumnIndex(NamedTuple):
+    """Keypoints of one image sorted by column, with exact integer descriptors (per-image work once).
+
+    Built by :func:`column_index`; used by :func:`match_in_neighbourhood` and
+    :func:`sift_home_angles_all_pairs`.
+
+    Attributes
+    ----------
+    x, y : ndarray, shape (N,), float64
+        Columns (ascending) and rows, pixels.
+    descriptors : ndarray, shape (ceil(N / 4) * 4, 128), float32
+        Descriptors in sorted order, integers (zero rows pad to a multiple of 4).
+    sq_norms : ndarray, shape (N,), int64
+        Squared descriptor norms.
+    rank : ndarray, shape (N,), int64
+        Index of each sorted keypoint in the original :class:`SiftFeatures`.
+    where : ndarray, shape (N,), int64
+        Sorted position of each original keypoint (``where[rank] = arange(N)``).
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    descriptors: np.ndarray
+    sq_norms: np.ndarray
+    rank: np.ndarray
+    where: np.ndarray
+
+
+def column_index(features: SiftFeatures) -> ColumnIndex | None:
+    """Sort keypoints by column for windowed matching; ``None`` unless descriptors are integers in ``[-255, 255]``.
+
+    OpenCV SIFT descriptors are integers in 0..255 (stored as float32), so
+    their distances are exact in integer arithmetic; other descriptors (``None``)
+    are matched by :func:`match_in_neighbourhood_reference`.
+    """
+    from bionav.homing.sift_kernels import GROUP
+
+    desc = np.asarray(features.descriptors)
+    if desc.size and (not np.all(np.abs(desc) <= 255) or not np.array_equal(desc, np.rint(desc))):
+        return None
+    xy = np.asarray(features.xy, dtype=np.float64).reshape(-1, 2)
+    order = np.argsort(xy[:, 0], kind="stable")
+    n = len(order)
+    padded = np.zeros(((n + GROUP - 1) // GROUP * GROUP, desc.shape[1] if desc.ndim == 2 else 128), np.float32)
+    padded[:n] = desc[order]
+    d = padded[:n].astype(np.int64)
+    where = np.empty(n, np.int64)
+    where[order] = np.arange(n)
+    return ColumnIndex(np.ascontiguousarray(xy[order, 0]), np.ascontiguousarray(xy[order, 1]), padded,
+                       np.einsum("ij,ij->i", d, d), order.astype(np.int64), where)
 
 
 def match_in_neighbourhood(
@@ -31,22 +87,67 @@ def match_in_neighbourhood(
     """Nearest-descriptor matching limited to a pixel neighbourhood (eqs. 5.1-5.3).
 
     For every current keypoint ``p`` the snapshot keypoint with the smallest
-    descriptor distance among those closer than ``radius`` pixels is chosen.
-    The column distance wraps around the panorama (width ``width``).
+    Euclidean descriptor distance (eq. 5.1) among those closer than ``radius``
+    pixels (eq. 5.3; the column distance wraps around the panorama of width
+    ``width``: ``dx = min(|x_c - x_s|, W - |x_c - x_s|)``, neighbours satisfy
+    ``dx^2 + dy^2 < radius^2``) is chosen (eq. 5.2); ties go to the lowest
+    snapshot index. Keypoints are sorted by column and only snapshot keypoints
+    within ``radius`` columns are visited; distances of OpenCV SIFT
+    descriptors (integers) are exact, so the result equals
+    :func:`match_in_neighbourhood_reference` (which is used for other
+    descriptors).
+
+    Parameters
+    ----------
+    current, snapshot : SiftFeatures or ColumnIndex
+        Keypoints of the current view and the snapshot (a :class:`ColumnIndex`
+        from :func:`column_index` saves sorting again).
+    radius : float
+        Neighbourhood radius ``q`` in pixels.
+    width : int
+        Panorama width ``W`` in pixels.
 
     Returns
     -------
     current_idx, snapshot_idx : ndarray of int
-        Matched index pairs (current keypoints without any candidate are dropped).
+        Matched index pairs, ascending current index (current keypoints
+        without any candidate are dropped).
+    """
+    from bionav.homing.sift_kernels import match_sorted, matches_from_keys
+
+    a = current if isinstance(current, ColumnIndex) else column_index(current)
+    b = snapshot if isinstance(snapshot, ColumnIndex) else column_index(snapshot)
+    if a is None or b is None:
+        if isinstance(current, ColumnIndex) or isinstance(snapshot, ColumnIndex):
+            raise TypeError("a ColumnIndex can only be matched against features with integer descriptors")
+        return match_in_neighbourhood_reference(current, snapshot, radius=radius, width=width)
+    key_a = np.empty(len(a.x), np.int64)
+    match_sorted(a.x, a.y, a.descriptors, a.sq_norms, a.rank, b.x, b.y, b.descriptors, b.sq_norms, b.rank,
+                 float(radius), float(width), key_a, key_a[:0], False)
+    return matches_from_keys(key_a, a.rank, len(a.x))
+
+
+def match_in_neighbourhood_reference(
+    current: SiftFeatures, snapshot: SiftFeatures, *, radius: float, width: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Plain all-against-all version of :func:`match_in_neighbourhood` (the definition; for tests).
+
+    Squared distances ``|d_c|^2 + |d_s|^2 - 2 d_c . d_s`` and the
+    neighbourhood test in float64 over every keypoint pair; ``numpy.argmin``
+    (lowest snapshot index on ties).
     """
     if len(current.xy) == 0 or len(snapshot.xy) == 0:
         empty = np.zeros(0, np.int64)
         return empty, empty
-    dx = current.xy[:, None, 0] - snapshot.xy[None, :, 0]
-    dx = (dx + width / 2.0) % width - width / 2.0
-    dy = current.xy[:, None, 1] - snapshot.xy[None, :, 1]
-    near = dx * dx + dy * dy < radius * radius
-    d2 = current.sq_norms[:, None] + snapshot.sq_norms[None, :] - 2.0 * (current.descriptors @ snapshot.descriptors.T)
+    cxy = np.asarray(current.xy, dtype=np.float64)
+    sxy = np.asarray(snapshot.xy, dtype=np.float64)
+    dx = np.abs(cxy[:, None, 0] - sxy[None, :, 0])
+    dx = np.minimum(dx, float(width) - dx)
+    dy = cxy[:, None, 1] - sxy[None, :, 1]
+    near = dx * dx + dy * dy < float(radius) * float(radius)
+    dc = np.asarray(current.descriptors, dtype=np.float64)
+    ds = np.asarray(snapshot.descriptors, dtype=np.float64)
+    d2 = np.einsum("ij,ij->i", dc, dc)[:, None] + np.einsum("ij,ij->i", ds, ds)[None, :] - 2.0 * (dc @ ds.T)
     d2 = np.where(near, d2, np.inf)
     best = np.argmin(d2, axis=1)
     ok = np.isfinite(d2[np.arange(len(best)), best])
@@ -144,6 +245,11 @@ def sift_home_vector(
 ) -> tuple[float, int]:
     """SIFT home vector between two aligned panoramas (thesis 5.1).
 
+    Matches by :func:`match_in_neighbourhood`, home angles per correspondence
+    by :func:`correspondence_home_angles` (eq. 5.12), combined by
+    :func:`combine_home_angles` (eqs. 5.14-5.15 or the histogram maximum);
+    for OpenCV SIFT descriptors all three run in one compiled kernel.
+
     Parameters
     ----------
     snapshot, current : SiftFeatures
@@ -154,6 +260,8 @@ def sift_home_vector(
         Neighbourhood radius ``q`` in pixels.
     combine : {"average", "max"}
         How the per-correspondence angles are combined (:func:`combine_home_angles`).
+    window : int
+        Window width in 1-degree bins for ``combine="max"``.
 
     Returns
     -------
@@ -163,14 +271,134 @@ def sift_home_vector(
     n_used : int
         Number of correspondences that contributed.
     """
-    ci, si = match_in_neighbourhood(current, snapshot, radius=search_radius, width=geometry.width)
+    if combine not in ("average", "max"):
+        raise ValueError(f"unknown combination method {combine!r}; use 'average' or 'max'")
+    a = column_index(current)
+    b = column_index(snapshot)
+    if a is not None and b is not None:
+        from bionav.homing.sift_kernels import home_angle_from_keys, match_sorted
+
+        keys = np.empty(len(a.x), np.int64)
+        match_sorted(a.x, a.y, a.descriptors, a.sq_norms, a.rank, b.x, b.y, b.descriptors, b.sq_norms, b.rank,
+                     float(search_radius), float(geometry.width), keys, keys[:0], False)
+        angle, used = home_angle_from_keys(
+            keys, a.x, a.y, a.where, b.x, b.y, b.where, geometry.rad_per_column, float(geometry.horizon_row),
+            float(geometry.rad_per_row), MIN_ELEVATION, combine == "max", N_BINS, int(window))
+        return float(angle), int(used)
+    ci, si = match_in_neighbourhood_reference(current, snapshot, radius=search_radius, width=geometry.width)
+    return _home_vector_from_matches(snapshot, current, ci, si, geometry=geometry, combine=combine, window=window)
+
+
+def _home_vector_from_matches(snapshot, current, ci, si, *, geometry, combine, window) -> tuple[float, int]:
+    """eqs. 5.4-5.15 in numpy from matched index pairs (the reference of the compiled kernel)."""
     if ci.size == 0:
         return float("nan"), 0
     az = geometry.rad_per_column
-    theta_c = current.xy[ci, 0] * az
-    theta_s = snapshot.xy[si, 0] * az
-    eps_c = (geometry.horizon_row - current.xy[ci, 1]) * geometry.rad_per_row
-    eps_s = (geometry.horizon_row - snapshot.xy[si, 1]) * geometry.rad_per_row
+    cxy = np.asarray(current.xy, dtype=np.float64)[ci]  # float64: float32 pixel angles cost up to 2e-4 rad
+    sxy = np.asarray(snapshot.xy, dtype=np.float64)[si]
+    theta_c = cxy[:, 0] * az
+    theta_s = sxy[:, 0] * az
+    eps_c = (geometry.horizon_row - cxy[:, 1]) * geometry.rad_per_row
+    eps_s = (geometry.horizon_row - sxy[:, 1]) * geometry.rad_per_row
     beta = correspondence_home_angles(theta_s, eps_s, theta_c, eps_c)
     used = int(np.sum(np.isfinite(beta)))
-    return combine_home_angles(beta, method=combine, window=window), used
+    return combine_home_angles(beta, method=combine, n_bins=N_BINS, window=window), used
+
+
+def sift_home_vector_reference(
+    snapshot: SiftFeatures, current: SiftFeatures, *, geometry: PanoramaGeometry, search_radius: float,
+    combine: str = "average", window: int = 10,
+) -> tuple[float, int]:
+    """:func:`sift_home_vector` from the plain parts: :func:`match_in_neighbourhood_reference`,
+    :func:`correspondence_home_angles` and :func:`combine_home_angles` in numpy (for tests)."""
+    ci, si = match_in_neighbourhood_reference(current, snapshot, radius=search_radius, width=geometry.width)
+    return _home_vector_from_matches(snapshot, current, ci, si, geometry=geometry, combine=combine, window=window)
+
+
+def sift_home_angles_all_pairs(
+    features: Sequence[SiftFeatures],
+    *,
+    geometry: PanoramaGeometry,
+    search_radius: float,
+    combine: str = "average",
+    window: int = 10,
+    snapshot_index: Sequence[int] | None = None,
+    workers: int = 1,
+    progress: Callable[..., Iterable[Any]] | None = None,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`sift_home_vector` for every pair of one set of images, each distance computed once.
+
+    The neighbourhood (eq. 5.3) is symmetric, so one pass over the
+    descriptor distances of images ``a`` and ``b`` gives the matches of both
+    directions (``a`` current / ``b`` snapshot and the reverse); each
+    image is sorted by column once. Unordered pairs are shared among
+    ``workers`` threads (the kernels release the GIL).
+
+    Parameters
+    ----------
+    features : sequence of SiftFeatures, length N
+        Features of every image (the same geometry).
+    geometry, search_radius, combine, window
+        As :func:`sift_home_vector`.
+    snapshot_index : sequence of int, optional
+        Only these snapshots (rows); other rows stay NaN.
+    workers : int
+        Threads.
+    progress : callable, optional
+        ``progress(iterable, desc=..., total=...)``, e.g. a tqdm wrapper.
+
+    Returns
+    -------
+    angles : ndarray, shape (N, N)
+        ``[s, c]``: home direction from current view ``c`` to snapshot ``s``,
+        radians CCW in the current view's own frame; NaN on the diagonal,
+        in rows not asked for and without usable correspondences.
+    n_used : ndarray of int, shape (N, N)
+        Correspondences that contributed.
+    None
+        When some descriptors are not integers (use :func:`sift_home_vector`).
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from bionav.homing.sift_kernels import home_angle_from_keys, match_sorted
+
+    if combine not in ("average", "max"):
+        raise ValueError(f"unknown combination method {combine!r}; use 'average' or 'max'")
+    index = [column_index(f) for f in features]
+    if any(ix is None for ix in index):
+        return None
+    n = len(index)
+    wanted = np.zeros(n, bool)
+    wanted[np.arange(n) if snapshot_index is None else np.asarray(snapshot_index, dtype=np.int64)] = True
+    angles = np.full((n, n), np.nan)
+    used = np.zeros((n, n), np.int64)
+    geo = (geometry.rad_per_column, float(geometry.horizon_row), float(geometry.rad_per_row), MIN_ELEVATION,
+           combine == "max", N_BINS, int(window))
+    radius, width = float(search_radius), float(geometry.width)
+
+    def row(a: int) -> None:
+        ia = index[a]
+        key_a = np.empty(len(ia.x), np.int64)
+        for b in range(a + 1, n):
+            if not (wanted[a] or wanted[b]):
+                continue
+            ib = index[b]
+            key_b = np.empty(len(ib.x), np.int64)
+            match_sorted(ia.x, ia.y, ia.descriptors, ia.sq_norms, ia.rank, ib.x, ib.y, ib.descriptors,
+                         ib.sq_norms, ib.rank, radius, width, key_a, key_b, bool(wanted[a]))
+            if wanted[b]:  # a is the current view, b the snapshot
+                angles[b, a], used[b, a] = home_angle_from_keys(key_a, ia.x, ia.y, ia.where, ib.x, ib.y, ib.where,
+                                                                *geo)
+            if wanted[a]:
+                angles[a, b], used[a, b] = home_angle_from_keys(key_b, ib.x, ib.y, ib.where, ia.x, ia.y, ia.where,
+                                                                *geo)
+
+    # rows of small ``a`` hold the most pairs: handed out first
+    pool = ThreadPoolExecutor(max(1, int(workers)))
+    try:
+        done = pool.map(row, range(n))
+        for _ in (progress(done, desc="home vectors (SIFT pairs)", total=n) if progress else done):
+            pass
+    finally:  # on Ctrl-C or an error, rows not yet started are dropped instead of awaited
+        pool.shutdown(wait=True, cancel_futures=True)
+    return angles, used

@@ -14,8 +14,11 @@ Modules
   given optical depth, chapter 6).
 * :mod:`~bionav.light.daylight` -- spectral sun, sky and cloud radiance and
   the irradiance they give on the ground (chapter 6).
+* :mod:`~bionav.light.measured_spectra` -- the measured spectra shipped in
+  ``bionav/data/spectra`` (ASTM G173 sun, Bird & Riordan gas absorption,
+  bumbleview leaf and petal reflectances, D65).
 * :mod:`~bionav.light.bands` -- the five sensor channels and their features.
-* :mod:`~bionav.light.materials` -- material reflectance tables.
+* :mod:`~bionav.light.materials` -- material reflectance spectra (measured or from band tables).
 * :mod:`~bionav.light.simple_sky` -- the rendered outdoor worlds' default sky.
 
 Frame: east-north-up; azimuths are radians counter-clockwise from east,

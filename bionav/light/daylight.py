@@ -1,33 +1,57 @@
 """Spectral daylight: sun, clear sky, clouds, and the irradiance they give on the ground.
 
-A deliberately small, documented model, good enough to reproduce *why* a UV
-channel separates sky from terrestrial objects (thesis ch. 6; Möller 2002):
+A small, documented model, good enough to reproduce *why* a UV channel
+separates sky from terrestrial objects (thesis ch. 6; Möller 2002) from the
+clear noon sky down to the low evening sun:
 
-* **Sun**: extraterrestrial spectrum of a 5778 K black body scaled to the solar
-  constant (Planck's law); direct beam attenuated by Beer-Lambert extinction
-  along the relative air mass of Kasten & Young (1989).
+* **Sun**: the measured ASTM G173-03 extraterrestrial spectrum (280-1200 nm,
+  :mod:`bionav.light.measured_spectra`; a 5778 K black body scaled to the solar
+  constant outside that range); direct beam attenuated by Beer-Lambert
+  extinction along the relative air mass of Kasten & Young (1989).
 * **Extinction**: Rayleigh optical depth of Hansen & Travis (1974),
   ``0.008569 lambda^-4 (1 + 0.0113 lambda^-2 + 0.00013 lambda^-4)`` (lambda in
-  micrometres), plus aerosol of Angstrom turbidity ``beta`` and exponent
-  ``alpha`` (``beta lambda^-alpha``). Ozone and water vapour absorption are
-  ignored (their bands barely touch the five channels; the Huggins ozone band
-  starts below 340 nm).
-* **Clear sky**: single scattering in a homogeneous plane-parallel atmosphere
-  viewed from the ground (e.g. Liou 2002, *An Introduction to Atmospheric
-  Radiation*, eq. 6.3.5):
-  ``L = E0 * P_eff(gamma) / (4 pi) * m_v / (m_v - m_s) * (exp(-tau m_s) - exp(-tau m_v))``
-  with the Rayleigh phase function ``3/4 (1 + cos^2 gamma)`` and a
-  Henyey-Greenstein aerosol phase function (g = 0.7, single-scattering albedo
-  0.9), weighted by their optical depths. This gives the lambda^-4 blue/UV sky,
-  brightest near the sun and the horizon, dimming as the sun sets.
+  micrometres), aerosol of Angstrom turbidity ``beta`` and exponent ``alpha``
+  (``beta lambda^-alpha``), and **ozone** (Bird & Riordan 1986 coefficients
+  times the column ``SkyState.ozone_atm_cm``; the Huggins band below 340 nm and
+  the Chappuis band around 600 nm) along the ozone-layer air mass
+  ``(1 + h/R) / sqrt(sin^2 h_s + 2 h/R)`` (layer at h = 22 km). Ozone lies above
+  the scattering air, so it filters the sunlight once, before it is scattered:
+  at a low sun its long slant path through the Chappuis band takes orange and
+  red out of the whole sky, which keeps the dusk sky blue (Hulburt 1953,
+  doi:10.1364/JOSA.43.000113). Water vapour (720, 820, 940 nm) and the oxygen
+  A band (760 nm) absorb in the R and IR channels (Bird & Riordan's
+  transmittance laws, :func:`gas_transmittance`; precipitable water
+  ``SkyState.precipitable_water_cm``).
+* **Clear sky**: single scattering in two stacked plane-parallel layers viewed
+  from the ground: the free troposphere and stratosphere (pure Rayleigh, the
+  molecules above ``AEROSOL_LAYER_M``) over a boundary layer holding the rest of
+  the molecules and all the aerosol. In each homogeneous layer (Liou 2002,
+  *An Introduction to Atmospheric Radiation*, eq. 6.3.5)
+  ``L = E_in P_eff(gamma) / (4 pi) * m_v / (m_v - m_s) * (exp(-tau m_s) - exp(-tau m_v))``,
+  with ``E_in`` the sunlight reaching the layer top and the upper layer's light
+  attenuated by the lower one on its way down; Rayleigh phase function
+  ``3/4 (1 + cos^2 gamma)``, Henyey-Greenstein aerosol phase function (g = 0.7,
+  single-scattering albedo 0.9). With the aerosol at the bottom, the blue and UV
+  light scattered high up at a low sun is not dimmed by the long slant path
+  through the hazy boundary layer, as in the real evening sky.
+* **Multiple scattering**: single scattering alone loses the light that is
+  scattered again on its way down, a large share of the UV and blue sky at a low
+  sun. bionav closes the energy budget with Bird & Riordan's (1986) SPCTRAL2
+  diffuse irradiance (half of all Rayleigh-scattered light reaches the ground,
+  the forward fraction of the aerosol-scattered light, ground-sky reflections,
+  their short-wave correction; :func:`diffuse_irradiance_bird`, validated there
+  against rigorous radiative transfer and measurements): the irradiance the
+  single-scattering sky lacks is spread over the sky in proportion to each line
+  of sight's scattering depth ``1 - exp(-tau m_v)``. The sky's angular structure
+  (sun aureole, horizon, colour across the sky) stays that of single scattering.
 * **Clouds**: spectrally grey scatterers. A cloud of optical depth ``tau_c`` seen
   from below has radiance ``E_top mu_s T(tau_c) / pi`` with the two-stream
   diffuse transmittance ``T = 1 / (1 + 0.75 (1 - g) tau_c)``, g = 0.85; broken
   clouds add sunlit sides ``(1 - T)`` in proportion to the clear fraction;
-  ``E_top`` is the sun attenuated by the air above the cloud base (80 % of the
-  Rayleigh and 30 % of the aerosol optical depth), and the air below adds a
-  little blue path radiance. So overcast skies are grey and dim, while cloud
-  cover *flattens* the sky spectrum relative to the blue sky.
+  ``E_top`` is the sun attenuated by ozone and the air above the cloud base
+  (80 % of the Rayleigh and 30 % of the aerosol optical depth), and the air
+  below adds a little blue path radiance. So overcast skies are grey and dim,
+  while cloud cover *flattens* the sky spectrum relative to the blue sky.
 * **Spatial clouds**: a cloud layer at height ``cloud_height_m`` carrying a
   smooth random field (sum of random plane waves), thresholded to the requested
   cover fraction, drifting with the wind (see :class:`CloudLayer`).
@@ -55,13 +79,60 @@ _SOLID_ANGLE_FACTOR = (6.957e8 / 1.495978707e11) ** 2  # (R_sun / AU)^2
 _HG_G_AEROSOL = 0.7
 _AEROSOL_SSA = 0.9
 _CLOUD_G = 0.85
+_EARTH_RADIUS_M = 6.371e6
+_OZONE_LAYER_M = 22_000.0
+#: Top of the boundary layer that holds the aerosol (m); the molecules above it form the upper layer.
+AEROSOL_LAYER_M = 1500.0
+#: Scale height of the molecular atmosphere (m).
+RAYLEIGH_SCALE_HEIGHT_M = 8000.0
+#: Grey albedo of the ground seen by the sky's multiple scattering and by downward-facing surfaces.
+GROUND_ALBEDO = 0.15
 
 
-def solar_spectrum(wavelengths_nm=WAVELENGTHS_NM, *, temperature_k: float = 5778.0) -> np.ndarray:
-    """Extraterrestrial solar spectral irradiance, W m^-2 nm^-1, shape ``(L,)`` (black-body sun)."""
+def black_body_sun(wavelengths_nm=WAVELENGTHS_NM, *, temperature_k: float = 5778.0) -> np.ndarray:
+    """Extraterrestrial irradiance of a black-body sun, W m^-2 nm^-1, shape ``(L,)`` (Planck's law at 1 AU)."""
     wl = np.asarray(wavelengths_nm, dtype=float) * 1e-9
     radiance = 2 * _H * _C**2 / wl**5 / np.expm1(_H * _C / (wl * _KB * temperature_k))  # W m^-2 sr^-1 m^-1
     return np.pi * radiance * _SOLID_ANGLE_FACTOR * 1e-9
+
+
+def solar_spectrum(wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
+    """Extraterrestrial solar spectral irradiance at 1 AU, W m^-2 nm^-1, shape ``(L,)``.
+
+    The measured ASTM G173-03 spectrum (cell means on the given grid) within
+    280-1200 nm, a 5778 K black body (:func:`black_body_sun`) outside it.
+    """
+    from bionav.light.measured_spectra import extraterrestrial_solar_spectrum
+
+    measured = extraterrestrial_solar_spectrum(wavelengths_nm)
+    return np.where(np.isnan(measured), black_body_sun(wavelengths_nm), measured)
+
+
+def gas_transmittance(state: "SkyState", wavelengths_nm, elevation) -> np.ndarray:
+    """Transmittance of a beam from ``elevation`` through ozone, water vapour and mixed gases, shape ``(L,)``.
+
+    Bird & Riordan (1986), eqs. 4-6: ozone ``exp(-a_o O3 M_o)`` along the ozone-layer
+    air mass :func:`ozone_air_mass`; water vapour
+    ``exp(-0.2385 a_w W M / (1 + 20.07 a_w W M)^0.45)`` and mixed gases
+    ``exp(-1.41 a_u M / (1 + 118.93 a_u M)^0.45)`` along the air mass ``M`` of
+    :func:`relative_air_mass` (sea level), with the column ``state.ozone_atm_cm``
+    and precipitable water ``state.precipitable_water_cm``.
+    """
+    from bionav.light.measured_spectra import gas_absorption
+
+    a = gas_absorption(wavelengths_nm)
+    m = float(relative_air_mass(elevation))
+    aw = a["water_vapor"] * state.precipitable_water_cm * m
+    au = a["mixed_gases"] * m
+    return np.exp(-a["ozone"] * state.ozone_atm_cm * float(ozone_air_mass(elevation))
+                  - 0.2385 * aw / (1 + 20.07 * aw) ** 0.45 - 1.41 * au / (1 + 118.93 * au) ** 0.45)
+
+
+def ozone_air_mass(elevation) -> np.ndarray:
+    """Air mass of the ozone layer (22 km) for an elevation in radians: ``(1 + h/R) / sqrt(sin^2 e + 2 h/R)``."""
+    ratio = _OZONE_LAYER_M / _EARTH_RADIUS_M
+    s = np.sin(np.maximum(np.asarray(elevation, dtype=float), np.deg2rad(-1.0)))
+    return (1 + ratio) / np.sqrt(s * s + 2 * ratio)
 
 
 def rayleigh_optical_depth(wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
@@ -97,6 +168,10 @@ class SkyState:
         Angstrom ``beta`` (0.05 very clear .. 0.3 hazy).
     angstrom_alpha : float
         Angstrom exponent.
+    ozone_atm_cm : float
+        Ozone column in atm-cm (Dobson units / 1000; mid-latitude summer about 0.3-0.35).
+    precipitable_water_cm : float
+        Precipitable water in cm (mid-latitude summer 1-3).
     clouds : CloudLayer
         Cloud layer (``cover = 0`` for a clear sky).
     time_s : float
@@ -107,6 +182,8 @@ class SkyState:
     sun_azimuth: float = 0.0
     turbidity: float = 0.1
     angstrom_alpha: float = 1.3
+    ozone_atm_cm: float = 0.3
+    precipitable_water_cm: float = 1.5
     clouds: CloudLayer = CloudLayer()
     time_s: float = 0.0
 
@@ -140,8 +217,118 @@ def _optical_depths(state: SkyState, wl):
     return tr, ta
 
 
-def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
-    """Single-scattering clear-sky spectral radiance, W m^-2 sr^-1 nm^-1.
+def _sun_transmittance(state: SkyState, wl, *, rayleigh=1.0, aerosol=1.0) -> np.ndarray:
+    """Transmittance of the sun's beam through the gases and fractions of the Rayleigh and aerosol depths, ``(L,)``."""
+    tr, ta = _optical_depths(state, wl)
+    m_s = float(relative_air_mass(state.sun_elevation))
+    return np.exp(-(rayleigh * tr + aerosol * ta) * m_s) * gas_transmittance(state, wl, state.sun_elevation)
+
+
+def _layer_path(tau, m_s, m_v):
+    """``m_v / (m_v - m_s) * (exp(-tau m_s) - exp(-tau m_v))``: single scattering of a homogeneous layer."""
+    delta = m_v - m_s
+    small = np.abs(delta) < 1e-6
+    safe = np.where(small, 1.0, delta)
+    return m_v * np.where(small, tau * np.exp(-tau * m_s), np.exp(-tau * m_s) * -np.expm1(-tau * safe) / safe)
+
+
+def _single_scattering(state: SkyState, d, wl) -> np.ndarray:
+    tr, ta = _optical_depths(state, wl)
+    f_low = 1.0 - np.exp(-AEROSOL_LAYER_M / RAYLEIGH_SCALE_HEIGHT_M)
+    tau_up = tr * (1 - f_low)
+    tau_low = tr * f_low + ta
+    e_in = solar_spectrum(wl) * _sun_transmittance(state, wl, rayleigh=0.0, aerosol=0.0)  # gases only
+    m_s = float(relative_air_mass(state.sun_elevation))
+    m_v = relative_air_mass(np.arcsin(np.clip(d[..., 2], -1, 1)))[..., None]
+    cos_g = np.clip(d @ state.sun_direction, -1, 1)[..., None]
+    p_r = 0.75 * (1 + cos_g**2)
+    g = _HG_G_AEROSOL
+    p_a = (1 - g**2) / (1 + g**2 - 2 * g * cos_g) ** 1.5
+    p_low = (tr * f_low * p_r + _AEROSOL_SSA * ta * p_a) / tau_low
+    upper = p_r * _layer_path(tau_up, m_s, m_v) * np.exp(-tau_low * m_v)
+    lower = p_low * np.exp(-tau_up * m_s) * _layer_path(tau_low, m_s, m_v)
+    return e_in / (4 * np.pi) * (upper + lower)
+
+
+_MS_CACHE: dict = {}
+
+
+def diffuse_irradiance_bird(state: SkyState, wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
+    """Clear-sky diffuse irradiance on a horizontal plane, multiple scattering included, W m^-2 nm^-1, ``(L,)``.
+
+    Bird & Riordan (1986), eqs. 7-13 (SPCTRAL2): the Rayleigh part
+    ``0.5 E0 cos Z T_gas T_aa (1 - T_r^0.95)`` -- half of all light the molecules
+    scatter reaches the ground, whatever the order of scattering -- the aerosol
+    part ``E0 cos Z T_gas T_aa T_r^1.5 (1 - T_as) F_s`` with the forward fraction
+    ``F_s`` of a Henyey-Greenstein aerosol (asymmetry g = 0.7, single-scattering
+    albedo 0.9, as in :func:`clear_sky_radiance`), and the ground-sky
+    reflections ``(E_dir cos Z + I_r + I_a) r_s a_g / (1 - r_s a_g)``, all times
+    Bird & Riordan's short-wave correction ``(lambda_um + 0.55)^1.8`` below 450 nm.
+    Rayleigh depth of Hansen & Travis, aerosol of Angstrom, gases of
+    :func:`gas_transmittance`; ground albedo :data:`GROUND_ALBEDO`.
+    """
+    wl = np.asarray(wavelengths_nm, dtype=float)
+    el = state.sun_elevation
+    if el <= 0:
+        return np.zeros_like(wl)
+    cos_z = np.sin(el)
+    tr, ta = _optical_depths(state, wl)
+    e0 = solar_spectrum(wl)
+    alg = np.log(1 - _HG_G_AEROSOL)
+    afs = alg * (1.459 + alg * (0.1595 + alg * 0.4129))
+    bfs = alg * (0.0783 + alg * (-0.3824 - alg * 0.5874))
+
+    def parts(m, gas, mu):
+        t_r = np.exp(-tr * m)
+        t_aa = np.exp(-(1 - _AEROSOL_SSA) * ta * m)
+        t_as = np.exp(-_AEROSOL_SSA * ta * m)
+        f_s = 1 - 0.5 * np.exp((afs + bfs * mu) * mu)
+        return t_r, t_aa, t_as, f_s, gas
+
+    m = float(relative_air_mass(el))
+    t_r, t_aa, t_as, f_s, gas = parts(m, gas_transmittance(state, wl, el), cos_z)
+    i_r = 0.5 * e0 * cos_z * gas * t_aa * (1 - t_r**0.95)
+    i_a = e0 * cos_z * gas * t_aa * t_r**1.5 * (1 - t_as) * f_s
+    direct_h = e0 * cos_z * gas * t_r * np.exp(-ta * m)
+    m2 = 1.8  # the sky's reflectance for light from the ground, at the effective air mass 1.8
+    t_r2, t_aa2, t_as2, f_s2, gas2 = parts(m2, gas_transmittance(state, wl, np.arcsin(1 / m2)), 1 / m2)
+    r_s = gas2 * t_aa2 * (0.5 * (1 - t_r2) + (1 - f_s2) * t_r2 * (1 - t_as2))
+    i_g = (direct_h + i_r + i_a) * r_s * GROUND_ALBEDO / (1 - r_s * GROUND_ALBEDO)
+    lam = wl / 1000.0
+    corr = np.where(lam <= 0.45, (lam + 0.55) ** 1.8, 1.0)
+    return (i_r + i_a + i_g) * corr
+
+
+def _multiple_scattering_source(state: SkyState, wl) -> tuple[np.ndarray, np.ndarray]:
+    """Radiance scale and the tau of the path shape of the multiple-scattering term (cached per sun and air)."""
+    key = (state.sun_elevation, state.turbidity, state.angstrom_alpha, state.ozone_atm_cm,
+           state.precipitable_water_cm, wl.tobytes())
+    hit = _MS_CACHE.get(key)
+    if hit is not None:
+        return hit
+    n_el, n_az = 8, 24  # the quadrature of :func:`illumination`
+    el = (np.arange(n_el) + 0.5) * (np.pi / 2) / n_el
+    az = (np.arange(n_az) + 0.5) * 2 * np.pi / n_az
+    ee, aa = np.meshgrid(el, az, indexing="ij")
+    flat = replace(state, sun_azimuth=0.0, clouds=CloudLayer())
+    rad = _single_scattering(flat, direction_from_angles(aa, ee), wl)
+    weight = (np.sin(ee) * np.cos(ee) * (np.pi / 2 / n_el) * (2 * np.pi / n_az))[..., None]
+    e_single = np.sum(rad * weight, axis=(0, 1))
+    tr, ta = _optical_depths(state, wl)
+    tau = tr + ta
+    shape = -np.expm1(-tau * relative_air_mass(ee)[..., None])
+    norm = np.sum(shape * weight, axis=(0, 1))
+    scale = np.maximum(diffuse_irradiance_bird(state, wl) - e_single, 0.0) / norm
+    out = (scale, tau)
+    if len(_MS_CACHE) > 256:
+        _MS_CACHE.clear()
+    _MS_CACHE[key] = out
+    return out
+
+
+def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM, *,
+                       multiple_scattering: bool = True) -> np.ndarray:
+    """Clear-sky spectral radiance, W m^-2 sr^-1 nm^-1: two-layer single scattering plus higher orders.
 
     Parameters
     ----------
@@ -150,30 +337,35 @@ def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_N
         Unit viewing directions (east-north-up); directions below the horizon
         are treated as looking 1 degree below it (horizon haze).
     wavelengths_nm : array_like, shape (L,)
+    multiple_scattering : bool
+        Add the higher orders (default); ``False`` gives single scattering only.
 
     Returns
     -------
     ndarray, shape (..., L)
+        Zero when the sun is more than 1 degree below the horizon (no twilight model).
+
+    Notes
+    -----
+    Single scattering in two stacked homogeneous layers (module docstring; Liou
+    2002, eq. 6.3.5 per layer). Higher orders: the diffuse irradiance that the
+    single-scattering sky lacks against Bird & Riordan's (1986) energy budget
+    (:func:`diffuse_irradiance_bird`) is spread over the sky in proportion to
+    each line of sight's scattering depth ``1 - exp(-tau m_v)`` (brighter
+    towards the horizon), so the hemispheric integral of the sky equals that
+    budget wherever single scattering falls short of it (the UV and blue,
+    most at a low sun).
     """
     wl = np.asarray(wavelengths_nm, dtype=float)
     d = np.asarray(directions, dtype=float)
-    e0 = solar_spectrum(wl)
-    tr, ta = _optical_depths(state, wl)
-    tau = tr + ta
-    m_s = float(relative_air_mass(state.sun_elevation))
-    m_v = relative_air_mass(np.arcsin(np.clip(d[..., 2], -1, 1)))[..., None]
-    cos_g = np.clip(d @ state.sun_direction, -1, 1)[..., None]
-    p_r = 0.75 * (1 + cos_g**2)
-    g = _HG_G_AEROSOL
-    p_a = (1 - g**2) / (1 + g**2 - 2 * g * cos_g) ** 1.5
-    p_eff = (tr * p_r + _AEROSOL_SSA * ta * p_a) / tau
-    delta = m_v - m_s
-    small = np.abs(delta) < 1e-6
-    safe = np.where(small, 1.0, delta)
-    path = np.where(small, tau, -np.expm1(-tau * safe) / safe)  # (1 - exp(-tau delta)) / delta
     if state.sun_elevation <= np.deg2rad(-1.0):
         return np.zeros(d.shape[:-1] + wl.shape)
-    return e0 * p_eff / (4 * np.pi) * m_v * np.exp(-tau * m_s) * path
+    single = _single_scattering(state, d, wl)
+    if not multiple_scattering or state.sun_elevation <= 0:
+        return single
+    scale, tau = _multiple_scattering_source(state, wl)
+    m_v = relative_air_mass(np.arcsin(np.clip(d[..., 2], -1, 1)))[..., None]
+    return single + scale * -np.expm1(-tau * m_v)
 
 
 def _cloud_transmittance(tau_c):
@@ -194,11 +386,9 @@ def sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM, *, 
         return clear
     tau_c = state.clouds.optical_depth_at(d, time_s=state.time_s, origin_m=origin_m)[..., None]
     opacity = -np.expm1(-0.5 * tau_c)
-    e0 = solar_spectrum(wl)
     tr, ta = _optical_depths(state, wl)
     mu_s = max(np.sin(state.sun_elevation), 0.0)
-    m_s = float(relative_air_mass(state.sun_elevation))
-    e_top = e0 * np.exp(-(0.8 * tr + 0.3 * ta) * m_s)
+    e_top = solar_spectrum(wl) * _sun_transmittance(state, wl, rayleigh=0.8, aerosol=0.3)
     t_c = _cloud_transmittance(tau_c)
     sides = (1.0 - state.clouds.cover) * (1.0 - t_c)
     base = e_top * mu_s * (t_c + sides) / np.pi
@@ -274,10 +464,9 @@ def illumination(state: SkyState, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.
     d_omega = np.cos(ee) * (np.pi / 2 / n_elevation) * (2 * np.pi / n_azimuth)
     weight = (np.sin(ee) * d_omega)[..., None]
     diffuse = np.sum(rad * weight, axis=(0, 1))
-    tr, ta = _optical_depths(state, wl)
     m_s = float(relative_air_mass(state.sun_elevation))
     tau_sun = float(state.clouds.optical_depth_at(state.sun_direction, time_s=state.time_s, origin_m=origin_m))
-    direct = solar_spectrum(wl) * np.exp(-(tr + ta) * m_s - tau_sun * m_s)
+    direct = solar_spectrum(wl) * _sun_transmittance(state, wl) * np.exp(-tau_sun * m_s)
     return Illumination(direct, diffuse, state.sun_direction)
 
 

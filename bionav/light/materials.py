@@ -38,13 +38,16 @@ a log-normal jitter (``band_sd``).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
+
+from bionav.light.bands import PEAK_NM, WAVELENGTHS_NM, band_integrate
 
 
 @dataclass(frozen=True)
 class Material:
-    """A material's five-band reflectance and its variability.
+    """A material's reflectance spectrum (or spectra) and its variability.
 
     Attributes
     ----------
@@ -52,11 +55,24 @@ class Material:
     category : str
         ``"natural"`` or ``"artificial"``.
     reflectance : tuple of float
-        Diffuse reflectance at UV, B, G, R, IR.
+        Diffuse reflectance at UV, B, G, R, IR: the table values of materials
+        without measured spectra; for measured ones the channel-weighted mean
+        of the mean spectrum (``int S_b rho / int S_b``), for reference.
     gloss : tuple of float
         Range ``(low, high)`` of the specular (sky-mirroring) reflectance.
     brightness_sd, band_sd : float
-        Log-normal sample-to-sample variation of the whole spectrum and of each band.
+        Log-normal sample-to-sample variation of the whole spectrum and, smoothly
+        over wavelength, of each band.
+    spectra : tuple
+        Measured base spectra on :data:`~bionav.light.bands.WAVELENGTHS_NM`
+        (tuples of floats, one per measured sample); empty for table materials,
+        whose spectrum is interpolated from ``reflectance``
+        (:func:`spectrum_from_bands`).
+    leaf_fraction : tuple of float
+        Range of the green-leaf share of an areal mixture (flowers seen among
+        their leaves); ``(0, 0)`` for pure materials.
+    source : str
+        Where the spectrum comes from.
     """
 
     name: str
@@ -65,17 +81,86 @@ class Material:
     gloss: tuple = (0.0, 0.0)
     brightness_sd: float = 0.25
     band_sd: float = 0.08
+    spectra: tuple = ()
+    leaf_fraction: tuple = (0.0, 0.0)
+    source: str = "five-band table (USGS splib07 / ECOSTRESS shapes; UV assumption)"
+
+    def base_spectra(self) -> np.ndarray:
+        """Base reflectance spectra, shape ``(K, L)`` on :data:`~bionav.light.bands.WAVELENGTHS_NM`."""
+        if self.spectra:
+            return np.asarray(self.spectra, dtype=float)
+        return spectrum_from_bands(self.reflectance)[None, :]
+
+    def mean_spectrum(self) -> np.ndarray:
+        """The material's mean reflectance spectrum (leaf mixture at its mid share), shape ``(L,)``."""
+        mean = self.base_spectra().mean(axis=0)
+        f = 0.5 * (self.leaf_fraction[0] + self.leaf_fraction[1])
+        return (1 - f) * mean + f * _leaf_spectrum() if f > 0 else mean
 
     def sample(self, rng: np.random.Generator, n: int = 1) -> np.ndarray:
-        """``n`` random reflectance spectra of this material, shape ``(n, 5)``, clipped to [0.005, 0.98]."""
-        base = np.asarray(self.reflectance, dtype=float)
+        """``n`` random reflectance spectra, shape ``(n, L)`` on ``WAVELENGTHS_NM``, clipped to [0.005, 0.98].
+
+        Each sample takes one base spectrum (uniformly among the measured
+        ones), mixes in green leaf if the material has a ``leaf_fraction``,
+        and multiplies by a log-normal brightness factor and a smooth
+        log-normal band jitter (five factors at the channel peaks, linearly
+        interpolated over wavelength).
+        """
+        base = self.base_spectra()
+        pick = base[rng.integers(0, len(base), n)]
+        if self.leaf_fraction[1] > 0:
+            f = rng.uniform(*self.leaf_fraction, (n, 1))
+            pick = (1 - f) * pick + f * _leaf_spectrum()[None, :]
         bright = np.exp(rng.normal(0.0, self.brightness_sd, (n, 1)))
-        jitter = np.exp(rng.normal(0.0, self.band_sd, (n, base.size)))
-        return np.clip(base * bright * jitter, 0.005, 0.98)
+        jitter = np.exp(rng.normal(0.0, self.band_sd, (n, len(PEAK_NM))))
+        smooth = np.stack([np.interp(WAVELENGTHS_NM, PEAK_NM, j) for j in jitter])
+        return np.clip(pick * bright * smooth, 0.005, 0.98)
+
+
+def spectrum_from_bands(reflectance, wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
+    """A reflectance spectrum through five band values: linear between the channel peaks, flat beyond, ``(L,)``."""
+    return np.interp(np.asarray(wavelengths_nm, dtype=float), PEAK_NM, np.asarray(reflectance, dtype=float))
+
+
+def band_mean_reflectance(spectrum) -> np.ndarray:
+    """Channel-weighted mean reflectance ``int S_b rho / int S_b`` of spectra ``(..., L)``, shape ``(..., 5)``."""
+    return band_integrate(spectrum) / band_integrate(np.ones(WAVELENGTHS_NM.shape))
+
+
+@lru_cache(maxsize=1)
+def _leaf_spectrum() -> np.ndarray:
+    from bionav.light.measured_spectra import green_leaf_reflectance
+
+    out = green_leaf_reflectance(WAVELENGTHS_NM)
+    out.setflags(write=False)
+    return out
 
 
 def _m(name, cat, refl, **kw):
     return Material(name, cat, tuple(float(v) for v in refl), **kw)
+
+
+_LEAF_SOURCE = ("measured green leaf (bumbleview 0.2.8, 300-700 nm) x canopy factor {f:g}; "
+                "red edge and NIR plateau modelled beyond 700 nm")
+
+
+def _canopy(name, factor, **kw):
+    """Vegetation: the measured green-leaf spectrum times a grey canopy factor (shading inside the canopy)."""
+    spec = factor * _leaf_spectrum()
+    return Material(name, "natural", tuple(float(v) for v in band_mean_reflectance(spec)),
+                    spectra=(tuple(float(v) for v in spec),), source=_LEAF_SOURCE.format(f=factor), **kw)
+
+
+def _flowers():
+    from bionav.light.measured_spectra import petal_reflectances
+
+    _, petals = petal_reflectances(WAVELENGTHS_NM)
+    spectra = tuple(tuple(float(v) for v in row) for row in petals)
+    mean = 0.5 * petals.mean(axis=0) + 0.5 * _leaf_spectrum()
+    return Material("flowers", "natural", tuple(float(v) for v in band_mean_reflectance(mean)), spectra=spectra,
+                    leaf_fraction=(0.3, 0.8), band_sd=0.04,
+                    source="120 measured petal spectra (bumbleview 0.2.8, 300-700 nm, flat beyond) mixed with "
+                           "30-80 % measured green leaf")
 
 
 #: Every material bionav knows, keyed by name. Natural kinds follow thesis 6.2.1's
@@ -83,11 +168,12 @@ def _m(name, cat, refl, **kw):
 MATERIALS: dict[str, Material] = {
     m.name: m
     for m in (
-        # natural: vegetation (low UV, chlorophyll trough at R, high IR)
-        _m("grass", "natural", (0.030, 0.050, 0.090, 0.050, 0.450)),
-        _m("shrub", "natural", (0.028, 0.042, 0.075, 0.042, 0.380)),
-        _m("tree", "natural", (0.025, 0.038, 0.070, 0.040, 0.400)),
-        _m("conifer", "natural", (0.020, 0.030, 0.050, 0.030, 0.250)),
+        # natural: vegetation, measured (low UV, chlorophyll trough at R, red edge to high IR)
+        _canopy("grass", 0.9),
+        _canopy("shrub", 0.8),
+        _canopy("tree", 0.75),
+        _canopy("conifer", 0.5),
+        _flowers(),
         _m("dead_leaves", "natural", (0.040, 0.070, 0.100, 0.250, 0.400)),
         _m("dead_wood", "natural", (0.050, 0.090, 0.120, 0.230, 0.300)),
         # natural: minerals and ground
@@ -123,7 +209,7 @@ MATERIALS: dict[str, Material] = {
 
 #: Natural sample kinds and their share in ``sim_natural`` (thesis 6.2.1 list).
 NATURAL_MIX: dict[str, float] = {
-    "grass": 0.20, "shrub": 0.14, "tree": 0.18, "conifer": 0.06, "dead_leaves": 0.08,
+    "grass": 0.18, "shrub": 0.12, "flowers": 0.04, "tree": 0.18, "conifer": 0.06, "dead_leaves": 0.08,
     "dead_wood": 0.08, "tar": 0.05, "rock": 0.06, "gravel": 0.05, "sand": 0.04, "soil": 0.06,
 }
 
@@ -137,9 +223,15 @@ ARTIFICIAL_MIX: dict[str, float] = {
 
 
 def band_reflectance_table() -> tuple[list[str], np.ndarray]:
-    """Names and base reflectances ``(M, 5)`` of every material (documentation and plots)."""
+    """Names and band reflectances ``(M, 5)`` of every material (documentation and plots)."""
     names = list(MATERIALS)
     return names, np.array([MATERIALS[n].reflectance for n in names])
+
+
+def mean_spectra_table() -> tuple[list[str], np.ndarray]:
+    """Names and mean reflectance spectra ``(M, L)`` on ``WAVELENGTHS_NM`` of every material."""
+    names = list(MATERIALS)
+    return names, np.array([MATERIALS[n].mean_spectrum() for n in names])
 
 
 #: Relative reflectance of material kinds, per band. Rough textbook shapes

@@ -15,9 +15,14 @@ thesis' collections:
   reuses its sky readings).
 
 Each sample draws a time, a weather regime of that day, a cloud field, the
-viewing direction and, for objects, a material spectrum, a surface orientation,
-sun or shadow and a distance; radiance comes from :mod:`bionav.light.daylight`
-and counts from :class:`~bionav.spectral.sensor_model.LogSensorModel`.
+viewing direction and, for objects, a material reflectance spectrum
+(:data:`bionav.light.materials.MATERIALS`: measured leaf and petal spectra for
+vegetation and flowers, five-band tables elsewhere), a surface orientation, sun
+or shadow and a distance. The object radiance per channel is
+``int S_b(lambda) rho(lambda) E(lambda) dlambda / pi`` with the spectral
+irradiance ``E`` of :mod:`bionav.light.daylight`; counts come from the
+logarithmic :class:`~bionav.spectral.sensor_model.LogSensorModel`, so a
+contrast (difference of two channels' counts) is a log ratio of band radiances.
 """
 
 from __future__ import annotations
@@ -192,8 +197,8 @@ def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average):
             normal = normal * np.array([-1.0, -1.0, 1.0])
         in_shadow = rng.random() < 0.3
         ill = illumination(state)
-        irr = band_integrate(ill.on_surface(normal, sunlit=0.0 if in_shadow else 1.0))
-        rad = rho * irr / np.pi
+        # spectral shading: integrate reflectance x irradiance over each channel (not band means multiplied)
+        rad = band_integrate(rho * ill.on_surface(normal, sunlit=0.0 if in_shadow else 1.0)) / np.pi
         gloss = rng.uniform(*mat.gloss) if mat.gloss[1] > 0 else 0.0
         if gloss > 0:
             mirror = view - 2 * (view @ normal) * normal

@@ -5,12 +5,13 @@ analytic primitives (ground plane, yawed boxes, ellipsoids, vertical
 cylinders, a distant tree line) and shades the hits with the spectral daylight
 of :mod:`bionav.light.daylight`:
 
-``L_b = rho_b * tex * (sunlit * cos_i * E_dir_b + (1 + n_z)/2 * E_diff_b + (1 - n_z)/2 * a_g * E_glob_b) / pi``
+``L_b = tex * int S_b rho (sunlit * cos_i * E_dir + (1 + n_z)/2 * E_diff + (1 - n_z)/2 * a_g * E_glob) dlambda / pi``
 
 attenuated towards the sensor by the air (extinction per band) plus airlight
 (horizon sky radiance); lines of sight that hit nothing get the sky radiance
-with clouds. ``rho_b`` comes from :data:`bionav.light.materials.MATERIALS`
-(reflectance constant within each channel), ``tex`` is a smooth multiplicative
+with clouds. ``rho(lambda)`` is the material's mean reflectance spectrum from
+:data:`bionav.light.materials.MATERIALS` (measured leaf and petal spectra for
+vegetation and flowers), ``S_b`` the channel sensitivity, ``tex`` is a smooth multiplicative
 texture (log-normal, per material), shadows are cast by every primitive except
 the ground, foliage is lit in patches (sun flecks).
 
@@ -153,7 +154,7 @@ class OutdoorScene:
     def __post_init__(self) -> None:
         self._materials = sorted(MATERIALS)
         self._mat_index = {m: i for i, m in enumerate(self._materials)}
-        self._refl = np.array([MATERIALS[m].reflectance for m in self._materials])
+        self._spectra = np.array([MATERIALS[m].mean_spectrum() for m in self._materials])
         self._ill_cache = {}
         self._prefetch = None
         r = np.random.default_rng(self.seed)
@@ -318,9 +319,10 @@ class OutdoorScene:
         hit = ~sky
         if np.any(hit):
             ill = self._illumination()
-            e_dir = band_integrate(ill.direct_normal)
-            e_dif = band_integrate(ill.diffuse_horizontal)
-            e_glob = band_integrate(ill.global_horizontal)
+            # per material and channel: int S_b rho_m E dlambda of each light component, shape (M, 5)
+            e_dir = band_integrate(self._spectra * ill.direct_normal)
+            e_dif = band_integrate(self._spectra * ill.diffuse_horizontal)
+            e_glob = band_integrate(self._spectra * ill.global_horizontal)
             p = o + t[hit, None] * d[hit]
             n = normal[hit]
             sun = self.sky.sun_direction
@@ -333,9 +335,9 @@ class OutdoorScene:
             fleck = 0.5 + 0.5 * np.sin(p @ np.array([3.1, 2.3, 4.7]) + np.sin(p @ np.array([1.3, -2.9, 0.7])) * 2)
             lit = np.where(fol, lit * fleck, lit)
             sky_view = (1 + n[:, 2:3]) / 2
-            irr = lit[:, None] * cos_i[:, None] * e_dir + sky_view * e_dif + (1 - sky_view) * 0.15 * e_glob
-            rho = self._refl[mat[hit]] * self._texture(p, mat[hit])[:, None]
-            rad = rho * irr / np.pi
+            m = mat[hit]
+            refl_irr = lit[:, None] * cos_i[:, None] * e_dir[m] + sky_view * e_dif[m] + (1 - sky_view) * 0.15 * e_glob[m]
+            rad = self._texture(p, m)[:, None] * refl_irr / np.pi
             beta = (rayleigh_optical_depth(np.asarray(PEAK_NM)) / 8000.0
                     + aerosol_optical_depth(np.asarray(PEAK_NM), beta=self.sky.turbidity) / 1200.0)
             trans = np.exp(-beta * t[hit, None])
@@ -413,7 +415,8 @@ def backyard_scene(sky: SkyState, *, seed: int = 0) -> OutdoorScene:
         Box((-6.0, 3.0), (0.8, 9.0), 0.0, 1.8, "shrub", "shrub", yaw=-0.1),  # hedge (west)
         Box((7.5, -2.0), (5.0, 4.0), 0.0, 3.0, "brick", "roof_tile", yaw=0.5),  # garage (south-east)
     ]
-    patches = [GroundPatch(-0.6, 0.6, -10.0, 6.4, "concrete"), GroundPatch(1.5, 5.0, -3.0, -1.0, "soil")]
+    patches = [GroundPatch(-0.6, 0.6, -10.0, 6.4, "concrete"), GroundPatch(1.5, 5.0, -3.0, -1.0, "soil"),
+               GroundPatch(1.5, 4.0, 1.0, 2.5, "flowers")]  # a flower bed (measured petal spectra)
     return OutdoorScene(sky=sky, boxes=boxes, ellipsoids=ellipsoids, cylinders=cylinders, patches=patches,
                         tree_line=TreeLine(seed=seed), ground="grass", pan_zero_azimuth=np.pi / 4, seed=seed)
 

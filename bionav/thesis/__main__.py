@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
 def run(args) -> int:
     from bionav.thesis.items import Context, select_items
     from bionav.thesis.outcome import Outcome
-    from bionav.thesis.presets import PRESETS
+    from bionav.thesis.presets import PRESETS, PUBLIC_PRESETS
     from bionav.thesis.reference import load_reference
     from bionav.thesis.report import Section, markdown_to_html, report_markdown, verdict_counts, write_csv
     from bionav.thesis.runs import Runner, tool_env
@@ -81,7 +81,7 @@ def run(args) -> int:
     started = time.time()
     load_start = _loadavg()
     if args.preset not in PRESETS:
-        raise UserError(f"unknown --preset {args.preset!r}; choose quick or full.")
+        raise UserError(f"unknown --preset {args.preset!r}; choose one of {', '.join(PUBLIC_PRESETS)}.")
     preset = PRESETS[args.preset]
     items = select_items(args.only)
     out = Path(args.out).resolve()

@@ -8,6 +8,7 @@ the tests: the whole code path on the smallest inputs that still run.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 #: the eight variants of the original database (thesis 3.1, fig. 5.6)
@@ -160,6 +161,31 @@ TINY = Preset(
     reductions=("tiny preset: every size and count reduced to a minimum; for tests only",),
 )
 
-PRESETS = {p.name: p for p in (QUICK, FULL, TINY)}
+#: the checks of issue 18 (``--only standins``): SIFT homing at the thesis' 1122 x 162 on snapshot subsets,
+#: the thesis' warping parameters on hall1, the doorlit/winlit cross test, the reduced parameter grid
+STANDINS = dataclasses.replace(
+    QUICK,
+    name="standins",
+    summary="the stand-in hardness checks of issue 18 (about an hour on two idle cores)",
+    snapshots=16,
+    sift_size=(1122, 162),
+    warping=("warping2d_thesis", "minwarping_thesis"),
+    warping_snapshots=3,
+    cross_db_family=("sim_doorlit", "sim_winlit"),
+    cross_db_stride=9,
+    cross_db_size=None,
+    cross_db_homing=("sift", "warping2d"),
+    reductions=(
+        "SIFT homing (table 5.3): 16 snapshots per database (evenly spread over the images) instead of all, "
+        "every image a current view; 1122 x 162 as the thesis",
+        "table 5.4: the thesis' parameters (warping2d_thesis, minwarping_thesis), 3 snapshots per database",
+        "fig. 5.6: doorlit and winlit only, 4 snapshots per database (stride 9), SIFT homing at the native "
+        "561 x 81, the fast 2D-warping preset (homing=warping2d)",
+        "tables 5.5-5.7: the reduced parameter grid experiment.grid=ci (one image size, no preprocessing, "
+        "two ring counts and two Fourier-coefficient counts; thesis: 5202 configurations per database)",
+    ),
+)
+
+PRESETS = {p.name: p for p in (QUICK, FULL, TINY, STANDINS)}
 #: presets offered by ``--help`` (tiny is for tests)
-PUBLIC_PRESETS = ("quick", "full")
+PUBLIC_PRESETS = ("quick", "full", "standins")

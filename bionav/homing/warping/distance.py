@@ -20,6 +20,8 @@ summed in 16 bits, and the distance is stored as a byte,
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from numba import njit
 
@@ -98,9 +100,9 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     """8-bit NSAD in diagonal layout from 16-bit stacks.
 
     ``sq`` (K, R, W) and ``sn`` (K, W): quantised snapshot planes and column
-    norms; ``cq2`` (K, R, 2 W) and ``cn2`` (K, 2 W): the current view's, twice
-    side by side, so that the columns ``i + d`` of all snapshot columns ``i``
-    are one contiguous run. The sums of a plane are kept for all diagonals
+    norms; ``cq2`` (K, R, 2 W + 1) and ``cn2`` (K, 2 W + 1): the current view's,
+    twice side by side (and one more column), so that the columns ``i + d`` of
+    all snapshot columns ``i`` are one contiguous run. The sums of a plane are kept for all diagonals
     (``W x W`` 16-bit, in L2 cache) and built eight rows at a time, so that
     those rows stay in L1 cache while every diagonal visits them; the inner
     loops run over all ``W`` columns (32 16-bit lanes). The bytes are then
@@ -108,12 +110,13 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     """
     n_planes, n_rows, width = sq.shape
     n = width // step
-    acc = np.empty((width, width), np.uint16)
+    acc = np.empty((width + 1, width), np.uint16)  # row W: scratch for odd W
     t = np.zeros(width, np.uint8)
     qf = np.float32(quantum)
     for k in range(n_planes):
         acc[:] = 0
-        # |a - b| as max - min keeps the loops in 16-bit lanes
+        # |a - b| of 16-bit values (|a|, |b| <= 2047: no overflow); two
+        # diagonals per pass share the loads of the snapshot rows
         r = 0
         while r + 8 <= n_rows:
             a0 = sq[k, r]
@@ -124,22 +127,37 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
             a5 = sq[k, r + 5]
             a6 = sq[k, r + 6]
             a7 = sq[k, r + 7]
-            for d in range(width):
-                b0 = cq2[k, r, d:d + width]
-                b1 = cq2[k, r + 1, d:d + width]
-                b2 = cq2[k, r + 2, d:d + width]
-                b3 = cq2[k, r + 3, d:d + width]
-                b4 = cq2[k, r + 4, d:d + width]
-                b5 = cq2[k, r + 5, d:d + width]
-                b6 = cq2[k, r + 6, d:d + width]
-                b7 = cq2[k, r + 7, d:d + width]
+            for d in range(0, width, 2):
+                b0 = cq2[k, r, d:d + width + 1]
+                b1 = cq2[k, r + 1, d:d + width + 1]
+                b2 = cq2[k, r + 2, d:d + width + 1]
+                b3 = cq2[k, r + 3, d:d + width + 1]
+                b4 = cq2[k, r + 4, d:d + width + 1]
+                b5 = cq2[k, r + 5, d:d + width + 1]
+                b6 = cq2[k, r + 6, d:d + width + 1]
+                b7 = cq2[k, r + 7, d:d + width + 1]
                 ac = acc[d]
+                ad = acc[d + 1]
                 for i in range(width):
+                    x0 = a0[i]
+                    x1 = a1[i]
+                    x2 = a2[i]
+                    x3 = a3[i]
+                    x4 = a4[i]
+                    x5 = a5[i]
+                    x6 = a6[i]
+                    x7 = a7[i]
                     ac[i] += np.uint16(
-                        max(a0[i], b0[i]) - min(a0[i], b0[i]) + max(a1[i], b1[i]) - min(a1[i], b1[i])
-                        + max(a2[i], b2[i]) - min(a2[i], b2[i]) + max(a3[i], b3[i]) - min(a3[i], b3[i])
-                        + max(a4[i], b4[i]) - min(a4[i], b4[i]) + max(a5[i], b5[i]) - min(a5[i], b5[i])
-                        + max(a6[i], b6[i]) - min(a6[i], b6[i]) + max(a7[i], b7[i]) - min(a7[i], b7[i])
+                        abs(np.int16(x0 - b0[i])) + abs(np.int16(x1 - b1[i]))
+                        + abs(np.int16(x2 - b2[i])) + abs(np.int16(x3 - b3[i]))
+                        + abs(np.int16(x4 - b4[i])) + abs(np.int16(x5 - b5[i]))
+                        + abs(np.int16(x6 - b6[i])) + abs(np.int16(x7 - b7[i]))
+                    )
+                    ad[i] += np.uint16(
+                        abs(np.int16(x0 - b0[i + 1])) + abs(np.int16(x1 - b1[i + 1]))
+                        + abs(np.int16(x2 - b2[i + 1])) + abs(np.int16(x3 - b3[i + 1]))
+                        + abs(np.int16(x4 - b4[i + 1])) + abs(np.int16(x5 - b5[i + 1]))
+                        + abs(np.int16(x6 - b6[i + 1])) + abs(np.int16(x7 - b7[i + 1]))
                     )
             r += 8
         while r < n_rows:
@@ -148,7 +166,7 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
                 b0 = cq2[k, r, d:d + width]
                 ac = acc[d]
                 for i in range(width):
-                    ac[i] += np.uint16(max(a0[i], b0[i]) - min(a0[i], b0[i]))
+                    ac[i] += np.uint16(abs(np.int16(a0[i] - b0[i])))
             r += 1
         na = sn[k]
         for d in range(width):
@@ -165,40 +183,25 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
                 o0 = o[0]
                 for m in range(n):
                     o0[m] = t[m]
-                    o0[m + n] = t[m]
-            elif step == 3:  # constant stride: compiles to byte shuffles
-                o0 = o[0]
-                o1 = o[1]
-                o2 = o[2]
-                for m in range(n):
-                    x0 = t[3 * m]
-                    x1 = t[3 * m + 1]
-                    x2 = t[3 * m + 2]
-                    o0[m] = x0
-                    o1[m] = x1
-                    o2[m] = x2
-                    o0[m + n] = x0
-                    o1[m + n] = x1
-                    o2[m + n] = x2
+            elif step == 3:  # constant stride, one phase at a time: byte shuffles
+                for rr in range(3):
+                    orr = o[rr]
+                    for m in range(n):
+                        orr[m] = t[3 * m + rr]
             else:
                 for rr in range(step):
                     orr = o[rr]
                     for m in range(n):
-                        x = t[m * step + rr]
-                        orr[m] = x
-                        orr[m + n] = x
+                        orr[m] = t[m * step + rr]
 
 
 @njit(nogil=True, fastmath=True, cache=True)
 def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
-    """Fill ``out[k, d, i % step, i // step (+ n)] = NSAD(snap[k, :, i], cur[k, :, (i + d) % W])``.
+    """Fill ``out[k, d, i % step, i // step] = NSAD(snap[k, :, i], cur[k, :, (i + d) % W])``.
 
     ``cur2`` and ``cur_norm2`` hold the current view's planes and norms twice
     side by side (width ``2 W``) so that column ``i + d`` needs no wrap.
-    ``out`` has shape ``(K, W, step, 2 * n)`` with ``n = W // step``; the second
-    half of the last axis repeats the first, so that ``n`` consecutive entries
-    starting anywhere in the first half are a contiguous slice (the search
-    kernels read the distances of all ``n`` alpha steps as one vector).
+    ``out`` has shape ``(K, W, step, n)`` with ``n = W // step``.
     """
     n_planes, n_rows, width = snap.shape
     n = width // step
@@ -223,7 +226,19 @@ def _diagonal_distances(snap, cur2, snap_norm, cur_norm2, step, out):
                     if den > 0:
                         val = acc[i] / den
                     out[k, d, rr, m] = val
-                    out[k, d, rr, m + n] = val
+
+
+_SCRATCH = threading.local()
+
+
+def _scratch(name, shape, dtype):
+    """A per-thread array kept between calls (contents undefined)."""
+    cache = _SCRATCH.__dict__.setdefault("arrays", {})
+    arr = cache.get(name)
+    if arr is None or arr.shape != shape or arr.dtype != dtype:
+        arr = np.empty(shape, dtype=dtype)
+        cache[name] = arr
+    return arr
 
 
 def _absmax(stack, key):
@@ -241,7 +256,7 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
         Scale-plane stacks (see :func:`column_distance_matrix`).
     step : int
         Alpha step in columns (``W`` must be a multiple of it).
-    out : ndarray, shape (K, W, step, 2 * W // step), optional
+    out : ndarray, shape (K, W, step, W // step), optional
         Array to fill (C-contiguous, float32 or uint8 for ``quantised``), e.g.
         the first level of the search's window minima; a new one by default.
     quantised : bool
@@ -251,9 +266,8 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
 
     Returns
     -------
-    ndarray, shape (K, W, step, 2 * W // step), float32 or uint8
-        ``E[k, d, i % step, i // step]`` (and again at ``i // step + W // step``)
-        equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``
+    ndarray, shape (K, W, step, W // step), float32 or uint8
+        ``E[k, d, i % step, i // step]`` equals ``column_distance_matrix(snapshot, current)[k, i, (i + d) % W]``
         (times ``q`` and rounded when quantised).
     """
     snap = np.ascontiguousarray(snapshot["snap"], dtype=np.float32)
@@ -266,7 +280,7 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
     if width % step:
         raise ValueError(f"width {width} is not a multiple of the alpha step {step}")
     n = width // step
-    shape = (n_planes, width, step, 2 * n)
+    shape = (n_planes, width, step, n)
     dtype = np.uint8 if quantised else np.float32
     if out is None:
         out = np.empty(shape, dtype=dtype)
@@ -275,10 +289,11 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
     if quantised:
         top = max(_absmax(snapshot, "snap"), _absmax(current, "cur"))
         scale = np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
-        sq = np.empty((n_planes, n_rows, width), np.int16)
-        sn = np.empty((n_planes, width), np.int32)
-        cq2 = np.empty((n_planes, n_rows, 2 * width), np.int16)
-        cn2 = np.empty((n_planes, 2 * width), np.int32)
+        # per-thread scratch arrays: fresh ones would be new pages (page faults) on every call
+        sq = _scratch("sq", (n_planes, n_rows, width), np.int16)
+        sn = _scratch("sn", (n_planes, width), np.int32)
+        cq2 = _scratch("cq2", (n_planes, n_rows, 2 * width + 1), np.int16)
+        cn2 = _scratch("cn2", (n_planes, 2 * width + 1), np.int32)
         _quantise(snap, scale, sq, sn)
         _quantise(cur, scale, cq2, cn2)
         _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)

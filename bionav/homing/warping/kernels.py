@@ -60,7 +60,7 @@ def fill_window_minima(levels):
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
         ``levels[0]`` filled; levels ``1 .. J`` are overwritten.
     """
     n_levels, n_planes, width, step, m2 = levels.shape
@@ -85,7 +85,7 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
         Column distances (diagonal layout) and their sliding minima
         (:func:`fill_window_minima`).
     n_alpha : int
@@ -109,33 +109,36 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     ndarray, shape (P, n_alpha)
         ``out``: ``sum_u min_{v, k allowed} dist`` for each (psi, alpha); lower is better.
     """
-    _, n_planes, width, step, m2 = levels.shape
+    _, n_planes, width, step, n = levels.shape
     n_p = p_cols.shape[0]
-    best = np.empty((n_p, n_alpha), dtype=levels.dtype)
-    row_stride = step * m2
+    best = np.empty((n_p, n), dtype=levels.dtype)
+    row_stride = step * n
     # snapshot columns in phase order (u = rr, rr + step, ...): one phase reads
     # a third of the table (step 3), which keeps the reads in cache; per window
     # all rotations at once (the window's plane and level stay fixed); the
     # first window of a column is copied, the others compared and selected
-    # (packed byte compares)
+    # (packed byte compares). The minima are kept over whole rows (column
+    # i // step of the snapshot, any alpha) and added to the match values of
+    # alpha step (i // step - u // step) mod n afterwards, so that the table
+    # holds every distance once.
     for rr in range(step):
         for u in range(rr, width, step):
             e0 = start[u]
             e1 = start[u + 1]
-            off = rr * m2 + u // step
+            off = u // step
             for e in range(e0, e1):
                 flat = levels[w_level[e], w_plane[e]].reshape(-1)
                 v0 = w_v[e] - u
                 first = e == e0
                 for ip in range(n_p):
-                    base = _wrap(v0 - p_cols[ip], width) * row_stride + off
-                    row = flat[base:base + n_alpha]
+                    base = _wrap(v0 - p_cols[ip], width) * row_stride + rr * n
+                    row = flat[base:base + n]
                     b = best[ip]
                     if first:
-                        for a in range(n_alpha):
+                        for a in range(n):
                             b[a] = row[a]
                     else:
-                        for a in range(n_alpha):
+                        for a in range(n):
                             x = row[a]
                             if x < b[a]:
                                 b[a] = x
@@ -144,8 +147,14 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
             for ip in range(n_p):
                 acc = out[ip]
                 b = best[ip]
-                for a in range(n_alpha):
-                    acc[a] += b[a]
+                # slices: plain contiguous loops (indices ``a + off`` would
+                # keep them from vectorising)
+                b1 = b[off:]
+                acc2 = acc[n - off:]
+                for a in range(n - off):
+                    acc[a] += b1[a]
+                for a in range(off):
+                    acc2[a] += b[a]
     return out
 
 
@@ -158,7 +167,7 @@ def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
 
     Parameters
     ----------
-    levels : ndarray, shape (J + 1, K, W, step, 2 * W // step), float32 or uint8
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
     a_cols, p_cols : ndarray, shape (N,), int64
         Movement direction and rotation of each pair, in columns.
     start, w_plane, w_level, w_v : ndarray
@@ -199,12 +208,86 @@ def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
 
 
 @njit(nogil=True, fastmath=True, cache=True)
+def minwarp_scores_runs(levels, a_first, n_a, p_cols, start, w_plane, w_level, w_v):
+    """Min-warping match values of runs of consecutive movement directions.
+
+    For each rotation ``p_cols[t]`` the ``n_a`` directions ``a_first[t] ..
+    a_first[t] + n_a - 1`` (columns, modulo ``W``): the fine search's block of
+    hypotheses around the best grid point, for the pair and (with shifted
+    directions) for the swapped pair. Reads the same windows as
+    :func:`minwarp_scores`; per window and rotation one row of the table, the
+    directions of a run at offsets fixed per snapshot column.
+
+    Parameters
+    ----------
+    levels : ndarray, shape (J + 1, K, W, step, W // step), float32 or uint8
+    a_first : ndarray, shape (P,), int64
+        First movement direction of each run, in columns.
+    n_a : int
+        Directions per run.
+    p_cols : ndarray, shape (P,), int64
+        Rotation of each run, in columns.
+    start, w_plane, w_level, w_v : ndarray
+        Min-warping windows.
+
+    Returns
+    -------
+    ndarray, shape (P, n_a), float64
+        In the units of ``levels``.
+    """
+    n_levels, n_planes, width, step, m2 = levels.shape
+    row = step * m2
+    flat = levels.reshape(-1)
+    n_p = p_cols.shape[0]
+    total = np.zeros((n_p, n_a))
+    best = np.empty((n_p, n_a))
+    offs = np.empty((n_p, n_a), np.uint64)
+    p_t = np.empty(n_p, np.int64)
+    for t in range(n_p):
+        p_t[t] = p_cols[t] % width
+    for u in range(width):
+        for t in range(n_p):
+            # column i = u + a_first[t] + a (mod W) as (i % step, i // step),
+            # advanced without dividing
+            i = (u + a_first[t]) % width
+            m = i // step
+            r = i - m * step
+            for a in range(n_a):
+                offs[t, a] = np.uint64(r * m2 + m)
+                best[t, a] = np.inf
+                i += 1
+                r += 1
+                if r == step:
+                    r = 0
+                    m += 1
+                if i == width:
+                    i = 0
+                    r = 0
+                    m = 0
+        for e in range(start[u], start[u + 1]):
+            base = (w_level[e] * n_planes + w_plane[e]) * width
+            v0 = w_v[e] - u
+            for t in range(n_p):
+                rb = np.uint64((base + _wrap(v0 - p_t[t], width)) * row)
+                bt = best[t]
+                ot = offs[t]
+                for a in range(n_a):
+                    x = np.float64(flat[rb + ot[a]])
+                    if x < bt[a]:
+                        bt[a] = x
+        for t in range(n_p):
+            for a in range(n_a):
+                total[t, a] += best[t, a]
+    return total
+
+
+@njit(nogil=True, fastmath=True, cache=True)
 def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
     """2D-warping match values for every (rho, psi, alpha step).
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step), float32
+    dist : ndarray, shape (K, W, step, W // step), float32
     n_alpha : int
     p_cols : ndarray, shape (P,), int64
         Rotations in columns.
@@ -229,8 +312,12 @@ def warp2d_scores(dist, n_alpha, p_cols, v_tab, k_tab):
                 rr = u - m0 * step
                 d = _wrap(v_tab[ir, u] - u - pc, width)
                 row = dist[k_tab[ir, u], d, rr]
-                for a in range(n_alpha):
-                    acc[a] += row[m0 + a]
+                row1 = row[m0:]
+                acc2 = acc[n_alpha - m0:]
+                for a in range(n_alpha - m0):
+                    acc[a] += row1[a]
+                for a in range(m0):
+                    acc2[a] += row[a]
     return out
 
 
@@ -267,7 +354,7 @@ def compass_measure(dist, p_cols):
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step), float32 or uint8
+    dist : ndarray, shape (K, W, step, W // step), float32 or uint8
 
     Returns
     -------
@@ -276,17 +363,24 @@ def compass_measure(dist, p_cols):
     n_planes, width, step, m2 = dist.shape
     n = width // step
     out = np.zeros(p_cols.shape[0])
+    best = np.empty(n, dtype=dist.dtype)
+    # per rotation one diagonal d: the minimum over the planes is taken on
+    # whole rows (packed byte minima), then summed
     for ip in range(p_cols.shape[0]):
         d = (-p_cols[ip]) % width
         total = 0.0
         for rr in range(step):
+            row = dist[0, d, rr]
             for m in range(n):
-                best = dist[0, d, rr, m]
-                for k in range(1, n_planes):
-                    x = dist[k, d, rr, m]
-                    if x < best:
-                        best = x
-                total += best
+                best[m] = row[m]
+            for k in range(1, n_planes):
+                row = dist[k, d, rr]
+                for m in range(n):
+                    best[m] = min(best[m], row[m])
+            s = 0.0
+            for m in range(n):
+                s += np.float64(best[m])
+            total += s
         out[ip] = total
     return out
 
@@ -303,10 +397,10 @@ def swap_roles(dist, out):
 
     Parameters
     ----------
-    dist : ndarray, shape (K, W, step, 2 * W // step)
+    dist : ndarray, shape (K, W, step, W // step)
         Diagonal-layout distances of the pair.
     out : ndarray, same shape and dtype
-        Filled with those of the swapped pair (both halves of the last axis).
+        Filled with those of the swapped pair.
     """
     n_planes, width, step, m2 = dist.shape
     n = width // step
@@ -322,8 +416,11 @@ def swap_roles(dist, out):
                 ph = c - off * step
                 if off >= n:
                     off -= n
-                row = s[ph, off:off + n]
+                row = s[ph]
                 dst = o[rj]
-                for m in range(n):
-                    dst[m] = row[m]
-                    dst[m + n] = row[m]
+                row1 = row[off:]
+                dst2 = dst[n - off:]
+                for m in range(n - off):
+                    dst[m] = row1[m]
+                for m in range(off):
+                    dst2[m] = row[m]

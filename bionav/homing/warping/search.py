@@ -32,7 +32,7 @@ from bionav.homing.warping.kernels import (
     compass_measure,
     fill_window_minima,
     minwarp_scores,
-    minwarp_scores_at,
+    minwarp_scores_runs,
     swap_roles,
     warp2d_scores,
     warp2d_scores_at,
@@ -74,6 +74,19 @@ class WarpingResult:
 
 
 def _column_grid(n_steps: int, width: int) -> np.ndarray:
+    key = (int(n_steps), int(width))
+    grid = _GRIDS.get(key)
+    if grid is None:
+        grid = _column_grid_new(*key)
+        grid.flags.writeable = False
+        _GRIDS[key] = grid
+    return grid
+
+
+_GRIDS: dict = {}
+
+
+def _column_grid_new(n_steps: int, width: int) -> np.ndarray:
     if n_steps < 1:
         raise ValueError(f"the number of search steps must be >= 1, got {n_steps}")
     if n_steps > width:
@@ -119,7 +132,7 @@ def _window_minima(snapshot, current, step, windows, quantised, name="levels"):
     n_levels = int(windows[2].max(initial=0)) + 1
     n_planes, _, width = np.shape(snapshot["snap"])
     dtype = np.dtype(np.uint8 if quantised else np.float32)
-    levels = _buffer(name, (n_levels, n_planes, width, step, 2 * (width // step)), dtype)
+    levels = _buffer(name, (n_levels, n_planes, width, step, width // step), dtype)
     diagonal_distances(snapshot, current, step=step, out=levels[0], quantised=quantised)
     if n_levels > 1:
         fill_window_minima(levels)
@@ -144,6 +157,26 @@ def _symmetric_scales(scales) -> bool:
     return bool(np.allclose(s * s[::-1], 1.0, rtol=1e-9, atol=0.0))
 
 
+_SCALE_SETUPS: dict = {}
+
+
+def _scale_setup(scales, thresholds):
+    """``check_scales(scales, thresholds)`` and whether the scales are inversion
+    symmetric, memoised by value (the search calls it once per pair)."""
+    s = np.asarray(scales, dtype=np.float64)
+    t = None if thresholds is None else np.asarray(thresholds, dtype=np.float64)
+    key = (s.tobytes(), None if t is None else t.tobytes())
+    setup = _SCALE_SETUPS.get(key)
+    if setup is None:
+        s, tau = check_scales(s, t)
+        s.flags.writeable = False
+        tau.flags.writeable = False
+        setup = (s, tau, _symmetric_scales(s))
+        if len(_SCALE_SETUPS) < 64:
+            _SCALE_SETUPS[key] = setup
+    return setup
+
+
 def _select_psi(dist, p_cols, compass_fraction):
     if compass_fraction is None or compass_fraction >= 1.0:
         return p_cols
@@ -158,7 +191,7 @@ def _select_psi(dist, p_cols, compass_fraction):
 def _check_pair(snapshot, current):
     s1 = np.asarray(snapshot["scales"], dtype=np.float64)
     s2 = np.asarray(current["scales"], dtype=np.float64)
-    if s1.shape != s2.shape or not np.allclose(s1, s2):
+    if s1 is not s2 and (s1.shape != s2.shape or not (np.array_equal(s1, s2) or np.allclose(s1, s2))):
         raise ValueError("snapshot and current view were prepared with different scale factors")
     if np.shape(snapshot["snap"]) != np.shape(current["cur"]):
         raise ValueError(
@@ -211,7 +244,7 @@ def minwarping_scores(
         of ``1 / q``, :func:`~bionav.homing.warping.distance.distance_quantum`).
     """
     scales = _check_pair(snapshot, current)
-    scales, tau = check_scales(scales, thresholds)
+    scales, tau, _ = _scale_setup(scales, thresholds)
     width = int(np.shape(snapshot["snap"])[-1])
     a_cols = _column_grid(n_alpha, width)
     p_cols = _column_grid(n_psi, width) if psi_cols is None else np.asarray(psi_cols, np.int64) % width
@@ -305,7 +338,7 @@ def minwarping(
     computed anew.
     """
     scales = _check_pair(snapshot, current)
-    scales, tau = check_scales(scales, thresholds)
+    scales, tau, symmetric = _scale_setup(scales, thresholds)
     width = int(np.shape(snapshot["snap"])[-1])
     if double_search and width % 2:
         raise ValueError(f"double search needs an even image width, got {width}")
@@ -322,7 +355,7 @@ def minwarping(
     levels2 = None
     if double_search:
         levels2 = _buffer("levels2", levels.shape, levels.dtype)
-        if _symmetric_scales(scales):
+        if symmetric:
             swap_roles(levels[0], levels2[0])
             if levels2.shape[0] > 1:
                 fill_window_minima(levels2)
@@ -337,22 +370,31 @@ def minwarping(
     ip, ia = np.unravel_index(int(np.argmin(scores)), scores.shape)
     best_a, best_p, best = int(a_cols[ia]), int(p_cols[ip]), float(scores[ip, ia])
     if fine_search:
-        best_a, best_p, best = _fine(
-            lambda ac, pc: _minwarp_at(levels, levels2, ac, pc, windows, width),
-            best_a, best_p, best, width, n_alpha, n_psi,
-        )
+        best_a, best_p, best = _fine_minwarp(levels, levels2, windows, best_a, best_p, best, width,
+                                             n_alpha, n_psi)
     if quantised:
         best /= distance_quantum(width)[0]
     return _result(best_a, best_p, np.nan, best, width, n_psi_searched=int(p_cols.size))
 
 
-def _minwarp_at(levels, levels2, a_cols, p_cols, windows, width):
-    out = minwarp_scores_at(levels, a_cols, p_cols, *windows)
+def _fine_minwarp(levels, levels2, windows, best_a, best_p, best, width, n_alpha, n_psi):
+    """:func:`_fine` for min-warping: the block of hypotheses as runs of
+    directions per rotation (:func:`minwarp_scores_runs`), same order and ties."""
+    ra = max(1, int(np.ceil(width / n_alpha)) - 1)
+    rp = max(1, int(np.ceil(width / n_psi)) - 1)
+    pc = (best_p + np.arange(-rp, rp + 1, dtype=np.int64)) % width
+    a_first = np.full(pc.size, (best_a - ra) % width, dtype=np.int64)
+    vals = minwarp_scores_runs(levels, a_first, 2 * ra + 1, pc, *windows)
     if levels2 is not None:
-        out = out + minwarp_scores_at(
-            levels2, (a_cols + width // 2 - p_cols) % width, (-p_cols) % width, *windows
-        )
-    return out
+        # hypothesis (a, p) of the pair is (a + W/2 - p, -p) of the swapped pair
+        vals = vals + minwarp_scores_runs(levels2, (a_first + width // 2 - pc) % width, 2 * ra + 1,
+                                          (-pc) % width, *windows)
+    vals = vals.T.ravel()  # (direction, rotation) order, as _fine
+    t = int(np.argmin(vals))
+    if vals[t] < best:
+        ia, ip = divmod(t, pc.size)
+        return int((best_a - ra + ia) % width), int(pc[ip]), float(vals[t])
+    return best_a, best_p, best
 
 
 def _fine(score_at, best_a, best_p, best, width, n_alpha, n_psi):
@@ -399,7 +441,7 @@ def warping2d_scores(
     scores : ndarray, shape (R, P, n_alpha), float32
     """
     scales = _check_pair(snapshot, current)
-    scales, tau = check_scales(scales, thresholds)
+    scales, tau, _ = _scale_setup(scales, thresholds)
     width = int(np.shape(snapshot["snap"])[-1])
     a_cols = _column_grid(n_alpha, width)
     p_cols = _column_grid(n_psi, width) if psi_cols is None else np.asarray(psi_cols, np.int64) % width
@@ -459,7 +501,7 @@ def warping2d(
     WarpingResult
     """
     scales = _check_pair(snapshot, current)
-    scales, tau = check_scales(scales, thresholds)
+    scales, tau, _ = _scale_setup(scales, thresholds)
     width = int(np.shape(snapshot["snap"])[-1])
     a_cols = _column_grid(n_alpha, width)
     p_all = _column_grid(n_psi, width)

@@ -212,7 +212,6 @@ class ParameterHoming(HomingMethod):
         equals the per-pair call with the neighbour offsets expressed in the
         current view's frame.)
         """
-        from bionav.geometry import wrap_angle
         from bionav.homing import parameter as ph
 
         f = np.stack([p["f"] for p in prepared])
@@ -222,6 +221,51 @@ class ParameterHoming(HomingMethod):
             dfx = np.stack([p["df_dx"] for p in prepared])
             dfy = np.stack([p["df_dy"] for p in prepared])
             grad = ph.matched_filter_gradient_matrix(f, f, dfx, dfy)
+        return self._grid_angles(grad, headings)
+
+    def all_pairs_angles_by_coefficients(
+        self, prepared, *, n_coeffs, image_shape, headings: np.ndarray, neighbours: np.ndarray
+    ) -> np.ndarray:
+        """:meth:`all_pairs_angles` for several numbers ``K`` of Fourier coefficients at once.
+
+        ``prepared`` holds the images prepared with this method's signature,
+        whose ``n_coeffs`` must be at least ``max(n_coeffs)``; the signature
+        must have ``coefficient_index`` (the DFT signatures). Potentials or
+        matched-filter gradients for every ``K`` are partial sums over the
+        coefficients (:func:`bionav.homing.parameter.potential_matrices_by_coefficients`),
+        equal to those of signatures with ``n_coeffs=K`` up to float rounding.
+
+        Parameters
+        ----------
+        prepared : list of dict
+        n_coeffs : sequence of int, shape (N,)
+        image_shape : (H, W)
+            Shape of the prepared (grey) images.
+        headings, neighbours : ndarray
+            As in :meth:`all_pairs_angles`.
+
+        Returns
+        -------
+        ndarray, shape (N, S, C)
+            Grid-frame home angles, radians; NaN where none.
+        """
+        from bionav.homing import parameter as ph
+
+        kidx = self.signature.coefficient_index(tuple(image_shape))
+        f = np.stack([p["f"] for p in prepared])
+        if self.gradient == "test_steps":
+            pots = ph.potential_matrices_by_coefficients(f, f, kidx, n_coeffs)
+            grad = ph.gradient_matrix_from_test_steps(pots, neighbours)
+        else:
+            dfx = np.stack([p["df_dx"] for p in prepared])
+            dfy = np.stack([p["df_dy"] for p in prepared])
+            grad = ph.matched_filter_gradient_matrices_by_coefficients(f, f, dfx, dfy, kidx, n_coeffs)
+        return self._grid_angles(grad, headings)
+
+    def _grid_angles(self, grad: np.ndarray, headings: np.ndarray) -> np.ndarray:
+        """Home angles (grid frame, wrapped) from potential gradients of shape (..., S, C, 2)."""
+        from bionav.geometry import wrap_angle
+
         hx, hy = -grad[..., 0], -grad[..., 1]
         with np.errstate(invalid="ignore"):
             angles = np.arctan2(hy, hx)
@@ -229,5 +273,5 @@ class ParameterHoming(HomingMethod):
         angles[~(np.isfinite(hx) & np.isfinite(hy))] = np.nan
         if self.gradient != "test_steps":
             # flow templates live in the current view's own frame
-            angles = angles + np.asarray(headings)[None, :]
+            angles = angles + np.asarray(headings)
         return wrap_angle(angles)

@@ -72,6 +72,18 @@ class _PlaneWarping(HomingMethod):
         self._template_width = None
 
     def _scales(self):
+        """Checked ``(scales, thresholds)`` of the configuration (computed once per setting)."""
+        cfg = self.config
+        key = (None if cfg.scales is None else tuple(cfg.scales),
+               None if cfg.thresholds is None else tuple(cfg.thresholds),
+               getattr(cfg, "threshold_rule", "geometric"), getattr(cfg, "max_scale_ratio", None))
+        cached = getattr(self, "_scales_cache", None)
+        if cached is None or cached[0] != key:
+            cached = (key, self._compute_scales())
+            self._scales_cache = cached
+        return cached[1]
+
+    def _compute_scales(self):
         from bionav.homing.warping.scaleplanes import check_scales, default_scales, reference_thresholds
 
         cfg = self.config

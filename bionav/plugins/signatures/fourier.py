@@ -38,13 +38,32 @@ class FourierConfig:
     n_coeffs: int = bounded(8, ge=1, le=1000)
 
 
+def _coefficient_index(n_coeffs: int, repeats: int) -> np.ndarray:
+    return np.tile(np.arange(int(n_coeffs)), int(repeats))
+
+
 class _RowSpectrum(Signature):
     Config = FourierConfig
+    #: blocks of ``H K`` entries per row spectrum: 2 (real, imaginary) or 1 (amplitudes)
+    parts = 2
 
     def spectrum(self, image) -> np.ndarray:
         from bionav.homing.signatures.fourier import row_spectrum
 
         return row_spectrum(image, n_coeffs=self.config.n_coeffs)
+
+    def coefficient_index(self, image_shape) -> np.ndarray:
+        """Coefficient ``k`` of every entry of :meth:`compute` (and :meth:`derivative`) for images of ``(H, W)``.
+
+        The signature with ``K`` coefficients is the one with more coefficients
+        restricted to the entries with ``k < K``, in the same order, which lets
+        a sweep over ``K`` compute it once (partial sums over ``k``).
+
+        Returns
+        -------
+        ndarray of int, shape (L,)
+        """
+        return _coefficient_index(self.config.n_coeffs, self.parts * int(image_shape[0]))
 
 
 class Fc(_RowSpectrum):
@@ -64,6 +83,7 @@ class FcAbs(_RowSpectrum):
 
     name = "fc_abs"
     rotation_invariant = True
+    parts = 1
 
     def compute(self, image, *, raw=None) -> np.ndarray:
         return np.abs(self.spectrum(image)).ravel()
@@ -79,6 +99,10 @@ class _Profile(Signature):
 
         z = fourier.profile_spectrum(getattr(fourier, self.profile_name)(image), n_coeffs=self.config.n_coeffs)
         return fourier.complex_to_real(z) if self.with_phase else np.abs(z)
+
+    def coefficient_index(self, image_shape) -> np.ndarray:
+        """Coefficient ``k`` of every entry of :meth:`compute` (see :meth:`Fc.coefficient_index`); shape ``(L,)``."""
+        return _coefficient_index(self.config.n_coeffs, 2 if self.with_phase else 1)
 
 
 class MeanFft(_Profile):

@@ -42,6 +42,16 @@ class World:
         Cells that exist (False where an obstacle stands).
     free_area : tuple of float, optional
         ``(x0, y0, x1, y1)`` of an obstacle-free floor rectangle (apartment).
+    info : dict
+        Free-form facts about the world (room size, sun position ...).
+    floor_tilt_deg : float
+        Standard deviation in degrees, about each horizontal axis, of the
+        camera's tilt where the robot stands: the unevenness of the floor
+        (rug edges and carpet pile under one wheel, tile and paving joints,
+        slopes) and the sway of the camera mast after the robot stops. The
+        camera model of the stand-ins (:func:`bionav.db.camera.camera_images`)
+        tilts every capture by a Gaussian draw of this size unless
+        ``db.pose_error.tilt_sigma_deg`` is given.
     """
 
     scene: Scene
@@ -52,6 +62,7 @@ class World:
     cells: np.ndarray | None = None
     free_area: tuple[float, float, float, float] | None = None
     info: dict = field(default_factory=dict)
+    floor_tilt_deg: float = 0.0
 
     def __post_init__(self) -> None:
         if self.cells is None:

@@ -110,11 +110,15 @@ def wall_picture(scene: Scene, rng: np.random.Generator, *, wall: str, position:
 
 
 def potted_plant(scene: Scene, rng: np.random.Generator, *, x: float, y: float, height: float = 1.6,
-                 crown: float = 0.35, min_leaf_z: float = 0.75) -> None:
-    """An arboreal plant: pot, stem and clumps of foliage (none below ``min_leaf_z``)."""
+                 crown: float = 0.35, min_leaf_z: float = 0.75, leaf_glow: float = 0.12) -> None:
+    """An arboreal plant: pot, stem and clumps of foliage (none below ``min_leaf_z``).
+
+    ``leaf_glow`` is the radiance the translucent leaves pass on from the room light behind them
+    (an emission term; scale it with the room's light level, e.g. small in a dark hall).
+    """
     pot = scene.material(texture=tx.value_noise(rng, lo=0.35, hi=0.6), albedo=0.6, scale=0.3)
     soil = scene.material(texture=tx.carpet(rng, lo=0.05, hi=0.2), albedo=0.5, scale=0.2)
-    leaves = scene.material(texture=tx.foliage(rng), albedo=0.8, emission=0.12, scale=0.25,  # leaves are translucent
+    leaves = scene.material(texture=tx.foliage(rng), albedo=0.8, emission=leaf_glow, scale=0.25,  # leaves are translucent
                             kind="foliage")
     stem = scene.material(texture=tx.bark(rng), albedo=0.4, scale=0.2, kind="bark")
     scene.frustum((x, y), 0.0, 0.35, 0.12, 0.16, material=pot, top=soil)

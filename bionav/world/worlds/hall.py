@@ -24,6 +24,16 @@ GRID_SHAPE = (10, 20)
 SPACING = 0.5
 CAMERA_HEIGHT = 0.6
 N_MISSING = 30
+#: Probability that a lamp position under the galleries has its lamp on (night: few are).
+LAMPS_ON = 0.75
+#: Radiant intensity of one fluorescent lamp (downward Lambertian panel).
+LAMP_INTENSITY = 14.0
+#: Bounce light on upward / downward faces.
+AMBIENT = (0.09, 0.055)
+#: Camera gain.
+EXPOSURE = 3.2
+#: Camera tilt std (degrees) on the hall's stone floor (joints, mast sway; World.floor_tilt_deg).
+FLOOR_TILT_DEG = 0.5
 
 
 def _missing_cells(origin, obstacles, n_missing: int) -> np.ndarray:
@@ -133,7 +143,7 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
         qy = gy0 + r.uniform(0.5, 9.0)
         scene.cylinder((qx, qy), 0.0, 0.5, 0.35, material=planter_mat)
         potted_plant(scene, stream(seed, f"hall/part{part}/plant{k}"), x=qx, y=qy, height=1.6, crown=0.45,
-                     min_leaf_z=0.9)
+                     min_leaf_z=0.9, leaf_glow=0.01)
         obstacles.append((qx, qy, 0.4))
     bench = scene.material(texture=tx.wood(r), albedo=0.45, scale=1.0)
     bx, by = gx0 + r.uniform(0.5, 4.0), gy0 + r.uniform(0.0, 1.5)
@@ -153,7 +163,7 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
         if k % 3 == 0:
             scene.cylinder((x, y), 0.0, 0.5, 0.35, material=planter_mat)
             potted_plant(scene, stream(seed, f"hall/props/plant{k}"), x=x, y=y, height=1.8, crown=0.5,
-                         min_leaf_z=0.9)
+                         min_leaf_z=0.9, leaf_glow=0.01)
         elif k % 3 == 1:
             scene.box((x - 0.9, y - 0.2, 0.4), (x + 0.9, y + 0.2, 0.46), bench)
             scene.box((x - 0.85, y - 0.2, 0.0), (x - 0.8, y + 0.2, 0.4), bench)
@@ -164,16 +174,23 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
             scene.box((x - 0.55, y - 0.02, 0.0), (x - 0.5, y + 0.02, 0.5), concrete)
             scene.box((x + 0.5, y - 0.02, 0.0), (x + 0.55, y + 0.02, 0.5), concrete)
 
-    # few fluorescent lamps: dim
+    # night: no daylight through the upper windows, only a few fluorescent lamps under the galleries
+    # are on (thesis 3.1: "the illumination is sparse because there are only few fluorescent lamps").
+    # Most of the hall is lit only by light bounced off the lit floor patches, so the bounce
+    # (ambient) term is weak and large parts of each panorama stay dark.
     r = stream(seed, "hall/lights")
     lamp = scene.material(albedo=0.7, emission=2.5)
+    fitting = scene.material(albedo=0.5)
     for k in range(6):
         y = ly * (k + 0.5) / 6 + r.uniform(-1, 1)
         for x in (gal_d + 0.8, lx - gal_d - 0.8):
-            if r.random() < 0.75:
-                scene.box((x - 0.6, y - 0.08, gal_z - 0.56), (x + 0.6, y + 0.08, gal_z - 0.5), lamp, shadow=False)
-                scene.add_light(PointLight((x, y, gal_z - 0.6), 9.0, downward=True))
-    scene.ambient = Ambient(up=0.22, down=0.14)
-    scene.exposure = 3.2
+            on = r.random() < LAMPS_ON
+            scene.box((x - 0.6, y - 0.08, gal_z - 0.56), (x + 0.6, y + 0.08, gal_z - 0.5), lamp if on else fitting,
+                      shadow=False)
+            if on:
+                scene.add_light(PointLight((x, y, gal_z - 0.6), LAMP_INTENSITY, downward=True))
+    scene.ambient = Ambient(up=AMBIENT[0], down=AMBIENT[1])
+    scene.exposure = EXPOSURE
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT, cells=cells, info={"room": (lx, ly, lz), "part": part})
+                 camera_height=CAMERA_HEIGHT, cells=cells, info={"room": (lx, ly, lz), "part": part},
+                 floor_tilt_deg=FLOOR_TILT_DEG)

@@ -25,6 +25,12 @@ from bionav.world.worlds.furniture import cabinet, chair, potted_plant, shelf, t
 GRID_SHAPE = (10, 17)
 SPACING = 0.3
 CAMERA_HEIGHT = 0.6
+#: Camera tilt std (degrees) on the lab's hard, level floor (mast sway only; World.floor_tilt_deg).
+FLOOR_TILT_DEG = 0.3
+#: Bounce light per band that is on, on upward / downward faces (relative to a band's direct light).
+AMBIENT_PER_BAND = (0.07, 0.045)
+#: Total intensity of one ceiling light band (four point emitters).
+BAND_INTENSITY = 6.5
 
 #: Variant name -> builder options (what the thesis says changed).
 LAB_VARIANTS: dict[str, dict] = {
@@ -185,7 +191,7 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
 
     # ---------------------------------------------------------------- lights
     r = stream(seed, "lab/lights")
-    band_intensity = 5.5
+    band_intensity = BAND_INTENSITY
     fixture_off = scene.material(texture=tx.stripes(r, n=4, lo=0.6, hi=0.9), albedo=0.8, scale=(1.2, 0.15))
     fixture_on = scene.material(texture=tx.stripes(r, n=4, lo=0.75, hi=1.0), albedo=0.8, emission=3.0,
                                 scale=(1.2, 0.15))
@@ -196,8 +202,13 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
         if on:
             scene.add_light(light_band((bx_, 1.2, lz - 0.07), (bx_, ly - 1.2, lz - 0.07), n=4,
                                        intensity=band_intensity))
+    # Inter-reflected light: the walls and ceiling near a band that is on are its main secondary
+    # source, so the bounce light is weak next to a band that is off. A uniform ambient term cannot
+    # say where, so it is kept small against the bands' direct light (which carries the shading
+    # and the hard shadows that differ between doorlit and winlit).
     n_on = int(door_band) + int(window_band)
-    scene.ambient = Ambient(up=0.22 * n_on + 0.25 * daylight, down=0.14 * n_on + 0.15 * daylight)
+    scene.ambient = Ambient(up=AMBIENT_PER_BAND[0] * n_on + 0.25 * daylight,
+                            down=AMBIENT_PER_BAND[1] * n_on + 0.15 * daylight)
     if daylight > 0 and curtains_open:
         for c in win_centres:  # diffuse daylight entering through each window
             scene.add_light(PointLight((lx - 0.3, c, 2.0), 1.0 * daylight, downward=False))
@@ -224,9 +235,9 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
             scene.cylinder((0.86, yy), 0.0, 0.85, 0.02, material=legs)
             scene.box((0.6, yy - 0.02, 0.0), (1.1, yy + 0.02, 0.04), legs)
 
-    scene.exposure = 1.6
+    scene.exposure = 2.4
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)})
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG)
 
 
 def build_lab_variant(variant: str, seed: int = 0) -> World:

@@ -23,11 +23,18 @@ from bionav.world.worlds.furniture import cabinet, chair, oriented_box, potted_p
 
 SPACING = 0.1
 CAMERA_HEIGHT = 0.6
+#: Clearance in metres between the outermost grid cells and the furniture next to the lanes.
+CLUTTER_GAP = 0.2
+#: Camera tilt std (degrees) in the living rooms: rugs, carpet pile and parquet edges under one wheel of
+#: the two-wheeled robot, mast sway (World.floor_tilt_deg).
+FLOOR_TILT_DEG = 2.0
+#: Contrast of the painted walls (texture value range; real painted walls are nearly uniform).
+WALL_TEXTURE = (0.7, 0.8)
 
 
 def _shell(scene: Scene, seed: int, lx: float, ly: float, lz: float, tag: str) -> None:
     r = stream(seed, f"{tag}/shell")
-    wall = scene.material(texture=tx.plaster(r, lo=0.6, hi=0.8), albedo=0.85, scale=1.3)
+    wall = scene.material(texture=tx.plaster(r, lo=WALL_TEXTURE[0], hi=WALL_TEXTURE[1]), albedo=0.85, scale=1.3)
     floor = scene.material(texture=tx.wood(r, rings=14), albedo=0.6, scale=(1.4, 0.9))
     ceiling = scene.material(texture=tx.plaster(r, lo=0.75, hi=0.85), albedo=0.9, scale=2.0)
     scene.box((0, 0, 0), (lx, ly, lz), [wall, wall, wall, wall, floor, ceiling], inside=True, shadow=False)
@@ -118,6 +125,21 @@ def build_living_room(seed: int = 0) -> World:
     potted_plant(scene, stream(seed, "living/plant"), x=lx - 0.45, y=0.45, height=1.4, crown=0.35,
                  min_leaf_z=0.7)
     _floor_lamp(scene, r, x=0.35, y=0.4)
+    # furniture right beside the lanes (thesis 3.1: a small grid in a furnished room): a
+    # dining corner east of the grid and a stool and a side table at its ends, 0.15-0.4 m from
+    # the outermost cells, so that near objects fill much of the view and their image moves
+    # and occludes the room behind them from one cell to the next.
+    rc = stream(seed, "living/clutter")
+    table(scene, rc, x0=gx1 + CLUTTER_GAP, y0=gy0 + 0.9, x1=gx1 + CLUTTER_GAP + 0.8, y1=gy0 + 1.9, height=0.74)
+    for cy, yaw in ((gy0 + 1.15, np.pi), (gy0 + 1.65, np.pi)):
+        chair(scene, rc, x=gx1 + CLUTTER_GAP + 1.05, y=cy, yaw=yaw)
+    chair(scene, rc, x=gx1 + CLUTTER_GAP + 0.4, y=gy0 + 0.6, yaw=np.pi / 2)
+    stool = scene.material(texture=tx.value_noise(rc, lo=0.2, hi=0.6), albedo=0.6, scale=0.3)
+    scene.cylinder((gx0 + 0.3, gy0 - CLUTTER_GAP - 0.2), 0.0, 0.45, 0.2, material=stool)
+    side = scene.material(texture=tx.wood(rc), albedo=0.5, scale=0.6)
+    scene.box((gx0 + 0.45, gy1 + CLUTTER_GAP, 0.0), (gx0 + 0.95, gy1 + CLUTTER_GAP + 0.4, 0.6), side)
+    basket = scene.material(texture=tx.stripes(rc, n=8, lo=0.2, hi=0.7), albedo=0.7, scale=(0.3, 0.2))
+    scene.frustum((gx0 - CLUTTER_GAP - 0.15, gy1 - 0.3), 0.0, 0.35, 0.15, 0.18, material=basket)
     rug = scene.material(texture=tx.poster(r, n_shapes=20), fit=True, albedo=0.7)
     scene.box((gx0 - 0.9, gy0 + 0.2, 0.0), (gx1 + 0.2, gy1 - 0.2, 0.012), rug, shadow=False)
     _window(scene, r, wall_x=None, wall_y=0.0, centre=lx * 0.6, width=1.4, lx=lx, ly=ly)
@@ -140,7 +162,7 @@ def build_living_room(seed: int = 0) -> World:
     scene.ambient = Ambient(up=0.3, down=0.2)
     scene.exposure = 1.5
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 22),
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)})
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG)
 
 
 def build_living_kitchen(seed: int = 0) -> World:
@@ -187,10 +209,12 @@ def build_living_kitchen(seed: int = 0) -> World:
     scene.cylinder((1.3, 0.08), 0.9, 1.2, 0.015, material=sink)
     # dining table with chairs between kitchen and living room, east of the grid
     rt = stream(seed, "kitchen/dining")
-    table(scene, rt, x0=gx1 + 0.45, y0=1.6, x1=gx1 + 1.35, y1=3.0, height=0.74, apron=True)
+    dx0 = gx1 + CLUTTER_GAP
+    table(scene, rt, x0=dx0, y0=1.6, x1=dx0 + 0.9, y1=3.0, height=0.74, apron=True)
     for cy in (1.9, 2.6):
-        chair(scene, rt, x=gx1 + 1.55, y=cy, yaw=np.pi)
-    chair(scene, rt, x=gx1 + 0.9, y=1.25, yaw=np.pi / 2)
+        chair(scene, rt, x=dx0 + 1.1, y=cy, yaw=np.pi)
+    chair(scene, rt, x=dx0 + 0.45, y=1.25, yaw=np.pi / 2)
+    chair(scene, rt, x=dx0 + 0.45, y=3.35, yaw=-np.pi / 2)
     # living room: sofa close along the west wall, shelf, TV, armchair
     r = stream(seed, "kitchen/living")
     _sofa(scene, r, x=0.4, y=gy0 + 3.5 + 0.2, yaw=0.0, width=2.0)
@@ -198,7 +222,9 @@ def build_living_kitchen(seed: int = 0) -> World:
     cabinet(scene, r, x0=lx - 0.45, y0=ly - 2.8, x1=lx, y1=ly - 1.2, height=0.55, facing="-x", doors=(3, 1))
     tv = scene.material(texture=tx.poster(r, n_shapes=8), fit=True, albedo=0.35)
     scene.box((lx - 0.3, ly - 2.5, 0.6), (lx - 0.25, ly - 1.5, 1.2), tv)
-    table(scene, r, x0=gx1 + 0.3, y0=gy1 - 0.6, x1=gx1 + 0.9, y1=gy1 + 0.3, height=0.45, apron=False)
+    table(scene, r, x0=gx1 + CLUTTER_GAP, y0=gy1 - 0.6, x1=gx1 + CLUTTER_GAP + 0.6, y1=gy1 + 0.3, height=0.45,
+          apron=False)
+    _sofa(scene, r, x=gx1 + CLUTTER_GAP + 1.2, y=gy1 - 0.15, yaw=np.pi, width=0.9)  # armchair facing the sofa
     potted_plant(scene, stream(seed, "kitchen/plant"), x=lx - 0.4, y=ly - 0.4, height=1.5, crown=0.35,
                  min_leaf_z=0.7)
     _floor_lamp(scene, r, x=0.35, y=ly - 0.5)
@@ -219,4 +245,4 @@ def build_living_kitchen(seed: int = 0) -> World:
     scene.ambient = Ambient(up=0.3, down=0.2)
     scene.exposure = 1.5
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)})
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG)

@@ -28,6 +28,12 @@ from bionav.world.worlds.furniture import tree
 GRID_SHAPE = (10, 17)
 SPACING = 1.0
 CAMERA_HEIGHT = 0.8
+#: Least distance in metres between a tree and the capture area (thesis 3.1: distant buildings and trees).
+TREE_CLEARANCE = 7.0
+#: Camera tilt std (degrees) of the four-wheeled robot on the paving (joints, kerbs, slope; World.floor_tilt_deg).
+FLOOR_TILT_DEG = 1.5
+#: Value range of the paving texture (worn grey slabs, low contrast in the building's shadow).
+PAVING_TEXTURE = (0.45, 0.6)
 
 
 def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
@@ -92,7 +98,7 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     gx0, gy0 = 0.0, 0.0
     # ground: paving slab with grass areas and an asphalt road
     r = stream(seed, "campus/ground")
-    paving = mat("paving", tx.tiles(r, n=4, lo=0.35, hi=0.65, grout_level=0.25), scale=2.0)
+    paving = mat("paving", tx.tiles(r, n=4, lo=PAVING_TEXTURE[0], hi=PAVING_TEXTURE[1], grout_level=0.4), scale=2.0)
     grass = mat("grass", tx.foliage(r), scale=1.5)
     asphalt = mat("asphalt", tx.carpet(r, lo=0.3, hi=0.6), scale=3.0)
     scene.box((-300, -300, -1.0), (300, 300, 0.0), paving, shadow=False)
@@ -137,7 +143,7 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     placed = 0
     while placed < 22:
         x, y = r.uniform(-40, 50), r.uniform(-4, 60)
-        if not free(x, y, 3.0) or (-64 < x < -34 and -6 < y < 24) or (36 < x < 60 and 2 < y < 36):
+        if not free(x, y, TREE_CLEARANCE) or (-64 < x < -34 and -6 < y < 24) or (36 < x < 60 and 2 < y < 36):
             continue
         conifer = r.random() < 0.3
         h = r.uniform(6, 14)
@@ -181,4 +187,4 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
                  camera_height=CAMERA_HEIGHT,
                  info={"sun_elevation": float(sun_elevation), "sun_azimuth": float(sun_azimuth),
-                       "channels": channels})
+                       "channels": channels}, floor_tilt_deg=FLOOR_TILT_DEG)

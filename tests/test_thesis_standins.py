@@ -1,0 +1,94 @@
+"""The ``standins`` item of ``python -m bionav.thesis`` (issue 18) on hand-made run results with known verdicts."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import replace
+
+import pytest
+
+from bionav.thesis.items import REGISTRY, Context
+from bionav.thesis.presets import PRESETS
+from bionav.thesis.reference import load_reference
+from bionav.thesis.runs import RunResult
+
+THESIS_SIFT = {"original": (1.0, 0.095), "hall1": (0.8961, 0.2112), "moeller1": (0.6267, 0.5509),
+               "roeben1": (0.6494, 0.3422), "uni": (0.624, 0.2899)}
+
+
+def _cross(path, names, rr):
+    path.mkdir(parents=True)
+    with open(path / "cross_db.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["measure", "snapshot_db", *names])
+        for n, row in zip(names, rr):
+            w.writerow(["rr", n, *row])
+
+
+def _ranking(path, db, ranks):
+    """A ranking_<db>.csv; ``ranks``: signature -> (rank, rr, invariant)."""
+    path.mkdir(parents=True)
+    with open(path / f"ranking_{db}.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, ["rank", "parameter", "rr", "aae", "rot_invariant"])
+        w.writeheader()
+        for sig, (rank, rr, inv) in ranks.items():
+            w.writerow({"rank": rank, "parameter": f"[{sig}]", "rr": rr, "aae": 0.5, "rot_invariant": inv})
+
+
+def _evaluate(tmp_path, *, sift_rr_offset=0.0, warp_hall=0.95, cross_warp=0.4, uni_best=0.6, swap_invariance=False):
+    preset = replace(PRESETS["tiny"], warping=("warping2d", "minwarping"), cross_db_homing=("sift", "warping2d"))
+    item = REGISTRY["standins"]
+    specs = item.runs(preset)
+    ref = load_reference()
+    results = {}
+    n_warp, n_cross = len(preset.warping), len(preset.cross_db_homing)
+    sift_specs, rest = specs[:5], specs[5:]
+    for spec, db in zip(sift_specs, THESIS_SIFT):
+        rr, aae = THESIS_SIFT[db]
+        results[spec.key] = RunResult(spec, tmp_path, {"status": "completed", "rr": rr + sift_rr_offset, "aae": aae,
+                                                        "mae": 0.1})
+    for spec in rest[:n_warp]:
+        results[spec.key] = RunResult(spec, tmp_path, {"status": "completed", "rr": warp_hall, "aae": 0.2, "mae": 0.1})
+    names = ["sim_original", "sim_doorlit", "sim_winlit"]
+    for k, (spec, h) in enumerate(zip(rest[n_warp:n_warp + n_cross], preset.cross_db_homing)):
+        v = 0.9 if h == "sift" else cross_warp
+        d = tmp_path / f"cross{k}"
+        _cross(d, names, [[1.0, 0.9, 0.9], [0.9, 1.0, v], [0.9, v, 1.0]])
+        results[spec.key] = RunResult(spec, d, {"status": "completed"})
+    for spec, db in zip(rest[n_warp + n_cross:], ("original", "hall1", "uni")):
+        rows = ref[f"table5_{5 + ('original', 'hall1', 'uni').index(db)}"]["ranking"]
+        ranks = {}
+        for rank, sig, rr, *_, inv in rows:
+            inv_flag = "y" if inv == "j" else "n"  # the thesis marks invariant signatures "j"
+            ranks[sig] = (rank, rr if db != "uni" else uni_best * rr / rows[0][2],
+                          inv_flag if not swap_invariance else ("y" if inv_flag == "n" else "n"))
+        d = tmp_path / f"param_{db}"
+        _ranking(d, db, ranks)
+        results[spec.key] = RunResult(spec, d, {"status": "completed"})
+    (tmp_path / "out").mkdir(exist_ok=True)
+    ctx = Context(preset=preset, out=tmp_path / "out", ref=ref.get("standins", {}), results=results, ref_id="standins")
+    out = item.evaluate(ctx, specs)
+    return {c.rule: c for c in out.checks}, {r.quantity: r for r in out.rows}, out
+
+
+def test_standins_checks_hold_on_thesis_like_results(tmp_path):
+    checks, rows, out = _evaluate(tmp_path)
+    assert out.missing == []
+    assert all(c.passed for c in checks.values()), [(r, c.detail) for r, c in checks.items() if not c.passed]
+    assert len(checks) == 2 + 2 + 1 + 3 + 1  # table 5.3 (2), hall1 (2 methods), fig. 5.6, invariance (3), uni
+    # the thesis' own ranking correlates perfectly with itself
+    assert rows["parameter homing hall1: Spearman rho of the ranking against the thesis"].bionav == pytest.approx(1.0)
+    assert rows["fig. 5.6 sift: mean RR* doorlit <-> winlit"].bionav == pytest.approx(0.9)
+    assert (tmp_path / "out" / "standins.md").is_file()
+
+
+def test_standins_checks_fail_where_the_stand_ins_disagree(tmp_path):
+    checks, _, _ = _evaluate(tmp_path, sift_rr_offset=0.15, warp_hall=0.85, cross_warp=0.85, uni_best=0.99,
+                             swap_invariance=True)
+    failed = {r for r, c in checks.items() if c.passed is False}
+    assert any("table 5.3: every database's RR*" in r for r in failed)
+    assert not any("table 5.3: every database's AAE*" in r for r in failed)
+    assert any("on hall1 above SIFT" in r for r in failed)
+    assert any("doorlit <-> winlit" in r for r in failed)
+    assert any("uni is the hardest" in r for r in failed)
+    assert any("rotation-invariant signatures ranked below" in r for r in failed)
