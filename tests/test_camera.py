@@ -36,7 +36,6 @@ from bionav.world.lights import Ambient, PointLight
 from bionav.world.render import render_panorama
 from bionav.world.scene import Scene
 
-
 REPO = Path(__file__).resolve().parents[1]
 
 # a camera without sensor effects: no blur, no vignetting, fixed exposure, (almost) no noise
@@ -267,7 +266,6 @@ def test_bad_camera_values_are_rejected_with_one_clear_message(override, words, 
 
 def test_documented_camera_sheet_command_on_a_tiny_input(tmp_path):
     import cv2
-
     from helpers import run_bionav
 
     proc = run_bionav("camera", "sim_uni", "--out", str(tmp_path / "sheets"), "--cells", "2", "db.image_size=[48,8]",
