@@ -889,6 +889,11 @@ def _lda_item(table: str, data: str):
                                             [got[crit].get(f) for f in FEATURES]))
             best = max(DUALS, key=lambda f: got["J"].get(f, -np.inf))
             t_best = max(DUALS, key=lambda f: ref["J"][f])
+            for crit in ("J", "J_sigma"):
+                order = sorted(DUALS, key=lambda f: -got[crit].get(f, -np.inf))
+                t_order = sorted(DUALS, key=lambda f: -ref[crit][f])
+                out.rows.append(Row(f"rank of {t_best} among the 10 dual contrasts in {crit}",
+                                    t_order.index(t_best) + 1, order.index(t_best) + 1))
             out.checks.append(Check(f"best dual-channel contrast in J is {t_best}", best == t_best, f"bionav: {best}"))
             if data == "sim_natural":
                 few = min(DUALS, key=lambda f: got["n_f"].get(f, np.inf))
