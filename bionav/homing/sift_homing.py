@@ -39,8 +39,8 @@ class ColumnIndex(NamedTuple):
     ----------
     x, y : ndarray, shape (N,), float64
         Columns (ascending) and rows, pixels.
-    descriptors : ndarray, shape (ceil(N / 4) * 4, 128), float32
-        Descriptors in sorted order, integers (zero rows pad to a multiple of 4).
+    descriptors : ndarray, shape (ceil(N / 8) * 8, 128), float32
+        Descriptors in sorted order, integers (zero rows pad to a multiple of 8, the kernels' group).
     sq_norms : ndarray, shape (N,), int64
         Squared descriptor norms.
     rank : ndarray, shape (N,), int64
@@ -325,6 +325,7 @@ def sift_home_angles_all_pairs(
     snapshot_index: Sequence[int] | None = None,
     workers: int = 1,
     progress: Callable[..., Iterable[Any]] | None = None,
+    on_row: Callable[[int, np.ndarray, np.ndarray], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """:func:`sift_home_vector` for every pair of one set of images, each distance computed once.
 
@@ -346,6 +347,10 @@ def sift_home_angles_all_pairs(
         Threads.
     progress : callable, optional
         ``progress(iterable, desc=..., total=...)``, e.g. a tqdm wrapper.
+    on_row : callable, optional
+        ``on_row(s, angles[s], n_used[s])`` is called in the caller's thread,
+        in ascending ``s``, as soon as snapshot row ``s`` is complete (so a
+        crash loses no finished row).
 
     Returns
     -------
@@ -384,18 +389,13 @@ def sift_home_angles_all_pairs(
         row_home_angles(a, np.arange(a + 1, n, dtype=np.int64), wanted, *joined, kp_off, desc_off, *options,
                         angles, used)
 
-    def task(first: int) -> None:
-        """Rows ``first`` and ``n - 1 - first``: n - 1 pairs together, so every task is equally long."""
-        row(first)
-        if n - 1 - first != first:
-            row(n - 1 - first)
-
-    n_tasks = (n + 1) // 2
+    # row a holds the pairs (a, b > a) of both directions, so snapshot row s is complete once rows 0 .. s are
     pool = ThreadPoolExecutor(max(1, int(workers)))
     try:
-        done = pool.map(task, range(n_tasks))
-        for _ in (progress(done, desc="home vectors (SIFT, pairs of rows)", total=n_tasks) if progress else done):
-            pass
+        done = pool.map(row, range(n))
+        for a, _ in enumerate(progress(done, desc="home vectors (SIFT rows)", total=n) if progress else done):
+            if on_row is not None and wanted[a]:
+                on_row(a, angles[a].copy(), used[a].copy())
     finally:  # on Ctrl-C or an error, rows not yet started are dropped instead of awaited
         pool.shutdown(wait=True, cancel_futures=True)
     return angles, used
