@@ -61,6 +61,35 @@ def test_bench_whole_runs_print_cpu_and_wall(capsys, tmp_path):
     assert row["cpu_s"] > 0 and row["wall_s"] > 0 and 0 < row["coverage"] <= 1
 
 
+def test_bench_sift_times_a_small_grid_per_variant(capsys):
+    argv = ["--method", "sift", "--json", "--images", "4", "--sift-size", "281", "41", "--threads", "2"]
+    assert main(argv) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(r["variant"], r["threads"]) for r in rows] == [("plain", 1), ("plain", 2), ("histeq", 1), ("histeq", 2)]
+    rows = rows[1::2]  # --threads 2 (each variant also timed with 1 worker, alternately)
+    for r in rows:
+        assert r["method"] == "sift" and r["threads"] == 2 and r["image"] == "281x41" and r["db"] == "sim_original"
+        assert r["workers_speedup"] > 0
+        assert r["n_images"] == 4 and r["n_pairs"] == 12 and r["rounds"] == 1
+        assert 0 < r["keypoints_per_image"]["min"] <= r["keypoints_per_image"]["mean"] <= r["keypoints_per_image"]["max"]
+        assert r["pairs_cpu_s"] > 0 and r["grid_wall_s"] >= r["pairs_wall_s"] > 0
+        assert r["cpu_ms_per_home_vector"] == pytest.approx(1e3 * r["pairs_cpu_s"] / 12, rel=0.01, abs=1e-3)
+    # histogram equalisation spreads the grey levels: more keypoints
+    assert rows[1]["keypoints_per_image"]["mean"] > rows[0]["keypoints_per_image"]["mean"]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--method", "sift", "--variants", "plain,nope"], "--variants must be a comma-separated list of plain, histeq"),
+    (["--method", "sift", "--images", "1"], "--images must be >= 2"),
+    (["--method", "sift", "--sift-size", "4", "41"], "--sift-size W H must lie in 8..8192"),
+])
+def test_bench_sift_rejects_bad_arguments(capsys, argv, message):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert message in capsys.readouterr().err
+
+
 def test_bench_grid_mode_times_the_grid_runner_with_1_and_2_workers(capsys, tmp_path, monkeypatch):
     monkeypatch.setenv("BIONAV_CACHE", str(tmp_path))
     argv = ["--json", "--grid", "sim_original", "--grid-snapshots", "2", "--grid-rounds", "1", "--threads", "2",

@@ -15,6 +15,7 @@ from bionav.db.camera import (
     camera_config_for,
     camera_images,
     camera_setup,
+    noise_rng,
     pose_error_config_for,
     pose_offsets,
     sensor_frame,
@@ -34,7 +35,6 @@ from bionav.world.catadioptric import MirrorProjection, raw_frame_layout, render
 from bionav.world.lights import Ambient, PointLight
 from bionav.world.render import render_panorama
 from bionav.world.scene import Scene
-
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -149,14 +149,16 @@ def test_vignetting_darkens_towards_the_rim():
 
 
 def test_pose_errors_have_the_stated_statistics():
-    offsets, headings = pose_offsets(40000, position_sigma_m=0.05, heading_sigma_deg=3.0, seed=7, db_seed=1)
+    cells = np.argwhere(np.ones((200, 100), bool))
+    offsets, headings = pose_offsets(cells, position_sigma_m=0.05, heading_sigma_deg=3.0, seed=7, db_seed=1)
     assert offsets.std(axis=0) == pytest.approx([0.05, 0.05], rel=0.02)
     assert np.abs(offsets.mean(axis=0)).max() < 0.002
     assert np.degrees(headings.std()) == pytest.approx(3.0, rel=0.02)
     assert abs(np.corrcoef(offsets[:, 0], headings)[0, 1]) < 0.02
-    again = pose_offsets(40000, position_sigma_m=0.05, heading_sigma_deg=3.0, seed=7, db_seed=1)
-    assert np.array_equal(again[0], offsets)
-    other = pose_offsets(10, position_sigma_m=0.05, heading_sigma_deg=3.0, seed=8, db_seed=1)
+    # a cell's error does not depend on the other cells rendered (contact sheets show the database's poses)
+    part = pose_offsets(cells[[5, 17000]], position_sigma_m=0.05, heading_sigma_deg=3.0, seed=7, db_seed=1)
+    assert np.array_equal(part[0], offsets[[5, 17000]]) and np.array_equal(part[1], headings[[5, 17000]])
+    other = pose_offsets(cells[:10], position_sigma_m=0.05, heading_sigma_deg=3.0, seed=8, db_seed=1)
     assert not np.array_equal(other[0], offsets[:10])
 
 
@@ -178,8 +180,8 @@ def test_camera_images_are_rendered_at_the_perturbed_poses():
         x, y, z = world.cell_position(i, j)
         pos = (x + poses2["offsets_m"][k, 0], y + poses2["offsets_m"][k, 1], z)
         rad = render_raw_frame(world.scene, position=pos, heading=poses2["heading_errors"][k], layout=setup.layout)
-        rng = np.random.default_rng(np.random.SeedSequence([0, 0x63616D65, k]))
-        assert np.array_equal(unfold_frame(sensor_frame(rad, setup, rng=rng), setup, geometry), moved[k])
+        raw = sensor_frame(rad, setup, rng=noise_rng(0, (i, j)))
+        assert np.array_equal(unfold_frame(raw, setup, geometry), moved[k])
 
 
 def test_camera_database_keeps_the_nominal_grid_and_caches(tmp_path):
@@ -264,7 +266,6 @@ def test_bad_camera_values_are_rejected_with_one_clear_message(override, words, 
 
 def test_documented_camera_sheet_command_on_a_tiny_input(tmp_path):
     import cv2
-
     from helpers import run_bionav
 
     proc = run_bionav("camera", "sim_uni", "--out", str(tmp_path / "sheets"), "--cells", "2", "db.image_size=[48,8]",

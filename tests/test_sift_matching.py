@@ -159,8 +159,29 @@ def test_grid_runner_batch_path_equals_per_pair_calls(rendered):
     db = ImageDatabase(name="lab5", images=np.stack(images), positions=positions, geometry=geometry,
                        grid_shape=(10, 17))
     method = SiftHoming(SiftConfig(), geometry=geometry)
-    batch = home_vector_matrix(method, db, workers=2, snapshot_index=[0, 2])
-    pairs = home_vector_matrix(method, db, workers=2, snapshot_index=[0, 2], batch=False)
+    streamed = []
+    batch = home_vector_matrix(method, db, workers=2, snapshot_index=[2, 0],
+                               on_row=lambda s, angles, compass: streamed.append((s, angles, compass)))
+    pairs = home_vector_matrix(method, db, workers=2, snapshot_index=[2, 0], batch=False)
     assert np.allclose(batch.angles, pairs.angles, atol=1e-12, equal_nan=True)
-    assert np.isnan(batch.angles[0, 0]) and np.isnan(batch.angles[1, 2])
+    assert np.isnan(batch.angles[1, 0]) and np.isnan(batch.angles[0, 2])
     assert np.sum(np.isfinite(batch.angles)) == 8
+    # each snapshot row reaches on_row once, as soon as it is complete (ascending index), with the final angles
+    assert [s for s, _, _ in streamed] == [0, 2]
+    assert np.array_equal(streamed[0][1], batch.angles[1], equal_nan=True)
+    assert np.array_equal(streamed[1][1], batch.angles[0], equal_nan=True)
+    assert all(np.all(np.isnan(compass)) for _, _, compass in streamed)
+
+
+def test_rows_are_handed_out_as_soon_as_complete(features):
+    geometry, feats = features
+    seen = []
+
+    def on_row(s, angles, used):
+        # row s needs the pairs (c, s) of rows c < s and its own; later rows are not finished yet
+        seen.append(s)
+        assert np.isnan(angles[s]) and np.all(np.isfinite(np.delete(angles, s))) and np.all(np.delete(used, s) > 0)
+
+    full, _ = sh.sift_home_angles_all_pairs(feats, geometry=geometry, search_radius=0.22 * geometry.width, workers=2,
+                                            on_row=on_row)
+    assert seen == list(range(len(feats)))

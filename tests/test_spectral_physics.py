@@ -12,6 +12,7 @@ from bionav.light.daylight import (
     GROUND_ALBEDO,
     SkyState,
     clear_sky_radiance,
+    cloud_fraction,
     diffuse_irradiance_bird,
     gas_transmittance,
     illumination,
@@ -186,3 +187,27 @@ def test_vegetation_red_edge_and_low_uv():
     for name in ("paint_white", "plastic_white"):
         assert MATERIALS[name].reflectance[0] < 0.1 < MATERIALS[name].reflectance[1]
     assert len(CHANNELS) == 5
+
+
+def test_a_scattered_cloud_cover_neither_hides_a_low_sun_nor_veils_the_horizon():
+    """A 10 % cover of thick clouds seen at grazing angles (footprints averaging many clouds) lets through the
+    clear fraction of the light, not exp(-(mean optical depth) m): the radiances are averaged, not the depths.
+
+    Known answers: direct beam ``(1 - f) + f exp(-tau m)`` of the clear beam, with ``f`` the cloud fraction of
+    the sun's footprint, which for a low sun tends to the cover (here within 0.1 of it); the sky at 3 degrees
+    elevation, averaged over azimuth, differs from the clear sky by at most the cloud fraction.
+    """
+    wl = np.array([350.0, 800.0])
+    clear = SkyState(np.deg2rad(7.4), np.deg2rad(150.0), turbidity=0.1)
+    cloudy = replace(clear, clouds=CloudLayer(cover=0.1, optical_depth=10.0, seed=0))
+    f = float(cloud_fraction(cloudy, cloudy.sun_direction))
+    assert 0.0 <= f <= 0.2
+    m = float(relative_air_mass(cloudy.sun_elevation))
+    want = illumination(clear, wl).direct_normal * ((1 - f) + f * np.exp(-10.0 * m))
+    np.testing.assert_allclose(illumination(cloudy, wl).direct_normal, want, rtol=1e-9)
+    assert np.all(illumination(cloudy, wl).direct_normal > 0.8 * illumination(clear, wl).direct_normal)
+    d = direction_from_angles(np.linspace(0, 2 * np.pi, 72, endpoint=False), np.deg2rad(3.0))
+    rel = sky_radiance(cloudy, d, wl).mean(axis=0) / clear_sky_radiance(clear, d, wl).mean(axis=0)
+    frac = float(cloud_fraction(cloudy, d).mean())
+    assert 0.0 < frac < 0.2
+    assert np.all(np.abs(rel - 1) <= frac), (rel, frac)

@@ -373,12 +373,12 @@ def _sift_rows(args, variants) -> list[dict]:
     from bionav.experiments.common import load_configured_database
     from bionav.plugins.homing.sift import SiftConfig, SiftHoming
 
-    w, h = args.sift_size
+    w_img, h_img = args.sift_size
     rows = []
     load = _start_load(args.background_load)
     try:
         for variant in variants:
-            overrides = ["experiment=grid_homing", "homing=sift", f"db={args.db}", f"db.image_size=[{w},{h}]",
+            overrides = ["experiment=grid_homing", "homing=sift", f"db={args.db}", f"db.image_size=[{w_img},{h_img}]",
                          f"preprocess={'he' if variant == 'histeq' else 'none'}"]
             try:
                 cfg = compose(overrides)
@@ -400,42 +400,48 @@ def _sift_rows(args, variants) -> list[dict]:
             keypoints = np.array([len(p.xy) for p in prepared])
             home_vector_matrix(method, db, workers=args.threads, prepared=(prepared, prepared),
                                snapshot_index=[0, 1])  # warm-up: compiled kernels
-            cpu, wall = [], []
-            for _ in range(args.repeat):
-                c0, t0 = time.process_time(), time.perf_counter()
-                hv = home_vector_matrix(method, db, workers=args.threads, prepared=(prepared, prepared))
-                cpu.append(time.process_time() - c0)
-                wall.append(time.perf_counter() - t0)
+            counts = sorted({1, args.threads})
+            cpu = {w: [] for w in counts}
+            wall = {w: [] for w in counts}
+            for _ in range(args.repeat):  # 1 worker and --threads workers alternately
+                for w in counts:
+                    c0, t0 = time.process_time(), time.perf_counter()
+                    hv = home_vector_matrix(method, db, workers=w, prepared=(prepared, prepared))
+                    cpu[w].append(time.process_time() - c0)
+                    wall[w].append(time.perf_counter() - t0)
             loadavg.append(os.getloadavg()[0])
             n = hv.n_pairs
-            rows.append({
-                "method": "sift",
-                "variant": variant,
-                "threads": args.threads,
-                "cpu_ms_per_home_vector": round(1e3 * float(np.median(cpu)) / n, 4),
-                "wall_ms_per_home_vector": round(1e3 * float(np.median(wall)) / n, 4),
-                "cpu_ms_min": round(1e3 * float(np.min(cpu)) / n, 4),
-                "wall_ms_min": round(1e3 * float(np.min(wall)) / n, 4),
-                "pairs_cpu_s": round(float(np.median(cpu)), 3),
-                "pairs_wall_s": round(float(np.median(wall)), 3),
-                "prepare_cpu_ms_per_image": round(1e3 * prep_cpu / len(db), 3),
-                "prepare_wall_s": round(prep_wall, 3),
-                "grid_cpu_s": round(prep_cpu + float(np.median(cpu)), 3),
-                "grid_wall_s": round(prep_wall + float(np.median(wall)), 3),
-                "db_load_s": round(load_s, 3),
-                "db": args.db,
-                "image": f"{w}x{h}",
-                "n_images": len(db),
-                "n_pairs": n,
-                "keypoints_per_image": {"mean": round(float(keypoints.mean()), 1), "min": int(keypoints.min()),
-                                        "max": int(keypoints.max())},
-                "search_radius": method.config.search_radius,
-                "combine": method.config.combine,
-                "rounds": args.repeat,
-                "background_load": args.background_load,
-                "loadavg_1min": [round(v, 2) for v in loadavg],
-                "machine": f"{platform.machine()} {os.cpu_count()} cpus",
-            })
+            for w in counts:
+                rows.append({
+                    "method": "sift",
+                    "variant": variant,
+                    "threads": w,
+                    "cpu_ms_per_home_vector": round(1e3 * float(np.median(cpu[w])) / n, 4),
+                    "wall_ms_per_home_vector": round(1e3 * float(np.median(wall[w])) / n, 4),
+                    "cpu_ms_min": round(1e3 * float(np.min(cpu[w])) / n, 4),
+                    "wall_ms_min": round(1e3 * float(np.min(wall[w])) / n, 4),
+                    "workers_speedup": round(float(np.median(np.asarray(wall[1]) / np.asarray(wall[w]))), 3),
+                    "pairs_cpu_s": round(float(np.median(cpu[w])), 6),
+                    "pairs_wall_s": round(float(np.median(wall[w])), 6),
+                    "prepare_threads": args.threads,
+                    "prepare_cpu_ms_per_image": round(1e3 * prep_cpu / len(db), 3),
+                    "prepare_wall_s": round(prep_wall, 3),
+                    "grid_cpu_s": round(prep_cpu + float(np.median(cpu[w])), 3),
+                    "grid_wall_s": round(prep_wall + float(np.median(wall[w])), 3),
+                    "db_load_s": round(load_s, 3),
+                    "db": args.db,
+                    "image": f"{w_img}x{h_img}",
+                    "n_images": len(db),
+                    "n_pairs": n,
+                    "keypoints_per_image": {"mean": round(float(keypoints.mean()), 1), "min": int(keypoints.min()),
+                                            "max": int(keypoints.max())},
+                    "search_radius": method.config.search_radius,
+                    "combine": method.config.combine,
+                    "rounds": args.repeat,
+                    "background_load": args.background_load,
+                    "loadavg_1min": [round(v, 2) for v in loadavg],
+                    "machine": f"{platform.machine()} {os.cpu_count()} cpus",
+                })
     finally:
         _stop_load(load)
     return rows
@@ -447,11 +453,12 @@ def _print_sift(rows: list[dict], args) -> int:
             print(json.dumps(row))
         return 0
     header = ("variant", "image", "images", "keypoints/image", "threads", "grid wall s", "grid CPU s",
-              "SIFT CPU ms/image", "pairs wall s", "pairs CPU s", "CPU ms/hv", "db load s")
+              "SIFT CPU ms/image", "pairs wall s", "pairs CPU s", "CPU ms/hv", "speedup", "db load s")
     cells = [(r["variant"], r["image"], str(r["n_images"]), f"{r['keypoints_per_image']['mean']:.0f}",
               str(r["threads"]), f"{r['grid_wall_s']:.1f}", f"{r['grid_cpu_s']:.1f}",
               f"{r['prepare_cpu_ms_per_image']:.1f}", f"{r['pairs_wall_s']:.1f}", f"{r['pairs_cpu_s']:.1f}",
-              f"{r['cpu_ms_per_home_vector']:.3f}", f"{r['db_load_s']:.1f}") for r in rows]
+              f"{r['cpu_ms_per_home_vector']:.3f}", f"{r['workers_speedup']:.2f}", f"{r['db_load_s']:.1f}")
+             for r in rows]
     widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
     line = lambda cs: "| " + " | ".join(c.ljust(w) for c, w in zip(cs, widths)) + " |"  # noqa: E731
     print(line(header))

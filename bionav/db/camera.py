@@ -45,7 +45,7 @@ from bionav.geometry import PanoramaGeometry
 from bionav.world.catadioptric import MirrorProjection, RawFrameLayout, raw_frame_layout, render_raw_frame
 
 #: Bump whenever a change to the camera pipeline changes pixels (part of the cache key).
-CAMERA_VERSION = 1
+CAMERA_VERSION = 2
 
 #: The two mirrors of thesis 3.1 (Accowle Ltd.): the rim elevation is the upper limit of the field
 #: of view (thesis: about 26-46 deg for the ultra-wide-view mirror, 10-26 deg for the normal-view
@@ -93,14 +93,17 @@ def pose_error_config_for(kind: str, **overrides) -> PoseErrorConfig:
     return PoseErrorConfig(**{**POSE_ERRORS[kind], **overrides})
 
 
-def pose_offsets(n: int, *, position_sigma_m: float, heading_sigma_deg: float, seed: int,
+def pose_offsets(cells, *, position_sigma_m: float, heading_sigma_deg: float, seed: int,
                  db_seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Gaussian capture-pose errors of ``n`` images.
+    """Gaussian capture-pose errors of the images at grid ``cells``.
+
+    The error of a cell depends only on the cell and the seeds, not on which
+    other cells are rendered (a contact sheet shows the database's poses).
 
     Parameters
     ----------
-    n : int
-        Number of images.
+    cells : array_like, shape (N, 2), int
+        Grid cells ``(i, j)``.
     position_sigma_m : float
         Standard deviation of the position error per axis, metres.
     heading_sigma_deg : float
@@ -110,22 +113,33 @@ def pose_offsets(n: int, *, position_sigma_m: float, heading_sigma_deg: float, s
 
     Returns
     -------
-    offsets : ndarray, shape (n, 2)
+    offsets : ndarray, shape (N, 2)
         ``(dx, dy)`` in metres, world frame.
-    headings : ndarray, shape (n,)
+    headings : ndarray, shape (N,)
         Heading errors in radians (counter-clockwise).
     """
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF,
-                                                        0x706F7365]))
-    draw = rng.standard_normal((int(n), 3))
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    draw = np.empty((len(cells), 3))
+    for k, (i, j) in enumerate(cells):
+        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF,
+                                                            0x706F7365, int(i), int(j)]))
+        draw[k] = rng.standard_normal(3)
     return draw[:, :2] * float(position_sigma_m), draw[:, 2] * math.radians(float(heading_sigma_deg))
 
 
-def tilt_offsets(n: int, *, tilt_sigma_deg: float, seed: int, db_seed: int = 0) -> np.ndarray:
-    """Gaussian camera tilts of ``n`` captures (uneven floor, mast sway; :attr:`World.floor_tilt_deg`).
+def noise_rng(seed: int, cell) -> np.random.Generator:
+    """The generator of the sensor noise of the image at grid ``cell = (i, j)`` (``seed`` = ``db.seed``)."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x63616D65, int(cell[0]),
+                                                         int(cell[1])]))
 
-    Drawn from their own random stream, so the position and heading errors of
-    :func:`pose_offsets` do not depend on them.
+
+def tilt_offsets(cells, *, tilt_sigma_deg: float, seed: int, db_seed: int = 0) -> np.ndarray:
+    """Gaussian camera tilts of the captures at grid ``cells`` (N, 2) (uneven floor, mast sway;
+    :attr:`World.floor_tilt_deg`).
+
+    Drawn per cell from their own random stream, so the position and heading
+    errors of :func:`pose_offsets` do not depend on them, nor a cell's tilt on
+    the other cells rendered.
 
     Returns
     -------
@@ -133,9 +147,13 @@ def tilt_offsets(n: int, *, tilt_sigma_deg: float, seed: int, db_seed: int = 0) 
         ``(t_a, t_b)`` in radians: a view at panorama azimuth ``phi`` (column
         angle) is raised by ``t_a cos(phi) + t_b sin(phi)`` (small-angle tilt).
     """
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF,
-                                                        0x74696C74]))
-    return rng.standard_normal((int(n), 2)) * math.radians(float(tilt_sigma_deg))
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    draw = np.empty((len(cells), 2))
+    for k, (i, j) in enumerate(cells):
+        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF,
+                                                            0x74696C74, int(i), int(j)]))
+        draw[k] = rng.standard_normal(2)
+    return draw * math.radians(float(tilt_sigma_deg))
 
 
 def resolve_pose_error(pose_error: PoseErrorConfig, world) -> PoseErrorConfig:
@@ -303,8 +321,8 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     camera : CameraConfig
     pose_error : PoseErrorConfig
     seed : int
-        ``db.seed``; seeds the sensor noise (per image) and, with
-        ``pose_error.seed``, the pose errors.
+        ``db.seed``; seeds the sensor noise (per cell, :func:`noise_rng`) and,
+        with ``pose_error.seed``, the pose errors (per cell, :func:`pose_offsets`).
     native_size : (int, int)
         The stand-in's native panorama size (see :func:`camera_setup`).
     progress : callable, optional
@@ -324,10 +342,10 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     """
     pose_error = resolve_pose_error(pose_error, world)
     n = len(positions)
-    offsets, dheads = pose_offsets(n, position_sigma_m=float(pose_error.position_sigma_m),
+    offsets, dheads = pose_offsets(positions, position_sigma_m=float(pose_error.position_sigma_m),
                                    heading_sigma_deg=float(pose_error.heading_sigma_deg),
                                    seed=int(pose_error.seed), db_seed=int(seed))
-    tilts = tilt_offsets(n, tilt_sigma_deg=float(pose_error.tilt_sigma_deg), seed=int(pose_error.seed),
+    tilts = tilt_offsets(positions, tilt_sigma_deg=float(pose_error.tilt_sigma_deg), seed=int(pose_error.seed),
                          db_seed=int(seed))
     setup = camera_setup(camera, geometry, native_size=native_size,
                          tilt_margin=float(np.abs(tilts).sum(axis=1).max(initial=0.0)))
@@ -342,8 +360,7 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
         x, y, z = world.cell_position(i, j)
         radiance = render_raw_frame(world.scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
                                     heading=float(dheads[k]), layout=setup.layout, threads=threads)
-        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x63616D65, int(k)]))
-        raw = sensor_frame(radiance, setup, rng=rng)
+        raw = sensor_frame(radiance, setup, rng=noise_rng(seed, (i, j)))
         out[k] = unfold_frame(raw, setup, geometry, tilt=tilts[k])
         if raws is not None:
             raws[k] = raw

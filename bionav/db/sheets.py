@@ -171,7 +171,9 @@ def camera_sheet(name: str, *, camera, pose_error, seed: int = 0, image_size=Non
     for k, (i, j) in enumerate(positions):
         dx, dy = poses["offsets_m"][k] * 100.0
         dh = np.degrees(poses["heading_errors"][k])
-        for label, img in ((f"camera {i},{j} (pose error {dx:+.1f}, {dy:+.1f} cm, {dh:+.1f} deg)", images[k]),
+        tilt = np.degrees(np.hypot(*poses["tilts"][k])) if "tilts" in poses else 0.0
+        for label, img in ((f"camera {i},{j} (pose error {dx:+.1f}, {dy:+.1f} cm, heading {dh:+.1f} deg, "
+                            f"tilt {tilt:.1f} deg)", images[k]),
                            (f"ideal {i},{j}", ideal[k])):
             cv2.putText(sheet, label, (gap, top + lh - 4), font, 0.4, 0, 1, cv2.LINE_AA)
             pano = cv2.resize(grey(img), (pano_w, pano_h), interpolation=cv2.INTER_NEAREST if pano_w >= w

@@ -165,15 +165,15 @@ def home_vector_matrix(
     n_pairs = int(np.sum(~np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)))
     all_pairs = None
     if batch and same:
+        options = _batch_options(method, snapshot_index=s_idx, workers=workers, progress=progress, on_row=on_row)
         all_pairs = method.all_pairs_angles(
-            cur_prep, headings=currents.headings, neighbours=neighbour_table(currents),
-            **_batch_options(method, snapshot_index=s_idx, workers=workers, progress=progress),
+            cur_prep, headings=currents.headings, neighbours=neighbour_table(currents), **options,
         )
     if all_pairs is not None:
         angles = np.array(all_pairs, dtype=np.float64)[s_idx]
         angles[np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)] = np.nan
         t2 = time.perf_counter()
-        if on_row is not None:
+        if on_row is not None and "on_row" not in options:  # a method that streams rows has called it already
             no_compass = np.full(len(currents), np.nan)
             for row_angles, si in zip(angles, s_idx):
                 on_row(int(si), row_angles, no_compass)

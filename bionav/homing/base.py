@@ -138,8 +138,11 @@ class HomingMethod:
 
         A method may also accept the keywords ``snapshot_index`` (sequence of
         int: only these rows are needed), ``workers`` (int: threads it may use)
-        and ``progress`` (a ``progress(iterable, desc=..., total=...)``
-        wrapper); the runner passes those its signature names.
+        ``progress`` (a ``progress(iterable, desc=..., total=...)``
+        wrapper) and ``on_row`` (the runner's ``on_row(s, angles, compass)``,
+        to be called in the caller's thread as soon as snapshot row ``s`` is
+        complete; then the runner does not call it); the runner passes those
+        its signature names.
 
         Returns
         -------

@@ -39,8 +39,8 @@ class ColumnIndex(NamedTuple):
     ----------
     x, y : ndarray, shape (N,), float64
         Columns (ascending) and rows, pixels.
-    descriptors : ndarray, shape (ceil(N / 4) * 4, 128), float32
-        Descriptors in sorted order, integers (zero rows pad to a multiple of 4).
+    descriptors : ndarray, shape (ceil(N / 8) * 8, 128), float32
+        Descriptors in sorted order, integers (zero rows pad to a multiple of 8, the kernels' group).
     sq_norms : ndarray, shape (N,), int64
         Squared descriptor norms.
     rank : ndarray, shape (N,), int64
@@ -325,6 +325,7 @@ def sift_home_angles_all_pairs(
     snapshot_index: Sequence[int] | None = None,
     workers: int = 1,
     progress: Callable[..., Iterable[Any]] | None = None,
+    on_row: Callable[[int, np.ndarray, np.ndarray], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """:func:`sift_home_vector` for every pair of one set of images, each distance computed once.
 
@@ -346,6 +347,10 @@ def sift_home_angles_all_pairs(
         Threads.
     progress : callable, optional
         ``progress(iterable, desc=..., total=...)``, e.g. a tqdm wrapper.
+    on_row : callable, optional
+        ``on_row(s, angles[s], n_used[s])`` is called in the caller's thread,
+        in ascending ``s``, as soon as snapshot row ``s`` is complete (so a
+        crash loses no finished row).
 
     Returns
     -------
@@ -360,7 +365,7 @@ def sift_home_angles_all_pairs(
     """
     from concurrent.futures import ThreadPoolExecutor
 
-    from bionav.homing.sift_kernels import home_angle_from_keys, match_sorted
+    from bionav.homing.sift_kernels import row_home_angles
 
     if combine not in ("average", "max"):
         raise ValueError(f"unknown combination method {combine!r}; use 'average' or 'max'")
@@ -372,33 +377,25 @@ def sift_home_angles_all_pairs(
     wanted[np.arange(n) if snapshot_index is None else np.asarray(snapshot_index, dtype=np.int64)] = True
     angles = np.full((n, n), np.nan)
     used = np.zeros((n, n), np.int64)
-    geo = (geometry.rad_per_column, float(geometry.horizon_row), float(geometry.rad_per_row), MIN_ELEVATION,
-           combine == "max", N_BINS, int(window))
-    radius, width = float(search_radius), float(geometry.width)
+    # every image's sorted keypoints in one set of arrays: one compiled call per row, no GIL per pair
+    kp_off = np.concatenate([[0], np.cumsum([len(ix.x) for ix in index])]).astype(np.int64)
+    desc_off = np.concatenate([[0], np.cumsum([len(ix.descriptors) for ix in index])]).astype(np.int64)
+    joined = [np.concatenate([getattr(ix, name) for ix in index]) if n else np.zeros(0)
+              for name in ("x", "y", "descriptors", "sq_norms", "rank", "where")]
+    options = (float(search_radius), float(geometry.width), geometry.rad_per_column, float(geometry.horizon_row),
+               float(geometry.rad_per_row), MIN_ELEVATION, combine == "max", N_BINS, int(window))
 
     def row(a: int) -> None:
-        ia = index[a]
-        key_a = np.empty(len(ia.x), np.int64)
-        for b in range(a + 1, n):
-            if not (wanted[a] or wanted[b]):
-                continue
-            ib = index[b]
-            key_b = np.empty(len(ib.x), np.int64)
-            match_sorted(ia.x, ia.y, ia.descriptors, ia.sq_norms, ia.rank, ib.x, ib.y, ib.descriptors,
-                         ib.sq_norms, ib.rank, radius, width, key_a, key_b, bool(wanted[a]))
-            if wanted[b]:  # a is the current view, b the snapshot
-                angles[b, a], used[b, a] = home_angle_from_keys(key_a, ia.x, ia.y, ia.where, ib.x, ib.y, ib.where,
-                                                                *geo)
-            if wanted[a]:
-                angles[a, b], used[a, b] = home_angle_from_keys(key_b, ib.x, ib.y, ib.where, ia.x, ia.y, ia.where,
-                                                                *geo)
+        row_home_angles(a, np.arange(a + 1, n, dtype=np.int64), wanted, *joined, kp_off, desc_off, *options,
+                        angles, used)
 
-    # rows of small ``a`` hold the most pairs: handed out first
+    # row a holds the pairs (a, b > a) of both directions, so snapshot row s is complete once rows 0 .. s are
     pool = ThreadPoolExecutor(max(1, int(workers)))
     try:
         done = pool.map(row, range(n))
-        for _ in (progress(done, desc="home vectors (SIFT pairs)", total=n) if progress else done):
-            pass
+        for a, _ in enumerate(progress(done, desc="home vectors (SIFT rows)", total=n) if progress else done):
+            if on_row is not None and wanted[a]:
+                on_row(a, angles[a].copy(), used[a].copy())
     finally:  # on Ctrl-C or an error, rows not yet started are dropped instead of awaited
         pool.shutdown(wait=True, cancel_futures=True)
     return angles, used

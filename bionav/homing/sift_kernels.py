@@ -3,11 +3,13 @@
 Keypoints of each image are sorted by column once; for a group of eight
 neighbouring current keypoints only the snapshot keypoints whose columns lie
 within the search radius of the group (two contiguous index ranges at most on
-the circular panorama) are visited, and the exact neighbourhood test decides.
-Descriptor distances are exact integers: OpenCV SIFT descriptors are integers
-in 0..255, so ``|d_c|^2 + |d_s|^2 - 2 d_c . d_s`` is computed
-(float32 products and sums of such integers stay exact) without rounding. Ties in the distance go to the snapshot keypoint with the
-lowest original index (as ``numpy.argmin`` over the original order does).
+the circular panorama) are visited, and the exact neighbourhood test decides
+(skipped in the "core" columns, where every keypoint is inside for sure).
+Descriptor distances are exact: OpenCV SIFT descriptors are integers in
+0..255, and float32 products and sums of such integers stay exact (every
+partial sum is below 2**24), so ``|d_s|^2 - 2 d_c . d_s`` is an exact
+integer. Ties in the distance go to the snapshot keypoint with the lowest
+original index (as ``numpy.argmin`` over the original order does).
 
 The public functions are in :mod:`bionav.homing.sift_homing`; nothing here is
 meant to be called directly.
@@ -62,6 +64,78 @@ def _dot8(da, g0, db, j):
         a7 += da[g0 + 7, k] * bk
     return (np.int32(a0), np.int32(a1), np.int32(a2), np.int32(a3), np.int32(a4), np.int32(a5), np.int32(a6),
             np.int32(a7))
+
+
+@nb.njit(nogil=True, cache=True, fastmath={"reassoc", "contract"})
+def _dot8x2(da, g0, db, j):
+    """:func:`_dot8` for b descriptors ``j`` and ``j + 1`` (first the 8 products with ``j``), exact likewise."""
+    a0 = a1 = a2 = a3 = a4 = a5 = a6 = a7 = np.float32(0.0)
+    c0 = c1 = c2 = c3 = c4 = c5 = c6 = c7 = np.float32(0.0)
+    for k in range(da.shape[1]):
+        bk = db[j, k]
+        ck = db[j + 1, k]
+        x0 = da[g0, k]
+        x1 = da[g0 + 1, k]
+        x2 = da[g0 + 2, k]
+        x3 = da[g0 + 3, k]
+        x4 = da[g0 + 4, k]
+        x5 = da[g0 + 5, k]
+        x6 = da[g0 + 6, k]
+        x7 = da[g0 + 7, k]
+        a0 += x0 * bk
+        a1 += x1 * bk
+        a2 += x2 * bk
+        a3 += x3 * bk
+        a4 += x4 * bk
+        a5 += x5 * bk
+        a6 += x6 * bk
+        a7 += x7 * bk
+        c0 += x0 * ck
+        c1 += x1 * ck
+        c2 += x2 * ck
+        c3 += x3 * ck
+        c4 += x4 * ck
+        c5 += x5 * ck
+        c6 += x6 * ck
+        c7 += x7 * ck
+    return (np.int32(a0), np.int32(a1), np.int32(a2), np.int32(a3), np.int32(a4), np.int32(a5), np.int32(a6),
+            np.int32(a7), np.int32(c0), np.int32(c1), np.int32(c2), np.int32(c3), np.int32(c4), np.int32(c5),
+            np.int32(c6), np.int32(c7))
+
+
+@nb.njit(nogil=True, cache=True, fastmath={"reassoc", "contract"})
+def _dot4x4(da, g0, db, j):
+    """Products of a-descriptors ``g0 .. g0 + 3`` with b-descriptors ``j .. j + 3`` (b-major), exact likewise."""
+    a0 = a1 = a2 = a3 = b0 = b1 = b2 = b3 = np.float32(0.0)
+    c0 = c1 = c2 = c3 = d0 = d1 = d2 = d3 = np.float32(0.0)
+    for k in range(da.shape[1]):
+        x0 = da[g0, k]
+        x1 = da[g0 + 1, k]
+        x2 = da[g0 + 2, k]
+        x3 = da[g0 + 3, k]
+        p = db[j, k]
+        q = db[j + 1, k]
+        r = db[j + 2, k]
+        s = db[j + 3, k]
+        a0 += x0 * p
+        a1 += x1 * p
+        a2 += x2 * p
+        a3 += x3 * p
+        b0 += x0 * q
+        b1 += x1 * q
+        b2 += x2 * q
+        b3 += x3 * q
+        c0 += x0 * r
+        c1 += x1 * r
+        c2 += x2 * r
+        c3 += x3 * r
+        d0 += x0 * s
+        d1 += x1 * s
+        d2 += x2 * s
+        d3 += x3 * s
+    return (np.int32(a0), np.int32(a1), np.int32(a2), np.int32(a3), np.int32(b0), np.int32(b1), np.int32(b2),
+            np.int32(b3), np.int32(c0), np.int32(c1), np.int32(c2), np.int32(c3), np.int32(d0), np.int32(d1),
+            np.int32(d2), np.int32(d3))
 
 
 @nb.njit(nogil=True, cache=True)
@@ -126,7 +200,21 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
         for seg in range(2):
             start = s0 if seg == 0 else s1
             stop = e0 if seg == 0 else e1
-            for j in range(start, stop):
+            j = start
+            while j + 3 < stop:  # 4 x 4 tiles: each row load serves four products
+                for h in range(0, GROUP, 4):
+                    t16 = _dot4x4(da, g0 + h, db, j)
+                    for u in range(4):
+                        for t in range(4):
+                            buf[h + t, j + u] = t16[4 * u + t]
+                j += 4
+            while j + 1 < stop:
+                t16 = _dot8x2(da, g0, db, j)
+                for t in range(GROUP):
+                    buf[t, j] = t16[t]
+                    buf[t, j + 1] = t16[GROUP + t]
+                j += 2
+            if j < stop:
                 t8 = _dot8(da, g0, db, j)
                 for t in range(GROUP):
                     buf[t, j] = t8[t]
@@ -295,3 +383,39 @@ def home_angle_from_keys(keys, cur_x, cur_y, cur_where, snap_x, snap_y, snap_whe
             return np.nan, m
         angle = np.arctan2(vy, vx)
     return (angle + np.pi) % _TWO_PI - np.pi, m
+
+
+@nb.njit(nogil=True, cache=True)
+def row_home_angles(a, others, wanted, x, y, desc, norms, rank, where, kp_off, desc_off, radius, width,
+                    rad_per_column, horizon_row, rad_per_row, min_elevation, combine_max, n_bins, window,
+                    angles, used):
+    """Home angles between image ``a`` and each image of ``others``, both directions where ``wanted``.
+
+    All images' column-sorted keypoints are concatenated (``kp_off``,
+    ``desc_off``: start of each image, length N + 1). ``angles[s, c]`` and
+    ``used[s, c]`` are written for snapshot ``s`` and current view ``c``
+    when ``wanted[s]``; one distance pass serves both directions.
+    """
+    a0, a1 = kp_off[a], kp_off[a + 1]
+    da = desc[desc_off[a]:desc_off[a + 1]]
+    key_a = np.empty(a1 - a0, np.int64)
+    for b in others:
+        if not (wanted[a] or wanted[b]):
+            continue
+        b0, b1 = kp_off[b], kp_off[b + 1]
+        key_b = np.empty(b1 - b0, np.int64)
+        match_sorted(x[a0:a1], y[a0:a1], da, norms[a0:a1], rank[a0:a1], x[b0:b1], y[b0:b1],
+                     desc[desc_off[b]:desc_off[b + 1]], norms[b0:b1], rank[b0:b1], radius, width, key_a, key_b,
+                     wanted[a])
+        if wanted[b]:  # a is the current view, b the snapshot
+            angle, n = home_angle_from_keys(key_a, x[a0:a1], y[a0:a1], where[a0:a1], x[b0:b1], y[b0:b1],
+                                            where[b0:b1], rad_per_column, horizon_row, rad_per_row, min_elevation,
+                                            combine_max, n_bins, window)
+            angles[b, a] = angle
+            used[b, a] = n
+        if wanted[a]:
+            angle, n = home_angle_from_keys(key_b, x[b0:b1], y[b0:b1], where[b0:b1], x[a0:a1], y[a0:a1],
+                                            where[a0:a1], rad_per_column, horizon_row, rad_per_row, min_elevation,
+                                            combine_max, n_bins, window)
+            angles[a, b] = angle
+            used[a, b] = n

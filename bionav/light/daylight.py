@@ -54,7 +54,12 @@ clear noon sky down to the low evening sun:
   while cloud cover *flattens* the sky spectrum relative to the blue sky.
 * **Spatial clouds**: a cloud layer at height ``cloud_height_m`` carrying a
   smooth random field (sum of random plane waves), thresholded to the requested
-  cover fraction, drifting with the wind (see :class:`CloudLayer`).
+  cover fraction, drifting with the wind (see :class:`CloudLayer`). A line of
+  sight whose footprint on the layer spans several clouds sees their *fraction*
+  ``f`` (:func:`cloud_fraction`), each of the full optical depth: radiances and
+  the direct beam are averaged over the footprint (``(1 - f) + f exp(-tau m)``),
+  not computed from the footprint's mean optical depth, which would hide a low
+  sun behind a 10 % cover (``1 - exp(-x)`` is concave).
 
 Frames: directions are unit vectors in a local east-north-up frame (x east,
 y north, z up). Azimuths in this module are radians counter-clockwise from
@@ -368,6 +373,36 @@ def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_N
     return single + scale * -np.expm1(-tau * m_v)
 
 
+def cloud_fraction(state: SkyState, directions, *, origin_m=(0.0, 0.0)) -> np.ndarray:
+    """Fraction of each line of sight's footprint on the cloud layer that is cloud, shape ``(...)``, in [0, 1].
+
+    :meth:`bionav.light.clouds.CloudLayer.optical_depth_at` returns the layer's
+    optical depth times the cloud density of the footprint (anti-aliased:
+    distant, oblique footprints average many clouds and tend to the cover
+    fraction); this is that density. Zero for a layer of zero optical depth.
+
+    Parameters
+    ----------
+    state : SkyState
+        Its ``clouds`` layer and ``time_s`` (drift).
+    directions : array_like, shape (..., 3)
+        Unit viewing directions (east-north-up).
+    origin_m : tuple of float
+        Observer position (east, north) in metres.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Cloud fraction in [0, 1].
+    """
+    depth = float(state.clouds.optical_depth)
+    d = np.asarray(directions, dtype=float)
+    if state.clouds.cover <= 0 or depth <= 0:
+        return np.zeros(d.shape[:-1])
+    tau = state.clouds.optical_depth_at(d, time_s=state.time_s, origin_m=origin_m)
+    return np.clip(tau / depth, 0.0, 1.0)
+
+
 def _cloud_transmittance(tau_c):
     return 1.0 / (1.0 + 0.75 * (1 - _CLOUD_G) * np.asarray(tau_c, dtype=float))
 
@@ -376,20 +411,26 @@ def sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM, *, 
     """Spectral sky radiance with clouds, W m^-2 sr^-1 nm^-1, shape ``(..., L)``.
 
     Cloud-free lines of sight get :func:`clear_sky_radiance`; cloudy ones the
-    grey cloud radiance of the module docstring, blended by the cloud's opacity
-    ``1 - exp(-tau_c / 2)``.
+    grey cloud radiance of the module docstring. A line of sight sees the
+    fraction ``f`` of its footprint covered by cloud (:func:`cloud_fraction`),
+    each cloud of the layer's full optical depth ``tau``; the radiances are
+    averaged over the footprint: ``(1 - f o) L_clear + f o L_cloud`` with the
+    opacity ``o = 1 - exp(-tau / 2)`` of one cloud (averaging the optical depth
+    first would turn a distant 10 % cover into a uniform veil of a tenth of the
+    depth, far more opaque on average: ``1 - exp(-x)`` is concave).
     """
     wl = np.asarray(wavelengths_nm, dtype=float)
     d = np.asarray(directions, dtype=float)
     clear = clear_sky_radiance(state, d, wl)
     if state.clouds.cover <= 0:
         return clear
-    tau_c = state.clouds.optical_depth_at(d, time_s=state.time_s, origin_m=origin_m)[..., None]
-    opacity = -np.expm1(-0.5 * tau_c)
+    frac = cloud_fraction(state, d, origin_m=origin_m)[..., None]
+    depth = float(state.clouds.optical_depth)
+    opacity = frac * -np.expm1(-0.5 * depth)
     tr, ta = _optical_depths(state, wl)
     mu_s = max(np.sin(state.sun_elevation), 0.0)
     e_top = solar_spectrum(wl) * _sun_transmittance(state, wl, rayleigh=0.8, aerosol=0.3)
-    t_c = _cloud_transmittance(tau_c)
+    t_c = _cloud_transmittance(depth)
     sides = (1.0 - state.clouds.cover) * (1.0 - t_c)
     base = e_top * mu_s * (t_c + sides) / np.pi
     below = 0.2 * clear  # the air between the observer and the cloud base
@@ -449,8 +490,10 @@ def illumination(state: SkyState, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.
 
     The diffuse part integrates :func:`sky_radiance` over the upper hemisphere
     (midpoint rule, ``n_elevation x n_azimuth`` cells, cosine weighted), so it
-    is consistent with what a sensor pointed at the sky sees. The direct beam is
-    attenuated by the cloud optical depth in the sun's direction.
+    is consistent with what a sensor pointed at the sky sees. The direct beam
+    passes the cloud fraction ``f`` of the sun's footprint (:func:`cloud_fraction`)
+    attenuated by the layer's optical depth ``tau`` along the air mass ``m`` and
+    the rest unattenuated: ``(1 - f) + f exp(-tau m)``.
     """
     wl = np.asarray(wavelengths_nm, dtype=float)
     if state.sun_elevation <= np.deg2rad(-1.0):
@@ -465,8 +508,9 @@ def illumination(state: SkyState, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.
     weight = (np.sin(ee) * d_omega)[..., None]
     diffuse = np.sum(rad * weight, axis=(0, 1))
     m_s = float(relative_air_mass(state.sun_elevation))
-    tau_sun = float(state.clouds.optical_depth_at(state.sun_direction, time_s=state.time_s, origin_m=origin_m))
-    direct = solar_spectrum(wl) * _sun_transmittance(state, wl) * np.exp(-tau_sun * m_s)
+    f_sun = float(cloud_fraction(state, state.sun_direction, origin_m=origin_m))
+    t_cloud = (1.0 - f_sun) + f_sun * np.exp(-float(state.clouds.optical_depth) * m_s)
+    direct = solar_spectrum(wl) * _sun_transmittance(state, wl) * t_cloud
     return Illumination(direct, diffuse, state.sun_direction)
 
 

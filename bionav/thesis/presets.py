@@ -167,7 +167,7 @@ STANDINS = dataclasses.replace(
     QUICK,
     name="standins",
     summary="the stand-in hardness checks of issue 18 (about an hour on two idle cores)",
-    snapshots=16,
+    snapshots=12,
     sift_size=(1122, 162),
     warping=("warping2d_thesis", "minwarping_thesis"),
     warping_snapshots=3,
@@ -176,7 +176,7 @@ STANDINS = dataclasses.replace(
     cross_db_size=None,
     cross_db_homing=("sift", "warping2d"),
     reductions=(
-        "SIFT homing (table 5.3): 16 snapshots per database (evenly spread over the images) instead of all, "
+        "SIFT homing (table 5.3): 12 snapshots per database (evenly spread over the images) instead of all, "
         "every image a current view; 1122 x 162 as the thesis",
         "table 5.4: the thesis' parameters (warping2d_thesis, minwarping_thesis), 3 snapshots per database",
         "fig. 5.6: doorlit and winlit only, 4 snapshots per database (stride 9), SIFT homing at the native "

@@ -111,6 +111,8 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     n_planes, n_rows, width = sq.shape
     n = width // step
     acc = np.empty((width + 1, width), np.uint16)  # row W: scratch for odd W
+    af = acc.reshape(-1)
+    uw = np.uint64(width)
     t = np.zeros(width, np.uint8)
     qf = np.float32(quantum)
     for k in range(n_planes):
@@ -127,46 +129,52 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
             a5 = sq[k, r + 5]
             a6 = sq[k, r + 6]
             a7 = sq[k, r + 7]
+            c0 = cq2[k, r]
+            c1 = cq2[k, r + 1]
+            c2 = cq2[k, r + 2]
+            c3 = cq2[k, r + 3]
+            c4 = cq2[k, r + 4]
+            c5 = cq2[k, r + 5]
+            c6 = cq2[k, r + 6]
+            c7 = cq2[k, r + 7]
             for d in range(0, width, 2):
-                b0 = cq2[k, r, d:d + width + 1]
-                b1 = cq2[k, r + 1, d:d + width + 1]
-                b2 = cq2[k, r + 2, d:d + width + 1]
-                b3 = cq2[k, r + 3, d:d + width + 1]
-                b4 = cq2[k, r + 4, d:d + width + 1]
-                b5 = cq2[k, r + 5, d:d + width + 1]
-                b6 = cq2[k, r + 6, d:d + width + 1]
-                b7 = cq2[k, r + 7, d:d + width + 1]
-                ac = acc[d]
-                ad = acc[d + 1]
+                # unsigned offsets into whole rows: no array views per diagonal
+                ud = np.uint64(d)
+                ab = ud * uw
                 for i in range(width):
-                    x0 = a0[i]
-                    x1 = a1[i]
-                    x2 = a2[i]
-                    x3 = a3[i]
-                    x4 = a4[i]
-                    x5 = a5[i]
-                    x6 = a6[i]
-                    x7 = a7[i]
-                    ac[i] += np.uint16(
-                        abs(np.int16(x0 - b0[i])) + abs(np.int16(x1 - b1[i]))
-                        + abs(np.int16(x2 - b2[i])) + abs(np.int16(x3 - b3[i]))
-                        + abs(np.int16(x4 - b4[i])) + abs(np.int16(x5 - b5[i]))
-                        + abs(np.int16(x6 - b6[i])) + abs(np.int16(x7 - b7[i]))
+                    ui = np.uint64(i)
+                    j = ud + ui
+                    j1 = j + np.uint64(1)
+                    x0 = a0[ui]
+                    x1 = a1[ui]
+                    x2 = a2[ui]
+                    x3 = a3[ui]
+                    x4 = a4[ui]
+                    x5 = a5[ui]
+                    x6 = a6[ui]
+                    x7 = a7[ui]
+                    af[ab + ui] += np.uint16(
+                        abs(np.int16(x0 - c0[j])) + abs(np.int16(x1 - c1[j]))
+                        + abs(np.int16(x2 - c2[j])) + abs(np.int16(x3 - c3[j]))
+                        + abs(np.int16(x4 - c4[j])) + abs(np.int16(x5 - c5[j]))
+                        + abs(np.int16(x6 - c6[j])) + abs(np.int16(x7 - c7[j]))
                     )
-                    ad[i] += np.uint16(
-                        abs(np.int16(x0 - b0[i + 1])) + abs(np.int16(x1 - b1[i + 1]))
-                        + abs(np.int16(x2 - b2[i + 1])) + abs(np.int16(x3 - b3[i + 1]))
-                        + abs(np.int16(x4 - b4[i + 1])) + abs(np.int16(x5 - b5[i + 1]))
-                        + abs(np.int16(x6 - b6[i + 1])) + abs(np.int16(x7 - b7[i + 1]))
+                    af[ab + uw + ui] += np.uint16(
+                        abs(np.int16(x0 - c0[j1])) + abs(np.int16(x1 - c1[j1]))
+                        + abs(np.int16(x2 - c2[j1])) + abs(np.int16(x3 - c3[j1]))
+                        + abs(np.int16(x4 - c4[j1])) + abs(np.int16(x5 - c5[j1]))
+                        + abs(np.int16(x6 - c6[j1])) + abs(np.int16(x7 - c7[j1]))
                     )
             r += 8
         while r < n_rows:
             a0 = sq[k, r]
+            c0 = cq2[k, r]
             for d in range(width):
-                b0 = cq2[k, r, d:d + width]
-                ac = acc[d]
+                ud = np.uint64(d)
+                ab = ud * uw
                 for i in range(width):
-                    ac[i] += np.uint16(abs(np.int16(a0[i] - b0[i])))
+                    ui = np.uint64(i)
+                    af[ab + ui] += np.uint16(abs(np.int16(a0[ui] - c0[ud + ui])))
             r += 1
         na = sn[k]
         for d in range(width):

@@ -111,8 +111,11 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     """
     _, n_planes, width, step, n = levels.shape
     n_p = p_cols.shape[0]
-    best = np.empty((n_p, n), dtype=levels.dtype)
+    best = np.empty(n_p * n, dtype=levels.dtype)
     row_stride = step * n
+    flat = levels.reshape(-1)
+    plane_size = width * row_stride
+    un = np.uint64(n)
     # snapshot columns in phase order (u = rr, rr + step, ...): one phase reads
     # a third of the table (step 3), which keeps the reads in cache; per window
     # all rotations at once (the window's plane and level stay fixed); the
@@ -120,33 +123,35 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     # (packed byte compares). The minima are kept over whole rows (column
     # i // step of the snapshot, any alpha) and added to the match values of
     # alpha step (i // step - u // step) mod n afterwards, so that the table
-    # holds every distance once.
+    # holds every distance once. The inner loops index flat arrays with
+    # unsigned offsets (no array views per window and rotation).
     for rr in range(step):
         for u in range(rr, width, step):
             e0 = start[u]
             e1 = start[u + 1]
             off = u // step
             for e in range(e0, e1):
-                flat = levels[w_level[e], w_plane[e]].reshape(-1)
+                pb = (w_level[e] * n_planes + w_plane[e]) * plane_size + rr * n
                 v0 = w_v[e] - u
                 first = e == e0
                 for ip in range(n_p):
-                    base = _wrap(v0 - p_cols[ip], width) * row_stride + rr * n
-                    row = flat[base:base + n]
-                    b = best[ip]
+                    base = np.uint64(pb + _wrap(v0 - p_cols[ip], width) * row_stride)
+                    bb = np.uint64(ip) * un
                     if first:
                         for a in range(n):
-                            b[a] = row[a]
+                            ua = np.uint64(a)
+                            best[bb + ua] = flat[base + ua]
                     else:
                         for a in range(n):
-                            x = row[a]
-                            if x < b[a]:
-                                b[a] = x
+                            ua = np.uint64(a)
+                            x = flat[base + ua]
+                            if x < best[bb + ua]:
+                                best[bb + ua] = x
             if e1 == e0:
                 best[:] = big
             for ip in range(n_p):
                 acc = out[ip]
-                b = best[ip]
+                b = best[ip * n:(ip + 1) * n]
                 # slices: plain contiguous loops (indices ``a + off`` would
                 # keep them from vectorising)
                 b1 = b[off:]

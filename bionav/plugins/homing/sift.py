@@ -97,21 +97,29 @@ class SiftHoming(HomingMethod):
         return HomeVector(angle=angle, extras={"correspondences": used})
 
     def all_pairs_angles(self, prepared, *, headings: np.ndarray, neighbours: np.ndarray, snapshot_index=None,
-                         workers: int = 1, progress=None) -> np.ndarray | None:
+                         workers: int = 1, progress=None, on_row=None) -> np.ndarray | None:
         """Grid-frame home angles of all pairs, each pair's descriptor distances computed once.
 
         The same angles as :meth:`home_vector` pair by pair
         (:func:`bionav.homing.sift_homing.sift_home_angles_all_pairs`); ``None``
         (per-pair calls) for features whose descriptors are not integers.
+        ``on_row(s, angles, compass)`` receives each snapshot row (grid frame)
+        as soon as it is complete, in ascending ``s``.
         """
         from bionav.geometry import wrap_angle
         from bionav.homing.sift_homing import sift_home_angles_all_pairs
 
+        headings = np.asarray(headings, dtype=np.float64)
+        no_compass = np.full(len(headings), np.nan)
+
+        def row_done(s: int, angles: np.ndarray, _used: np.ndarray) -> None:
+            on_row(s, wrap_angle(angles + headings), no_compass)
+
         out = sift_home_angles_all_pairs(
             prepared, geometry=self.work_geometry, search_radius=self.config.search_radius * self.work_geometry.width,
             combine=self.config.combine, window=self.config.window, snapshot_index=snapshot_index, workers=workers,
-            progress=progress,
+            progress=progress, on_row=None if on_row is None else row_done,
         )
         if out is None:
             return None
-        return wrap_angle(out[0] + np.asarray(headings, dtype=np.float64)[None, :])
+        return wrap_angle(out[0] + headings[None, :])

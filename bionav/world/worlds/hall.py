@@ -33,7 +33,7 @@ AMBIENT = (0.09, 0.055)
 #: Camera gain.
 EXPOSURE = 3.2
 #: Camera tilt std (degrees) on the hall's stone floor (joints, mast sway; World.floor_tilt_deg).
-FLOOR_TILT_DEG = 0.5
+FLOOR_TILT_DEG = 0.3
 
 
 def _missing_cells(origin, obstacles, n_missing: int) -> np.ndarray:

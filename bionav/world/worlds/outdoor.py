@@ -30,8 +30,8 @@ SPACING = 1.0
 CAMERA_HEIGHT = 0.8
 #: Least distance in metres between a tree and the capture area (thesis 3.1: distant buildings and trees).
 TREE_CLEARANCE = 7.0
-#: Camera tilt std (degrees) of the four-wheeled robot on the paving (joints, kerbs, slope; World.floor_tilt_deg).
-FLOOR_TILT_DEG = 1.5
+#: Camera tilt std (degrees) of the four-wheeled robot on the level paving (joints, mast sway; World.floor_tilt_deg).
+FLOOR_TILT_DEG = 0.3
 #: Value range of the paving texture (worn grey slabs, low contrast in the building's shadow).
 PAVING_TEXTURE = (0.45, 0.6)
 
