@@ -110,11 +110,11 @@ def _batch(pool, threads: int, method, pairs, n: int):
 
 def _grid_rows(args, load_procs_n: int) -> list[dict]:
     """Grid homing with 1 and ``args.threads`` workers, alternating; one row per variant and worker count."""
+    from hydra.errors import HydraException
+
     from bionav.config import compose
     from bionav.evaluation.pairs import home_vector_matrix, prepare_images
     from bionav.experiments.common import load_configured_database
-
-    from hydra.errors import HydraException
 
     try:
         cfg = compose([f"db={args.grid}"])
