@@ -193,6 +193,19 @@ def _stop_load(procs: list[subprocess.Popen]) -> None:
             p.kill()
 
 
+def _print_aligned(header, cells) -> None:
+    """Print a Markdown table whose columns are padded to a common width (readable as plain text)."""
+    widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
+
+    def line(cs):
+        return "| " + " | ".join(c.ljust(w) for c, w in zip(cs, widths)) + " |"
+
+    print(line(header))
+    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+    for c in cells:
+        print(line(c))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m bionav.bench",
@@ -354,12 +367,7 @@ def _print_rows(rows: list[dict], args) -> int:
               f"{r['cpu_ms_per_home_vector']:.2f}", f"{r['cpu_ms_min']:.2f}",
               f"{r['wall_ms_per_home_vector']:.2f}", f"{r['wall_ms_min']:.2f}",
               f"{r[key]:.2f}") for r in rows]
-    widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
-    line = lambda cs: "| " + " | ".join(c.ljust(w) for c, w in zip(cs, widths)) + " |"  # noqa: E731
-    print(line(header))
-    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
-    for c in cells:
-        print(line(c))
+    _print_aligned(header, cells)
     print(f"load average (1 min) {rows[0]['loadavg_1min'][0]} -> {rows[0]['loadavg_1min'][1]}, "
           f"background load {args.background_load}, {rows[0]['machine']}")
     return 0
@@ -459,12 +467,7 @@ def _print_sift(rows: list[dict], args) -> int:
               f"{r['prepare_cpu_ms_per_image']:.1f}", f"{r['pairs_wall_s']:.1f}", f"{r['pairs_cpu_s']:.1f}",
               f"{r['cpu_ms_per_home_vector']:.3f}", f"{r['workers_speedup']:.2f}", f"{r['db_load_s']:.1f}")
              for r in rows]
-    widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
-    line = lambda cs: "| " + " | ".join(c.ljust(w) for c, w in zip(cs, widths)) + " |"  # noqa: E731
-    print(line(header))
-    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
-    for c in cells:
-        print(line(c))
+    _print_aligned(header, cells)
     print(f"sift on {rows[0]['db']}: {rows[0]['n_pairs']} home vectors per grid; load average (1 min) "
           f"{rows[0]['loadavg_1min'][0]} -> {rows[-1]['loadavg_1min'][-1]}, background load {args.background_load}, "
           f"{rows[0]['machine']}")
