@@ -304,6 +304,43 @@ def unfold_frame(raw_u8: np.ndarray, setup: CameraSetup, geometry: PanoramaGeome
     return np.clip(np.rint(np.stack(chans, axis=-1).astype(np.float64) * 255.0), 0, 255).astype(np.uint8)
 
 
+def daylight_seed(seed: int, db_seed: int = 0) -> int:
+    """Seed of a recording session's clouds (:class:`bionav.world.worlds.common.Daylight`).
+
+    A recording session is one draw of everything that happened while the
+    database was taken: the pose errors and the clouds share
+    ``db.pose_error.seed`` (and ``db.seed``).
+    """
+    return int(np.random.SeedSequence([int(db_seed) & 0xFFFFFFFF, int(seed) & 0xFFFFFFFF, 0x44415921])
+               .generate_state(1)[0])
+
+
+def _daylight_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int):
+    """``scene_at(k)``: the compiled scene of capture ``k`` under the world's daylight (None: no daylight)."""
+    daylight = getattr(world, "daylight", None)
+    if daylight is None:
+        return None
+    from bionav.world.render import _compiled
+
+    session = _compiled(daylight.session_scene(world.scene))
+    kinds = session.light_params[:, 0]
+    sun = int(np.flatnonzero(kinds == 1)[-1])
+    sky = []
+    for idx in daylight.sky_lights:
+        pos = np.asarray(world.scene.lights[idx].position, float)
+        hit = np.flatnonzero((kinds == 0) & np.all(np.isclose(session.light_params[:, 1:4], pos), axis=1))
+        sky.append(int(hit[0]))
+    cond = daylight.conditions(positions, world.grid_shape, seed=daylight_seed(seed, db_seed))
+    base_emission, base_power = session.mat_emission, session.light_power
+    sky = np.asarray(sky, np.int64)
+
+    def scene_at(k: int):
+        return daylight.capture_scene(session, base_emission, sun, sky, base_power, sun_dir=cond["sun_dir"][k],
+                                      transmission=float(cond["transmission"][k]), sky=float(cond["sky"][k]))
+
+    return scene_at
+
+
 def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, camera: CameraConfig,
                   pose_error: PoseErrorConfig, seed: int, native_size=(561, 81),
                   progress: Callable[[Iterable], Iterable] | None = None, threads: int | None = 1,
@@ -355,11 +392,15 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     it = range(n)
     if progress is not None:
         it = progress(it)
+    scene_at = _daylight_scenes(world, positions, seed=int(pose_error.seed), db_seed=int(seed))
     for k in it:
         i, j = positions[k]
         x, y, z = world.cell_position(i, j)
-        radiance = render_raw_frame(world.scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
+        scene = world.scene if scene_at is None else scene_at(k)
+        radiance = render_raw_frame(scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
                                     heading=float(dheads[k]), layout=setup.layout, threads=threads)
+        if scene_at is not None:  # a CompiledScene renders without the scene's exposure
+            radiance *= float(world.scene.exposure)
         raw = sensor_frame(radiance, setup, rng=noise_rng(seed, (i, j)))
         out[k] = unfold_frame(raw, setup, geometry, tilt=tilts[k])
         if raws is not None:

@@ -329,6 +329,8 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         del params["noise"]
         params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
                       pose_error=dataclasses.asdict(pose_error), native_size=list(spec.native_size))
+        if getattr(world, "daylight", None) is not None:
+            params["daylight"] = dataclasses.asdict(world.daylight)
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     tag = "" if realism == "ideal" else "-camera"

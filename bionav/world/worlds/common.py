@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import zlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from bionav.world.scene import Scene
+from bionav.world.lights import DirectionalLight
+from bionav.world.scene import CompiledScene, Scene
 
 
 def stream(seed: int, name: str) -> np.random.Generator:
@@ -18,6 +21,172 @@ def stream(seed: int, name: str) -> np.random.Generator:
     never changes the rest of the world.
     """
     return np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, zlib.crc32(name.encode())]))
+
+
+@dataclass(frozen=True)
+class Daylight:
+    """Daylight through a room's windows while a database was being recorded.
+
+    The living-room databases took hours to record (a supervised robot, its
+    position corrected semi-automatically at every cell; thesis 3.1, Kreft
+    2007). Meanwhile the sun moved: its light, entering through the windows,
+    lays bright patches on the floor, the furniture and the walls that move
+    across the room and come and go with passing clouds, and the brightness
+    of the sky seen through the windows changes. A cell's capture time follows
+    the robot's lanes (boustrophedon along grid axis ``lane_axis``, one image
+    every ``duration_h / N`` hours), so cells in far-apart lanes were taken
+    hours apart. Used by the camera model only (``db.realism=camera``,
+    :func:`bionav.db.camera.camera_images`); ``db.realism=ideal`` renders the
+    scene as built.
+
+    Parameters
+    ----------
+    room : (float, float, float)
+        Inner room size ``(lx, ly, lz)`` in metres (the room shell spans
+        ``[0, lx] x [0, ly] x [0, lz]``).
+    windows : tuple of (str, float, float, float, float)
+        Openings the sun can shine through: ``(wall, u0, u1, z0, z1)`` with
+        ``wall`` in ``"x0", "x1", "y0", "y1"`` (the wall at ``x = 0``,
+        ``x = lx``, ``y = 0``, ``y = ly``), ``u0 .. u1`` the span along the
+        wall and ``z0 .. z1`` the height span, metres.
+    sun_azimuth_deg, sun_elevation_deg : (float, float)
+        Direction towards the sun at the first and at the last capture
+        (azimuth counter-clockwise from world ``+x``), degrees; in between
+        linear in time.
+    sun_irradiance : float
+        Irradiance of the unclouded sun on a surface facing it, in the units
+        of the scene's lights.
+    duration_h : float
+        Hours from the first to the last image (stated with the world).
+    cloud_sigma : float
+        Log-standard deviation of the clouds' transmission of the sun.
+    cloud_images : float
+        Correlation length of the clouds in captured images (an AR(1)
+        process along the capture order).
+    sky_lights : tuple of int
+        Indices into ``scene.lights`` of the lights standing for the skylight
+        through the windows; scaled by ``(1 + T) / 2`` with the cloud
+        transmission ``T`` (brighter sky when the sun is out).
+    panes : tuple of int
+        Material indices of the window panes; their emission is scaled like
+        the skylight.
+    lane_axis : int
+        Grid axis (0: ``i``, 1: ``j``) along which the robot drove its lanes.
+    """
+
+    room: tuple[float, float, float]
+    windows: tuple[tuple[str, float, float, float, float], ...]
+    sun_azimuth_deg: tuple[float, float]
+    sun_elevation_deg: tuple[float, float]
+    sun_irradiance: float
+    duration_h: float
+    cloud_sigma: float = 0.0
+    cloud_images: float = 20.0
+    sky_lights: tuple[int, ...] = ()
+    panes: tuple[int, ...] = ()
+    lane_axis: int = 1
+
+    def capture_fraction(self, cells: np.ndarray, grid_shape: tuple[int, int]) -> np.ndarray:
+        """Capture time of each cell as a fraction ``0 .. 1`` of the session (boustrophedon lanes).
+
+        Parameters
+        ----------
+        cells : ndarray, shape (N, 2), int
+            Grid cells ``(i, j)``.
+        grid_shape : (int, int)
+            ``(nx, ny)``.
+
+        Returns
+        -------
+        ndarray, shape (N,)
+            0 for the first cell of the first lane, 1 for the last cell of the last lane.
+        """
+        cells = np.asarray(cells, np.int64).reshape(-1, 2)
+        along, across = (cells[:, 1], cells[:, 0]) if self.lane_axis == 1 else (cells[:, 0], cells[:, 1])
+        n_along = int(grid_shape[self.lane_axis])
+        n_across = int(grid_shape[1 - self.lane_axis])
+        step = np.where(across % 2 == 0, along, n_along - 1 - along)
+        return (across * n_along + step) / max(n_along * n_across - 1, 1)
+
+    def conditions(self, cells: np.ndarray, grid_shape: tuple[int, int], *, seed: int) -> dict:
+        """Sun direction, cloud transmission and skylight factor at each cell's capture.
+
+        Returns
+        -------
+        dict
+            ``fraction`` (N,) capture time fraction, ``sun_dir`` (N, 3) unit
+            vectors towards the sun, ``transmission`` (N,) clouds' transmission
+            of the sun (mean 1 over the session's process), ``sky`` (N,)
+            skylight factor ``(1 + T) / 2``.
+        """
+        f = self.capture_fraction(cells, grid_shape)
+        az = np.radians(self.sun_azimuth_deg[0] + f * (self.sun_azimuth_deg[1] - self.sun_azimuth_deg[0]))
+        el = np.radians(self.sun_elevation_deg[0] + f * (self.sun_elevation_deg[1] - self.sun_elevation_deg[0]))
+        sun = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
+        # clouds: a stationary AR(1) log-transmission along the capture order (seeded per session)
+        n_total = int(np.prod(grid_shape))
+        rng = stream(seed, "daylight/clouds")
+        rho = float(np.exp(-1.0 / max(self.cloud_images, 1e-9)))
+        z = np.empty(n_total)
+        e = rng.standard_normal(n_total)
+        z[0] = e[0]
+        for k in range(1, n_total):
+            z[k] = rho * z[k - 1] + np.sqrt(1.0 - rho * rho) * e[k]
+        s = float(self.cloud_sigma)
+        t_all = np.exp(s * z - 0.5 * s * s)
+        idx = np.rint(f * (n_total - 1)).astype(np.int64)
+        t = t_all[idx]
+        return {"fraction": f, "sun_dir": sun, "transmission": t, "sky": 0.5 * (1.0 + t)}
+
+    def session_scene(self, scene: Scene) -> Scene:
+        """A copy of ``scene`` with the sun added and the room closed against it except at the windows.
+
+        The walls of the room shell cast no shadows (the lamps are inside);
+        the sun, outside, must be blocked by the walls and the ceiling except
+        where the windows are: thin shadow-casting slabs just outside the
+        shell (never seen from inside) with holes at ``windows``. The sun is
+        the last light of the copy.
+        """
+        s = copy.deepcopy(scene)
+        s.info.pop("_compiled", None)
+        lx, ly, lz = self.room
+        t, m = 0.05, 0.01  # slab thickness, gap outside the shell
+        blk = s.material(albedo=0.0)
+        s.box((-m - t, -m - t, lz + m), (lx + m + t, ly + m + t, lz + m + t), blk)  # above the ceiling
+        for wall in ("x0", "x1", "y0", "y1"):
+            length = ly if wall[0] == "x" else lx
+            holes = sorted((u0, u1, z0, z1) for w, u0, u1, z0, z1 in self.windows if w == wall)
+            pieces = []  # (u0, u1, z0, z1) slabs covering the wall minus its holes
+            u = -m - t
+            for u0, u1, z0, z1 in holes:
+                pieces += [(u, u0, 0.0, lz + m), (u0, u1, 0.0, z0), (u0, u1, z1, lz + m)]
+                u = u1
+            pieces.append((u, length + m + t, 0.0, lz + m))
+            for u0, u1, z0, z1 in pieces:
+                if u1 - u0 <= 0 or z1 - z0 <= 0:
+                    continue
+                if wall[0] == "x":
+                    x0 = -m - t if wall == "x0" else lx + m
+                    s.box((x0, u0, z0), (x0 + t, u1, z1), blk)
+                else:
+                    y0 = -m - t if wall == "y0" else ly + m
+                    s.box((u0, y0, z0), (u1, y0 + t, z1), blk)
+        s.add_light(DirectionalLight((0.0, 0.0, 1.0), float(self.sun_irradiance)))
+        return s
+
+    def capture_scene(self, session: CompiledScene, base_emission: np.ndarray, sun_index: int,
+                      sky_index: np.ndarray, base_power: np.ndarray, *, sun_dir, transmission: float,
+                      sky: float) -> CompiledScene:
+        """The compiled session scene at one capture: sun direction and power, skylight and panes scaled."""
+        params = session.light_params.copy()
+        params[sun_index, 1:4] = sun_dir
+        power = base_power.copy()
+        power[sun_index] *= transmission
+        power[sky_index] *= sky
+        emission = base_emission.copy()
+        emission[list(self.panes)] *= sky
+        return dataclasses.replace(session, light_params=params, light_power=power, mat_emission=emission,
+                                   shadow_grids=None, shadow_starts=None, shadow_items=None)
 
 
 @dataclass
@@ -44,6 +213,8 @@ class World:
         ``(x0, y0, x1, y1)`` of an obstacle-free floor rectangle (apartment).
     info : dict
         Free-form facts about the world (room size, sun position ...).
+    daylight : Daylight, optional
+        Daylight through the windows during the recording (camera model only).
     floor_tilt_deg : float
         Standard deviation in degrees, about each horizontal axis, of the
         camera's tilt where the robot stands: the unevenness of the floor
@@ -63,6 +234,7 @@ class World:
     free_area: tuple[float, float, float, float] | None = None
     info: dict = field(default_factory=dict)
     floor_tilt_deg: float = 0.0
+    daylight: Daylight | None = None
 
     def __post_init__(self) -> None:
         if self.cells is None:

@@ -18,7 +18,7 @@ import numpy as np
 from bionav.world import textures as tx
 from bionav.world.lights import Ambient, PointLight
 from bionav.world.scene import Scene
-from bionav.world.worlds.common import World, stream
+from bionav.world.worlds.common import Daylight, World, stream
 from bionav.world.worlds.furniture import cabinet, chair, oriented_box, potted_plant, shelf, table, wall_picture
 
 SPACING = 0.1
@@ -30,6 +30,15 @@ CLUTTER_GAP = 0.2
 FLOOR_TILT_DEG = {"living": 1.0, "kitchen": 0.8}
 #: Contrast of the painted walls (texture value range; real painted walls are nearly uniform).
 WALL_TEXTURE = (0.7, 0.8)
+#: Seconds per image of the supervised recording (drive, semi-automatic position correction, capture):
+#: fixes the hours the sun moves while a database is taken (Daylight.duration_h).
+SECONDS_PER_IMAGE = 40.0
+#: Irradiance of the unclouded sun entering through the windows, in the units of the scene's lights
+#: (the ceiling lamp gives about 0.8 on the floor below it); 0 would be an overcast day.
+SUN_IRRADIANCE = 3.0
+#: Clouds passing the sun: log-standard deviation of their transmission and correlation length in images.
+CLOUD_SIGMA = 1.0
+CLOUD_IMAGES = 15.0
 
 
 def _shell(scene: Scene, seed: int, lx: float, ly: float, lz: float, tag: str) -> None:
@@ -62,8 +71,8 @@ def _sofa(scene: Scene, r: np.random.Generator, *, x: float, y: float, yaw: floa
 
 
 def _window(scene: Scene, r: np.random.Generator, *, wall_x: float | None, wall_y: float | None, centre: float,
-            width: float, lx: float, ly: float, open_fraction: float = 0.6) -> None:
-    """A bright window with curtains drawn to both sides, on an x- or y-wall."""
+            width: float, lx: float, ly: float, open_fraction: float = 0.6) -> int:
+    """A bright window with curtains drawn to both sides, on an x- or y-wall; returns the pane's material."""
     pane = scene.material(texture=tx.window_view(r), fit=True, albedo=0.2, emission=1.6)
     curtain = scene.material(texture=tx.curtain(r, folds=5, lo=0.4, hi=0.85), albedo=0.8, scale=(0.8, 2.0))
     cw = width * (1 - open_fraction) / 2 + 0.15
@@ -83,6 +92,7 @@ def _window(scene: Scene, r: np.random.Generator, *, wall_x: float | None, wall_
             a = centre + sgn * (width / 2 + 0.15)
             b = a - sgn * cw
             scene.box((min(a, b), cy0, 0.05), (max(a, b), cy1, 2.35), curtain)
+    return pane
 
 
 def _floor_lamp(scene: Scene, r: np.random.Generator, *, x: float, y: float) -> None:
@@ -142,8 +152,9 @@ def build_living_room(seed: int = 0) -> World:
     scene.frustum((gx0 - CLUTTER_GAP - 0.15, gy1 - 0.3), 0.0, 0.35, 0.15, 0.18, material=basket)
     rug = scene.material(texture=tx.poster(r, n_shapes=20), fit=True, albedo=0.7)
     scene.box((gx0 - 0.9, gy0 + 0.2, 0.0), (gx1 + 0.2, gy1 - 0.2, 0.012), rug, shadow=False)
-    _window(scene, r, wall_x=None, wall_y=0.0, centre=lx * 0.6, width=1.4, lx=lx, ly=ly)
-    _window(scene, r, wall_x=lx, wall_y=None, centre=ly * 0.2, width=1.0, lx=lx, ly=ly)
+    panes = (_window(scene, r, wall_x=None, wall_y=0.0, centre=lx * 0.6, width=1.4, lx=lx, ly=ly),
+             _window(scene, r, wall_x=lx, wall_y=None, centre=ly * 0.2, width=1.0, lx=lx, ly=ly))
+    windows = (("y0", lx * 0.6 - 0.7, lx * 0.6 + 0.7, 0.9, 2.2), ("x1", ly * 0.2 - 0.5, ly * 0.2 + 0.5, 0.9, 2.2))
     door = scene.material(texture=tx.panel(r, nx=1, ny=3), fit=True, albedo=0.85)
     scene.box((0.0, ly - 1.3, 0.0), (0.04, ly - 0.45, 2.05), door, shadow=False)
     radiator = scene.material(texture=tx.stripes(r, n=14, lo=0.55, hi=0.95), albedo=0.9, scale=(1.0, 0.5))
@@ -158,11 +169,18 @@ def build_living_room(seed: int = 0) -> World:
     lamp = scene.material(albedo=0.9, emission=1.5)
     scene.ellipsoid((lx / 2, ly / 2, lz - 0.25), (0.25, 0.25, 0.12), material=lamp, shadow=False)
     scene.add_light(PointLight((lx / 2, ly / 2, lz - 0.4), 3.0, downward=False))
+    sky = len(scene.lights)
     scene.add_light(PointLight((lx * 0.6, 0.4, 1.6), 0.8, downward=False))  # daylight from the window
     scene.ambient = Ambient(up=0.3, down=0.2)
     scene.exposure = 1.5
+    # an afternoon: the sun moves west past the south window (azimuth -60 -> -100 deg, sinking)
+    daylight = Daylight(room=(lx, ly, lz), windows=windows, sun_azimuth_deg=(-60.0, -100.0),
+                        sun_elevation_deg=(40.0, 22.0), sun_irradiance=SUN_IRRADIANCE,
+                        duration_h=11 * 22 * SECONDS_PER_IMAGE / 3600.0, cloud_sigma=CLOUD_SIGMA,
+                        cloud_images=CLOUD_IMAGES, sky_lights=(sky,), panes=panes, lane_axis=1)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 22),
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["living"])
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["living"],
+                 daylight=daylight)
 
 
 def build_living_kitchen(seed: int = 0) -> World:
@@ -228,8 +246,9 @@ def build_living_kitchen(seed: int = 0) -> World:
     potted_plant(scene, stream(seed, "kitchen/plant"), x=lx - 0.4, y=ly - 0.4, height=1.5, crown=0.35,
                  min_leaf_z=0.7)
     _floor_lamp(scene, r, x=0.35, y=ly - 0.5)
-    _window(scene, r, wall_x=lx, wall_y=None, centre=1.5, width=1.2, lx=lx, ly=ly)
-    _window(scene, r, wall_x=lx, wall_y=None, centre=ly - 3.8, width=1.4, lx=lx, ly=ly)
+    panes = (_window(scene, r, wall_x=lx, wall_y=None, centre=1.5, width=1.2, lx=lx, ly=ly),
+             _window(scene, r, wall_x=lx, wall_y=None, centre=ly - 3.8, width=1.4, lx=lx, ly=ly))
+    windows = (("x1", 1.5 - 0.6, 1.5 + 0.6, 0.9, 2.2), ("x1", ly - 3.8 - 0.7, ly - 3.8 + 0.7, 0.9, 2.2))
     door = scene.material(texture=tx.panel(r, nx=1, ny=3), fit=True, albedo=0.85)
     scene.box((0.0, ly - 2.6, 0.0), (0.04, ly - 1.75, 2.05), door, shadow=False)
     for wall, pos in (("west", 4.2), ("north", lx * 0.6), ("east", ly - 0.9), ("south", 3.4)):
@@ -244,5 +263,11 @@ def build_living_kitchen(seed: int = 0) -> World:
         scene.add_light(PointLight((lx / 2, cy, lz - 0.35), 2.2, downward=False))
     scene.ambient = Ambient(up=0.3, down=0.2)
     scene.exposure = 1.5
+    # a morning: the sun rises in front of the east windows (azimuth -50 -> +16 deg)
+    daylight = Daylight(room=(lx, ly, lz), windows=windows, sun_azimuth_deg=(-50.0, 16.0),
+                        sun_elevation_deg=(15.0, 40.0), sun_irradiance=SUN_IRRADIANCE,
+                        duration_h=11 * 36 * SECONDS_PER_IMAGE / 3600.0, cloud_sigma=CLOUD_SIGMA,
+                        cloud_images=CLOUD_IMAGES, sky_lights=(), panes=panes, lane_axis=1)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"])
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"],
+                 daylight=daylight)
