@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bionav.db.camera import _daylight_scenes, daylight_seed
+from bionav.db.camera import capture_scenes, session_seed
 from bionav.db.synthetic import get_spec, synthetic_database
 from bionav.world.lights import Ambient
 from bionav.world.render import render_ray_grid
 from bionav.world.scene import Scene
-from bionav.world.worlds.common import Daylight, World
+from bionav.world.worlds.common import Daylight, Supervisor, World
 
 ROOM = (4.0, 4.0, 2.5)
 WINDOW = ("y0", 1.5, 2.5, 1.0, 2.0)  # on the wall y = 0, x 1.5 .. 2.5, z 1.0 .. 2.0
@@ -39,7 +39,7 @@ def _radiance_towards(scene, eye, target) -> float:
 
 def test_the_sun_lights_the_floor_only_where_it_enters_through_the_window():
     world = _empty_room()
-    scene_at = _daylight_scenes(world, np.array([[0, 0]]), seed=0, db_seed=0)
+    scene_at = capture_scenes(world, np.array([[0, 0]]), seed=0, db_seed=0)
     sunny = scene_at(0)
     eye = world.cell_position(0, 0)
     # sun from -y at 45 deg: a floor point at y = 1.5 sees the wall y = 0 at height 1.5, inside the window
@@ -71,9 +71,9 @@ def test_clouds_are_seeded_by_the_recording_session():
     d = Daylight(room=ROOM, windows=(WINDOW,), sun_azimuth_deg=(0.0, 0.0), sun_elevation_deg=(30.0, 30.0),
                  sun_irradiance=1.0, duration_h=2.0, cloud_sigma=1.0, cloud_images=5.0)
     cells = np.argwhere(np.ones((11, 22), bool))
-    a = d.conditions(cells, (11, 22), seed=daylight_seed(0))["transmission"]
-    b = d.conditions(cells, (11, 22), seed=daylight_seed(0))["transmission"]
-    c = d.conditions(cells, (11, 22), seed=daylight_seed(1))["transmission"]
+    a = d.conditions(cells, (11, 22), seed=session_seed(0))["transmission"]
+    b = d.conditions(cells, (11, 22), seed=session_seed(0))["transmission"]
+    c = d.conditions(cells, (11, 22), seed=session_seed(1))["transmission"]
     np.testing.assert_array_equal(a, b)
     assert not np.allclose(a, c)
     assert np.all(a > 0) and 0.5 < np.mean(a) < 1.5 and np.std(np.log(a)) == pytest.approx(1.0, abs=0.3)
@@ -116,3 +116,31 @@ def test_living_rooms_are_recorded_in_daylight_and_ideal_ignores_it(name, tmp_pa
     assert not np.array_equal(cam_dark.images, cam.images)
     ideal = synthetic_database(name, realism="ideal", **kw)
     np.testing.assert_array_equal(ideal.images, ideal_dark.images)
+
+
+def test_the_supervisor_stands_behind_the_robot_facing_it():
+    sup = Supervisor(room=(4.0, 4.0), distance_m=1.2, jitter_m=0.0, margin_m=0.3, lane_axis=1)
+    cells = np.array([[0, 5], [1, 5], [0, 0]])
+    xy = np.array([[2.0, 2.0], [2.1, 2.0], [2.0, 0.5]])
+    feet, yaw = sup.stances(cells, xy, seed=0)
+    # lane 0 drives towards +y (the person is at -y), lane 1 back towards -y; clipped 0.3 m from the wall
+    np.testing.assert_allclose(feet, [[2.0, 0.8], [2.1, 3.2], [2.0, 0.3]])
+    np.testing.assert_allclose(yaw, [np.pi / 2, -np.pi / 2, np.pi / 2])
+    jittered = Supervisor(room=(4.0, 4.0), jitter_m=0.3).stances(cells, xy, seed=3)[0]
+    np.testing.assert_array_equal(jittered, Supervisor(room=(4.0, 4.0), jitter_m=0.3).stances(cells, xy, seed=3)[0])
+    assert not np.allclose(jittered, Supervisor(room=(4.0, 4.0), jitter_m=0.3).stances(cells, xy, seed=4)[0])
+
+
+def test_the_supervisor_is_seen_where_he_stands_and_nowhere_else():
+    world = _empty_room()
+    world.daylight = None
+    world.supervisor = Supervisor(room=ROOM[:2], distance_m=1.2, jitter_m=0.0)
+    scene_at = capture_scenes(world, np.array([[0, 0]]), seed=0, db_seed=0)
+    eye = world.cell_position(0, 0)  # (2.0, 2.0, 0.6): lane 0, the person stands at (2.0, 0.8)
+    seen = scene_at(0)
+    torso, beside = (2.0, 0.8, 1.2), (3.0, 0.8, 1.2)
+    wall = _radiance_towards(world.scene, eye, torso)
+    assert _radiance_towards(seen, eye, torso) != pytest.approx(wall, rel=1e-3)  # the shirt, not the wall
+    assert _radiance_towards(seen, eye, beside) == pytest.approx(_radiance_towards(world.scene, eye, beside))
+    assert capture_scenes(World(scene=world.scene, grid_origin=(2.0, 2.0), spacing=0.1, grid_shape=(1, 1),
+                                camera_height=0.6), np.array([[0, 0]]), seed=0) is None

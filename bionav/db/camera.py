@@ -304,39 +304,78 @@ def unfold_frame(raw_u8: np.ndarray, setup: CameraSetup, geometry: PanoramaGeome
     return np.clip(np.rint(np.stack(chans, axis=-1).astype(np.float64) * 255.0), 0, 255).astype(np.uint8)
 
 
-def daylight_seed(seed: int, db_seed: int = 0) -> int:
-    """Seed of a recording session's clouds (:class:`bionav.world.worlds.common.Daylight`).
+def session_seed(seed: int, db_seed: int = 0) -> int:
+    """Seed of what happened during a recording session besides the pose errors.
 
     A recording session is one draw of everything that happened while the
-    database was taken: the pose errors and the clouds share
+    database was taken: the pose errors, the clouds
+    (:class:`bionav.world.worlds.common.Daylight`) and where the supervisor
+    stood (:class:`bionav.world.worlds.common.Supervisor`) share
     ``db.pose_error.seed`` (and ``db.seed``).
     """
     return int(np.random.SeedSequence([int(db_seed) & 0xFFFFFFFF, int(seed) & 0xFFFFFFFF, 0x44415921])
                .generate_state(1)[0])
 
 
-def _daylight_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int):
-    """``scene_at(k)``: the compiled scene of capture ``k`` under the world's daylight (None: no daylight)."""
+def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0):
+    """``scene_at(k)``: the compiled scene at capture ``k`` of a recording session, or None if the world is static.
+
+    Adds what changes while a database is recorded (``world.daylight``: the
+    sun and the clouds; ``world.supervisor``: the person following the robot)
+    to a copy of the world's scene, compiled once; each capture then only
+    moves lights and the person in the compiled arrays.
+
+    Parameters
+    ----------
+    world : bionav.world.worlds.common.World
+    positions : ndarray, shape (N, 2), int
+        Grid cells ``(i, j)`` in capture order of the database (not the time order).
+    seed, db_seed : int
+        ``db.pose_error.seed`` and ``db.seed`` (:func:`session_seed`).
+
+    Returns
+    -------
+    callable or None
+        ``scene_at(k) -> CompiledScene`` (radiance without the scene's exposure).
+    """
+    import copy
+
     daylight = getattr(world, "daylight", None)
-    if daylight is None:
+    supervisor = getattr(world, "supervisor", None)
+    if daylight is None and supervisor is None:
         return None
     from bionav.world.render import _compiled
+    from bionav.world.worlds.common import Supervisor
 
-    session = _compiled(daylight.session_scene(world.scene))
-    kinds = session.light_params[:, 0]
-    sun = int(np.flatnonzero(kinds == 1)[-1])
-    sky = []
-    for idx in daylight.sky_lights:
-        pos = np.asarray(world.scene.lights[idx].position, float)
-        hit = np.flatnonzero((kinds == 0) & np.all(np.isclose(session.light_params[:, 1:4], pos), axis=1))
-        sky.append(int(hit[0]))
-    cond = daylight.conditions(positions, world.grid_shape, seed=daylight_seed(seed, db_seed))
-    base_emission, base_power = session.mat_emission, session.light_power
-    sky = np.asarray(sky, np.int64)
+    sseed = session_seed(seed, db_seed)
+    scene = daylight.session_scene(world.scene) if daylight is not None else copy.deepcopy(world.scene)
+    scene.info.pop("_compiled", None)
+    parts = supervisor.add_to(scene, seed=sseed) if supervisor is not None else None
+    session = _compiled(scene)
+    if daylight is not None:
+        kinds = session.light_params[:, 0]
+        sun = int(np.flatnonzero(kinds == 1)[-1])
+        sky = []
+        for idx in daylight.sky_lights:
+            pos = np.asarray(world.scene.lights[idx].position, float)
+            hit = np.flatnonzero((kinds == 0) & np.all(np.isclose(session.light_params[:, 1:4], pos), axis=1))
+            sky.append(int(hit[0]))
+        sky = np.asarray(sky, np.int64)
+        cond = daylight.conditions(positions, world.grid_shape, seed=sseed)
+    if supervisor is not None:
+        xy = np.array([world.cell_position(i, j)[:2] for i, j in positions], float).reshape(-1, 2)
+        feet, yaw = supervisor.stances(positions, xy, seed=sseed)
 
     def scene_at(k: int):
-        return daylight.capture_scene(session, base_emission, sun, sky, base_power, sun_dir=cond["sun_dir"][k],
-                                      transmission=float(cond["transmission"][k]), sky=float(cond["sky"][k]))
+        kw = {}
+        if daylight is not None:
+            kw.update(daylight.capture_lighting(session, sun_index=sun, sky_index=sky, sun_dir=cond["sun_dir"][k],
+                                                transmission=float(cond["transmission"][k]),
+                                                sky=float(cond["sky"][k])))
+        if supervisor is not None:
+            boxes, ell = Supervisor.place(session.boxes, session.ellipsoids, parts, feet[k], float(yaw[k]))
+            kw.update(boxes=boxes, ellipsoids=ell, prim_kind=None, prim_idx=None, spheres=None, casters=None)
+        return dataclasses.replace(session, **kw, shadow_grids=None, shadow_starts=None, shadow_items=None)
 
     return scene_at
 
@@ -392,7 +431,7 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     it = range(n)
     if progress is not None:
         it = progress(it)
-    scene_at = _daylight_scenes(world, positions, seed=int(pose_error.seed), db_seed=int(seed))
+    scene_at = capture_scenes(world, positions, seed=int(pose_error.seed), db_seed=int(seed))
     for k in it:
         i, j = positions[k]
         x, y, z = world.cell_position(i, j)

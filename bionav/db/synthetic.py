@@ -329,8 +329,9 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         del params["noise"]
         params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
                       pose_error=dataclasses.asdict(pose_error), native_size=list(spec.native_size))
-        if getattr(world, "daylight", None) is not None:
-            params["daylight"] = dataclasses.asdict(world.daylight)
+        for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
+            if getattr(world, what, None) is not None:
+                params[what] = dataclasses.asdict(getattr(world, what))
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     tag = "" if realism == "ideal" else "-camera"

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import dataclasses
 import zlib
 from dataclasses import dataclass, field
 
@@ -174,19 +173,115 @@ class Daylight:
         s.add_light(DirectionalLight((0.0, 0.0, 1.0), float(self.sun_irradiance)))
         return s
 
-    def capture_scene(self, session: CompiledScene, base_emission: np.ndarray, sun_index: int,
-                      sky_index: np.ndarray, base_power: np.ndarray, *, sun_dir, transmission: float,
-                      sky: float) -> CompiledScene:
-        """The compiled session scene at one capture: sun direction and power, skylight and panes scaled."""
+    def capture_lighting(self, session: CompiledScene, *, sun_index: int, sky_index: np.ndarray, sun_dir,
+                         transmission: float, sky: float) -> dict:
+        """Light arrays of the compiled session scene at one capture (for ``dataclasses.replace``).
+
+        Sun direction and power, skylight lights and pane emission scaled;
+        the shadow bins must be rebuilt (the sun moved).
+        """
         params = session.light_params.copy()
         params[sun_index, 1:4] = sun_dir
-        power = base_power.copy()
+        power = session.light_power.copy()
         power[sun_index] *= transmission
         power[sky_index] *= sky
-        emission = base_emission.copy()
+        emission = session.mat_emission.copy()
         emission[list(self.panes)] *= sky
-        return dataclasses.replace(session, light_params=params, light_power=power, mat_emission=emission,
-                                   shadow_grids=None, shadow_starts=None, shadow_items=None)
+        return {"light_params": params, "light_power": power, "mat_emission": emission}
+
+
+@dataclass(frozen=True)
+class Supervisor:
+    """The person who supervised a recording, standing behind the robot in every image.
+
+    The living-room databases were recorded with a supervised robot whose
+    position was corrected semi-automatically (thesis 3.1, Kreft 2007): a
+    person stayed close to it, and an omnidirectional camera cannot be
+    hidden from. The supervisor follows the robot along its lanes
+    (boustrophedon along grid axis ``lane_axis``), standing ``distance_m``
+    behind it (against its driving direction) with a Gaussian scatter of
+    ``jitter_m`` per horizontal axis, facing the robot, inside the room at
+    least ``margin_m`` from the walls. Used by the camera model only
+    (``db.realism=camera``); the stance is drawn per recording session
+    (``db.pose_error.seed``, ``db.seed``).
+
+    Parameters
+    ----------
+    room : (float, float)
+        Inner room size ``(lx, ly)`` in metres.
+    distance_m, jitter_m, margin_m : float
+        Metres.
+    height_m : float
+        The person's height.
+    lane_axis : int
+        Grid axis (0: ``i``, 1: ``j``) along which the robot drove its lanes.
+    """
+
+    room: tuple[float, float]
+    distance_m: float = 1.2
+    jitter_m: float = 0.3
+    margin_m: float = 0.3
+    height_m: float = 1.75
+    lane_axis: int = 1
+
+    def stances(self, cells: np.ndarray, xy: np.ndarray, *, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        """Where the supervisor stands at each capture.
+
+        Parameters
+        ----------
+        cells : ndarray, shape (N, 2), int
+            Grid cells ``(i, j)`` (the lane is the index across ``lane_axis``).
+        xy : ndarray, shape (N, 2)
+            Robot positions in metres, world frame.
+        seed : int
+            The recording session's seed.
+
+        Returns
+        -------
+        feet : ndarray, shape (N, 2)
+            Position of the person in metres, world frame.
+        yaw : ndarray, shape (N,)
+            Direction the person faces (towards the robot), radians CCW from ``+x``.
+        """
+        cells = np.asarray(cells, np.int64).reshape(-1, 2)
+        xy = np.asarray(xy, float).reshape(-1, 2)
+        lane = cells[:, 1 - self.lane_axis]
+        forward = np.where(lane % 2 == 0, 1.0, -1.0)  # driving direction along the lane axis
+        back = np.zeros_like(xy)
+        back[:, self.lane_axis] = -forward
+        rng = stream(seed, "supervisor/stance")
+        feet = xy + self.distance_m * back + self.jitter_m * rng.standard_normal(xy.shape)
+        lo, hi = self.margin_m, np.asarray(self.room, float) - self.margin_m
+        feet = np.clip(feet, lo, hi)
+        d = xy - feet
+        return feet, np.arctan2(d[:, 1], d[:, 0])
+
+    def add_to(self, scene: Scene, *, seed: int) -> tuple[slice, slice]:
+        """Add the person at the origin facing ``+x``; returns the slices of its boxes and ellipsoids."""
+        from bionav.world.worlds.furniture import person
+
+        b0, e0 = len(scene.boxes), len(scene.ellipsoids)
+        n_frusta = len(scene.frusta)
+        person(scene, stream(seed, "supervisor/looks"), height=self.height_m)
+        if len(scene.frusta) != n_frusta:
+            raise RuntimeError("the supervisor's figure must consist of boxes and spheres")
+        return slice(b0, len(scene.boxes)), slice(e0, len(scene.ellipsoids))
+
+    @staticmethod
+    def place(boxes: np.ndarray, ellipsoids: np.ndarray, parts: tuple[slice, slice], feet, yaw: float):
+        """Copies of the compiled ``boxes`` and ``ellipsoids`` with the person moved to ``feet``, turned to ``yaw``."""
+        bs, es = parts
+        c, s = float(np.cos(yaw)), float(np.sin(yaw))
+        boxes = boxes.copy()
+        ellipsoids = ellipsoids.copy()
+        for arr, sl in ((boxes, bs), (ellipsoids, es)):
+            x, y = arr[sl, 0].copy(), arr[sl, 1].copy()
+            arr[sl, 0] = feet[0] + c * x - s * y
+            arr[sl, 1] = feet[1] + s * x + c * y
+        cb, sb = boxes[bs, 6].copy(), boxes[bs, 7].copy()
+        boxes[bs, 6] = c * cb - s * sb
+        boxes[bs, 7] = s * cb + c * sb
+        return boxes, ellipsoids
 
 
 @dataclass
@@ -215,6 +310,8 @@ class World:
         Free-form facts about the world (room size, sun position ...).
     daylight : Daylight, optional
         Daylight through the windows during the recording (camera model only).
+    supervisor : Supervisor, optional
+        The person supervising the recording (camera model only).
     floor_tilt_deg : float
         Standard deviation in degrees, about each horizontal axis, of the
         camera's tilt where the robot stands: the unevenness of the floor
@@ -235,6 +332,7 @@ class World:
     info: dict = field(default_factory=dict)
     floor_tilt_deg: float = 0.0
     daylight: Daylight | None = None
+    supervisor: Supervisor | None = None
 
     def __post_init__(self) -> None:
         if self.cells is None:

@@ -165,3 +165,37 @@ def building(scene: Scene, rng: np.random.Generator, *, x0: float, y0: float, x1
     fac = scene.material(texture=tex, albedo=alb, scale=(4 * window_width, 4 * floor_height), kind=kind)
     roof = roof_material if roof_material is not None else scene.material(albedo=0.3, kind=kind)
     scene.box((x0, y0, 0.0), (x1, y1, height), [fac, fac, fac, fac, roof, roof])
+
+
+def person(scene: Scene, rng: np.random.Generator, *, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
+           height: float = 1.75) -> None:
+    """A standing person (shoes, trousers, shirt, arms, head), facing ``yaw``, feet at ``(x, y, 0)``.
+
+    Built from boxes and a spherical head (rotation-invariant about ``+z``), so
+    that the figure can be moved and turned as a whole in a compiled scene
+    (:meth:`bionav.world.worlds.common.Supervisor.place`).
+    """
+    s = height / 1.75
+    trousers = scene.material(texture=tx.carpet(rng, lo=0.1, hi=0.35), albedo=rng.uniform(0.3, 0.6), scale=0.3)
+    shirt = scene.material(texture=tx.stripes(rng, n=int(rng.integers(6, 14)), lo=0.3, hi=0.9)
+                           if rng.uniform() < 0.5 else tx.value_noise(rng, lo=0.4, hi=0.8),
+                           albedo=rng.uniform(0.5, 0.9), scale=(0.3, 0.4))
+    skin = scene.material(albedo=rng.uniform(0.55, 0.75))
+    hair = scene.material(albedo=rng.uniform(0.05, 0.3))
+    shoe = scene.material(albedo=0.1)
+
+    def part(u, v, z0, size, mat):  # u forward, v left, in the person's frame
+        dx, dy = _rot(u, v, yaw)
+        oriented_box(scene, (x + dx, y + dy, z0 * s), (size[0] * s, size[1] * s, size[2] * s), mat, yaw=yaw)
+
+    for v in (-0.1, 0.1):
+        part(0.03, v, 0.0, (0.26, 0.1, 0.07), shoe)
+        part(0.0, v, 0.07, (0.14, 0.14, 0.8), trousers)
+    part(0.0, 0.0, 0.87, (0.22, 0.38, 0.08), trousers)
+    part(0.0, 0.0, 0.95, (0.24, 0.42, 0.5), shirt)
+    for v in (-0.25, 0.25):
+        part(0.0, v, 0.8, (0.1, 0.09, 0.62), shirt)
+        part(0.0, v, 0.68, (0.09, 0.08, 0.12), skin)
+    part(0.0, 0.0, 1.45, (0.1, 0.1, 0.08), skin)
+    scene.ellipsoid((x, y, 1.62 * s), 0.11 * s, material=skin)
+    scene.ellipsoid((x - 0.02 * np.cos(yaw), y - 0.02 * np.sin(yaw), 1.66 * s), 0.1 * s, material=hair)

@@ -18,7 +18,7 @@ import numpy as np
 from bionav.world import textures as tx
 from bionav.world.lights import Ambient, PointLight
 from bionav.world.scene import Scene
-from bionav.world.worlds.common import Daylight, World, stream
+from bionav.world.worlds.common import Daylight, Supervisor, World, stream
 from bionav.world.worlds.furniture import cabinet, chair, oriented_box, potted_plant, shelf, table, wall_picture
 
 SPACING = 0.1
@@ -39,6 +39,9 @@ SUN_IRRADIANCE = 3.0
 #: Clouds passing the sun: log-standard deviation of their transmission and correlation length in images.
 CLOUD_SIGMA = 1.0
 CLOUD_IMAGES = 15.0
+#: The supervisor (Supervisor): metres behind the robot along its lane, and the scatter of the stance.
+SUPERVISOR_DISTANCE = 1.2
+SUPERVISOR_JITTER = 0.3
 
 
 def _shell(scene: Scene, seed: int, lx: float, ly: float, lz: float, tag: str) -> None:
@@ -180,7 +183,8 @@ def build_living_room(seed: int = 0) -> World:
                         cloud_images=CLOUD_IMAGES, sky_lights=(sky,), panes=panes, lane_axis=1)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 22),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["living"],
-                 daylight=daylight)
+                 daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
+                                                          jitter_m=SUPERVISOR_JITTER, lane_axis=1))
 
 
 def build_living_kitchen(seed: int = 0) -> World:
@@ -270,4 +274,5 @@ def build_living_kitchen(seed: int = 0) -> World:
                         cloud_images=CLOUD_IMAGES, sky_lights=(), panes=panes, lane_axis=1)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"],
-                 daylight=daylight)
+                 daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
+                                                          jitter_m=SUPERVISOR_JITTER, lane_axis=1))
