@@ -27,7 +27,7 @@ CAMERA_HEIGHT = 0.6
 CLUTTER_GAP = 0.2
 #: Camera tilt std (degrees) in the living rooms (World.floor_tilt_deg): the robot rocks on its caster
 #: over the rug and carpet pile under the moeller1 grid, less on the kitchen tiles and parquet of roeben1.
-FLOOR_TILT_DEG = {"living": 1.0, "kitchen": 0.8}
+FLOOR_TILT_DEG = {"living": 1.3, "kitchen": 1.2}
 #: Contrast of the painted walls (texture value range; real painted walls are nearly uniform).
 WALL_TEXTURE = (0.7, 0.8)
 #: Seconds per image of the supervised recording (drive, semi-automatic position correction, capture):
