@@ -9,7 +9,6 @@ from bionav.geometry import direction_from_angles
 from bionav.light.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import (
-    GROUND_ALBEDO,
     SkyState,
     clear_sky_radiance,
     cloud_fraction,
@@ -22,7 +21,7 @@ from bionav.light.daylight import (
     sky_radiance,
     solar_spectrum,
 )
-from bionav.light.materials import MATERIALS
+from bionav.light.materials import MATERIALS, landscape_albedo
 from bionav.spectral.sensor_model import LogSensorModel
 
 
@@ -110,7 +109,8 @@ def test_sky_integrates_to_the_bird_riordan_diffuse_budget():
     e0 = solar_spectrum([800.0])[0]
     i_r = 0.5 * e0 * (1 - np.exp(-0.95 * tau))
     r_s = 0.5 * (1 - np.exp(-1.8 * tau))
-    i_g = (e0 * np.exp(-tau) + i_r) * r_s * GROUND_ALBEDO / (1 - r_s * GROUND_ALBEDO)
+    a_g = landscape_albedo([800.0])[0]
+    i_g = (e0 * np.exp(-tau) + i_r) * r_s * a_g / (1 - r_s * a_g)
     assert e == pytest.approx(i_r + i_g, rel=1e-3)
 
 
