@@ -216,9 +216,14 @@ def markdown(header: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
 
 
 def write_table(ctx: Context, out: Outcome, name: str, title: str, rows: Sequence[Row]) -> None:
-    body = markdown(["quantity", "thesis", "bionav", "difference", "tolerance", "verdict"],
-                    [[r.quantity, fmt(r.thesis), fmt(r.bionav), fmt(r.difference), fmt(r.tolerance), r.verdict]
-                     for r in rows])
+    """A markdown table of ``rows``; a ``note`` column is added when any row has a note (e.g. per-draw values)."""
+    head = ["quantity", "thesis", "bionav", "difference", "tolerance", "verdict"]
+    body_rows = [[r.quantity, fmt(r.thesis), fmt(r.bionav), fmt(r.difference), fmt(r.tolerance), r.verdict]
+                 for r in rows]
+    if any(r.note for r in rows):
+        head.append("note")
+        body_rows = [b + [r.note] for b, r in zip(body_rows, rows)]
+    body = markdown(head, body_rows)
     (ctx.out / name).write_text(f"# {title}\n\n{body}")
     out.tables.append(name)
 
