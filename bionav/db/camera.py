@@ -344,6 +344,9 @@ def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0)
     supervisor = getattr(world, "supervisor", None)
     if daylight is None and supervisor is None:
         return None
+    if getattr(world.scene, "sky", None) is not None:
+        raise ValueError("recording-session changes (daylight, supervisor) are modelled for indoor worlds only "
+                         "(a compiled scene renders without the world's sky)")
     from bionav.world.render import _compiled
     from bionav.world.worlds.common import Supervisor
 
