@@ -93,9 +93,12 @@ def section_markdown(s: Section, out: Path) -> str:
     if o.missing:
         md += ["**Not produced / incomplete:**", *[f"- {m}" for m in o.missing], ""]
     if o.rows:
-        md += ["| quantity | thesis | bionav | difference | tolerance | verdict |", "|---|---|---|---|---|---|"]
+        notes = any(r.note for r in o.rows)  # e.g. the per-draw values of table 5.3 on the stand-ins
+        md += ["| quantity | thesis | bionav | difference | tolerance | verdict |" + (" note |" if notes else ""),
+               "|---|---|---|---|---|---|" + ("---|" if notes else "")]
         md += [f"| {_cell(r.quantity)} | {_cell(fmt(r.thesis))} | {_cell(fmt(r.bionav))} | {fmt(r.difference)} | "
-               f"{'' if r.tolerance is None else fmt(r.tolerance)} | {r.verdict} |" for r in o.rows]
+               f"{'' if r.tolerance is None else fmt(r.tolerance)} | {r.verdict} |"
+               + (f" {_cell(r.note)} |" if notes else "") for r in o.rows]
         md.append("")
     if o.checks:
         md += ["| check | result | detail |", "|---|---|---|"]
