@@ -358,7 +358,8 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     for k in it:
         i, j = positions[k]
         x, y, z = world.cell_position(i, j)
-        radiance = render_raw_frame(world.scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
+        scene = world.scene if getattr(world, "capture_scene", None) is None else world.capture_scene(int(i), int(j))
+        radiance = render_raw_frame(scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
                                     heading=float(dheads[k]), layout=setup.layout, threads=threads)
         raw = sensor_frame(radiance, setup, rng=noise_rng(seed, (i, j)))
         out[k] = unfold_frame(raw, setup, geometry, tilt=tilts[k])

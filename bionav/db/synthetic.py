@@ -157,7 +157,7 @@ SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
               _lazy("bionav.world.worlds.living", "build_living_kitchen"), "semi-automatic"),
         _spec("sim_uni", (10, 17), 1.0, 170, "normal-view",
               "outdoors at a university entrance: buildings, trees, sky and sun",
-              _lazy("bionav.world.worlds.outdoor", "build_campus"), "outdoor-odometry"),
+              _lazy("bionav.world.worlds.outdoor", "build_uni"), "outdoor-odometry"),
     ]
 }
 
@@ -329,6 +329,8 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         del params["noise"]
         params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
                       pose_error=dataclasses.asdict(pose_error), native_size=list(spec.native_size))
+        if "capture_light" in world.info:  # light changing during the capture (sim_uni)
+            params["capture_light"] = world.info["capture_light"]
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     tag = "" if realism == "ideal" else "-camera"

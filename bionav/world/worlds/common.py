@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import zlib
+from typing import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,6 +53,11 @@ class World:
         camera model of the stand-ins (:func:`bionav.db.camera.camera_images`)
         tilts every capture by a Gaussian draw of this size unless
         ``db.pose_error.tilt_sigma_deg`` is given.
+    capture_scene : callable, optional
+        ``capture_scene(i, j) -> Scene``: the world as lit when cell ``(i, j)``
+        was captured, for worlds whose light changed during the capture (the
+        outdoor *uni*: sun, clouds). The camera model renders every capture
+        with it; ``None`` (and ``db.realism=ideal``) use ``scene``.
     """
 
     scene: Scene
@@ -63,6 +69,7 @@ class World:
     free_area: tuple[float, float, float, float] | None = None
     info: dict = field(default_factory=dict)
     floor_tilt_deg: float = 0.0
+    capture_scene: Callable[[int, int], Scene] | None = None
 
     def __post_init__(self) -> None:
         if self.cells is None:
