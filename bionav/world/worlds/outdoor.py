@@ -41,9 +41,9 @@ PAVING_TEXTURE = (0.45, 0.6)
 # assumptions (docs/databases.md, "uni: light changes during the capture").
 #: Bielefeld University, north entrance (latitude, longitude in degrees).
 SITE_DEG = (52.037, 8.494)
-#: Start of the capture (UTC): a day near the equinox, late morning, so the sun stands about 33-35 deg
+#: Start of the capture (UTC): a day near the equinox, late morning, so the sun stands about 31-33 deg
 #: high in the south during the whole capture and the grid stays in the main building's shadow.
-CAPTURE_START_UTC = "2006-03-13T10:50:00"
+CAPTURE_START_UTC = "2006-03-06T10:50:00"
 #: Seconds per capture: drive 1 m, stop, let the mast settle, grab and store (one lane after the other).
 SECONDS_PER_CAPTURE = 30.0
 #: Fraction of the sky covered by (fair-weather cumulus) clouds.
