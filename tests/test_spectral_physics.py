@@ -9,7 +9,6 @@ from bionav.geometry import direction_from_angles
 from bionav.light.bands import CHANNELS, FWHM_NM, PEAK_NM, band_integrate, band_sensitivity, feature_subsets
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import (
-    GROUND_ALBEDO,
     SkyState,
     clear_sky_radiance,
     cloud_fraction,
@@ -22,7 +21,7 @@ from bionav.light.daylight import (
     sky_radiance,
     solar_spectrum,
 )
-from bionav.light.materials import MATERIALS
+from bionav.light.materials import MATERIALS, landscape_albedo
 from bionav.spectral.sensor_model import LogSensorModel
 
 
@@ -110,7 +109,8 @@ def test_sky_integrates_to_the_bird_riordan_diffuse_budget():
     e0 = solar_spectrum([800.0])[0]
     i_r = 0.5 * e0 * (1 - np.exp(-0.95 * tau))
     r_s = 0.5 * (1 - np.exp(-1.8 * tau))
-    i_g = (e0 * np.exp(-tau) + i_r) * r_s * GROUND_ALBEDO / (1 - r_s * GROUND_ALBEDO)
+    a_g = landscape_albedo([800.0])[0]
+    i_g = (e0 * np.exp(-tau) + i_r) * r_s * a_g / (1 - r_s * a_g)
     assert e == pytest.approx(i_r + i_g, rel=1e-3)
 
 
@@ -211,3 +211,39 @@ def test_a_scattered_cloud_cover_neither_hides_a_low_sun_nor_veils_the_horizon()
     frac = float(cloud_fraction(cloudy, d).mean())
     assert 0.0 < frac < 0.2
     assert np.all(np.abs(rel - 1) <= frac), (rel, frac)
+
+
+def test_green_ground_lights_tilted_surfaces_with_its_own_spectrum():
+    """A vertical wall facing away from the sun: E = diffuse / 2 + a(lambda) E_global / 2 (isotropic sky and ground)."""
+    wl = np.array([350.0, 800.0])
+    state = SkyState(np.deg2rad(40.0), np.deg2rad(90.0), turbidity=0.1)
+    ill = illumination(state, wl)
+    away = -np.array([state.sun_direction[0], state.sun_direction[1], 0.0])
+    away /= np.linalg.norm(away)
+    grass = np.array([0.03, 0.45])
+    got = ill.on_surface(away, ground_albedo=grass)
+    expected = 0.5 * ill.diffuse_horizontal + 0.5 * grass * ill.global_horizontal
+    np.testing.assert_allclose(got, expected, rtol=1e-12)
+    # the green ground makes the wall's light redder in UV-IR than a grey ground of 0.15 does
+    grey = ill.on_surface(away, ground_albedo=0.15)
+    assert got[1] / got[0] > 1.5 * grey[1] / grey[0]
+
+
+def test_landscape_albedo_is_dark_in_uv_and_bright_in_ir_and_brightens_the_cloud_base(monkeypatch):
+    import bionav.light.daylight as daylight
+
+    a = landscape_albedo(np.array([350.0, 440.0, 800.0]))
+    assert 0.02 < a[0] < 0.1 and a[1] < 0.12 and 0.25 < a[2] < 0.4
+    # overcast of optical depth 40: the cloud base reflects the ground's light back down, L = L0 / (1 - a c (1 - T))
+    wl = np.array([350.0, 800.0])
+    state = SkyState(np.deg2rad(45.0), turbidity=0.1, clouds=CloudLayer(cover=1.0, optical_depth=40.0, seed=3))
+    zenith = np.array([0.0, 0.0, 1.0])
+    with_ground = sky_radiance(state, zenith, wl)
+    below = 0.2 * clear_sky_radiance(state, zenith, wl)
+    monkeypatch.setattr(daylight, "landscape_albedo", lambda w: np.zeros(np.shape(w)))
+    monkeypatch.setattr(daylight, "_MS_CACHE", {})  # the clear sky's ground-sky term changes too
+    without = sky_radiance(state, zenith, wl)
+    below_without = 0.2 * clear_sky_radiance(state, zenith, wl)
+    t_c = 1.0 / (1.0 + 0.75 * (1 - 0.85) * 40.0)
+    np.testing.assert_allclose((with_ground - below) / (without - below_without),
+                               1.0 / (1.0 - a[[0, 2]] * (1.0 - t_c)), rtol=1e-9)

@@ -75,6 +75,7 @@ import numpy as np
 from bionav.geometry import direction_from_angles
 from bionav.light.bands import WAVELENGTHS_NM, band_integrate
 from bionav.light.clouds import CloudLayer
+from bionav.light.materials import landscape_albedo
 from bionav.light.sun import BIELEFELD_LAT_DEG, BIELEFELD_LON_DEG, parse_time, sun_position
 
 _H = 6.62607015e-34
@@ -90,7 +91,8 @@ _OZONE_LAYER_M = 22_000.0
 AEROSOL_LAYER_M = 1500.0
 #: Scale height of the molecular atmosphere (m).
 RAYLEIGH_SCALE_HEIGHT_M = 8000.0
-#: Grey albedo of the ground seen by the sky's multiple scattering and by downward-facing surfaces.
+#: Grey ground albedo of :meth:`Illumination.on_surface` when no ground spectrum is given (the sky's
+#: ground reflections use the spectral :func:`bionav.light.materials.landscape_albedo`).
 GROUND_ALBEDO = 0.15
 
 
@@ -270,7 +272,9 @@ def diffuse_irradiance_bird(state: SkyState, wavelengths_nm=WAVELENGTHS_NM) -> n
     reflections ``(E_dir cos Z + I_r + I_a) r_s a_g / (1 - r_s a_g)``, all times
     Bird & Riordan's short-wave correction ``(lambda_um + 0.55)^1.8`` below 450 nm.
     Rayleigh depth of Hansen & Travis, aerosol of Angstrom, gases of
-    :func:`gas_transmittance`; ground albedo :data:`GROUND_ALBEDO`.
+    :func:`gas_transmittance`; spectral ground albedo
+    :func:`bionav.light.materials.landscape_albedo` (a green landscape: dark in
+    the UV, bright in the near infrared).
     """
     wl = np.asarray(wavelengths_nm, dtype=float)
     el = state.sun_elevation
@@ -298,7 +302,8 @@ def diffuse_irradiance_bird(state: SkyState, wavelengths_nm=WAVELENGTHS_NM) -> n
     m2 = 1.8  # the sky's reflectance for light from the ground, at the effective air mass 1.8
     t_r2, t_aa2, t_as2, f_s2, gas2 = parts(m2, gas_transmittance(state, wl, np.arcsin(1 / m2)), 1 / m2)
     r_s = gas2 * t_aa2 * (0.5 * (1 - t_r2) + (1 - f_s2) * t_r2 * (1 - t_as2))
-    i_g = (direct_h + i_r + i_a) * r_s * GROUND_ALBEDO / (1 - r_s * GROUND_ALBEDO)
+    a_g = landscape_albedo(wl)
+    i_g = (direct_h + i_r + i_a) * r_s * a_g / (1 - r_s * a_g)
     lam = wl / 1000.0
     corr = np.where(lam <= 0.45, (lam + 0.55) ** 1.8, 1.0)
     return (i_r + i_a + i_g) * corr
@@ -432,7 +437,9 @@ def sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_NM, *, 
     e_top = solar_spectrum(wl) * _sun_transmittance(state, wl, rayleigh=0.8, aerosol=0.3)
     t_c = _cloud_transmittance(depth)
     sides = (1.0 - state.clouds.cover) * (1.0 - t_c)
-    base = e_top * mu_s * (t_c + sides) / np.pi
+    # light reflected by the ground and back down by the cloud base (reflectance (1 - T) where cloud):
+    # the green landscape's bright near infrared brightens the cloud base there, not in the UV
+    base = e_top * mu_s * (t_c + sides) / np.pi / (1.0 - landscape_albedo(wl) * state.clouds.cover * (1.0 - t_c))
     below = 0.2 * clear  # the air between the observer and the cloud base
     cloud = base * np.exp(-(0.2 * tr + 0.7 * ta) * relative_air_mass(np.arcsin(np.clip(d[..., 2], 0.02, 1)))[..., None]) + below
     return (1 - opacity) * clear + opacity * cloud
@@ -460,7 +467,7 @@ class Illumination:
         """Direct plus diffuse irradiance on a horizontal plane, shape ``(L,)``."""
         return self.direct_normal * max(self.sun_direction[2], 0.0) + self.diffuse_horizontal
 
-    def on_surface(self, normals, *, sunlit=1.0, ground_albedo: float = 0.15) -> np.ndarray:
+    def on_surface(self, normals, *, sunlit=1.0, ground_albedo=GROUND_ALBEDO) -> np.ndarray:
         """Irradiance on tilted surfaces, shape ``(..., L)``.
 
         Parameters
@@ -469,8 +476,10 @@ class Illumination:
             Unit surface normals (east-north-up).
         sunlit : float or array_like, shape (...)
             1 in the sun, 0 in shadow (or any fraction: penumbra, foliage).
-        ground_albedo : float
-            Grey albedo of the ground that lights downward-facing surfaces.
+        ground_albedo : float or array_like, shape (L,)
+            Albedo of the ground that lights surfaces tilted towards it: grey, or
+            a reflectance spectrum on the illumination's wavelengths (green
+            ground reflects several times more near infrared than UV).
 
         Notes
         -----

@@ -221,6 +221,42 @@ ARTIFICIAL_MIX: dict[str, float] = {
     "lacquered_metal": 0.20, "metal_bare": 0.04,
 }
 
+#: The ground round the natural samples (whose reflection lights surfaces tilted towards it):
+#: the ground kinds of :data:`NATURAL_MIX` in their shares there.
+NATURAL_GROUND_MIX: dict[str, float] = {
+    "grass": 0.18, "dead_leaves": 0.08, "tar": 0.05, "gravel": 0.05, "sand": 0.04, "soil": 0.06,
+}
+
+#: The ground round the artificial samples (built-up surroundings: paving, asphalt, lawn).
+ARTIFICIAL_GROUND_MIX: dict[str, float] = {"concrete": 1.0, "tar": 1.0, "grass": 1.0}
+
+
+@lru_cache(maxsize=1)
+def _landscape_albedo() -> np.ndarray:
+    w = np.array(list(NATURAL_GROUND_MIX.values()))
+    out = sum(wi * MATERIALS[k].mean_spectrum() for wi, k in zip(w / w.sum(), NATURAL_GROUND_MIX))
+    out.setflags(write=False)
+    return out
+
+
+def landscape_albedo(wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
+    """Spectral albedo of the landscape round the observer, shape ``(L,)``.
+
+    The share-weighted mean reflectance of the ground kinds of
+    :data:`NATURAL_GROUND_MIX` (grass, dead leaves, tar, gravel, sand, soil):
+    about 0.06 at 350 nm, 0.09 at 440, 0.12 at 500, 0.19 at 680 and 0.30 at
+    800 nm (channel means), the green landscape's dark UV and bright near
+    infrared (satellite albedos of vegetated land: 0.03-0.08 visible, 0.25-0.35
+    near infrared). It lights the sky from below (ground-sky and ground-cloud
+    reflections, :mod:`bionav.light.daylight`).
+
+    Parameters
+    ----------
+    wavelengths_nm : array_like, shape (L,)
+        Wavelengths in nm (300-1100; held constant outside).
+    """
+    return np.interp(np.asarray(wavelengths_nm, dtype=float), WAVELENGTHS_NM, _landscape_albedo())
+
 
 def band_reflectance_table() -> tuple[list[str], np.ndarray]:
     """Names and band reflectances ``(M, 5)`` of every material (documentation and plots)."""

@@ -42,7 +42,13 @@ from bionav.light.daylight import (
     illumination,
     rayleigh_optical_depth,
 )
-from bionav.light.materials import ARTIFICIAL_MIX, MATERIALS, NATURAL_MIX
+from bionav.light.materials import (
+    ARTIFICIAL_GROUND_MIX,
+    ARTIFICIAL_MIX,
+    MATERIALS,
+    NATURAL_GROUND_MIX,
+    NATURAL_MIX,
+)
 from bionav.light.sun import BIELEFELD_LAT_DEG, BIELEFELD_LON_DEG, sun_position
 from bionav.spectral.sensor_model import LogSensorModel
 
@@ -178,10 +184,14 @@ def _sky_samples(rng, n, ranges, sensor, n_average):
     return np.array(counts), np.array(kinds), np.array(times)
 
 
-def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average):
+def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average, ground_mix):
     weather = _Weather(rng)
     names = list(mix)
     p = np.array([mix[k] for k in names])
+    # the ground round each object, drawn from its own stream (the object draws stay as they were)
+    ground_rng = np.random.default_rng(rng.bit_generator.seed_seq.spawn(1)[0])
+    ground_names = list(ground_mix)
+    ground_p = np.array([ground_mix[k] for k in ground_names])
     counts, kinds, times = [], [], []
     for _ in range(n):
         t, el, az = _draw_time(rng, ranges, np.deg2rad(5.0))
@@ -197,8 +207,11 @@ def _object_samples(rng, n, ranges, mix, distance_m, sensor, n_average):
             normal = normal * np.array([-1.0, -1.0, 1.0])
         in_shadow = rng.random() < 0.3
         ill = illumination(state)
+        ground = MATERIALS[ground_names[ground_rng.choice(len(ground_names), p=ground_p / ground_p.sum())]]
+        ground_albedo = ground.sample(ground_rng)[0]
         # spectral shading: integrate reflectance x irradiance over each channel (not band means multiplied)
-        rad = band_integrate(rho * ill.on_surface(normal, sunlit=0.0 if in_shadow else 1.0)) / np.pi
+        rad = band_integrate(rho * ill.on_surface(normal, sunlit=0.0 if in_shadow else 1.0,
+                                                         ground_albedo=ground_albedo)) / np.pi
         gloss = rng.uniform(*mat.gloss) if mat.gloss[1] > 0 else 0.0
         if gloss > 0:
             mirror = view - 2 * (view @ normal) * normal
@@ -263,7 +276,8 @@ def sim_natural(*, seed: int, n_objects: int = 239, n_sky: int = 233,
     """
     sensor = sensor or LogSensorModel()
     rng = np.random.default_rng([seed, 1])
-    c, k, t = _object_samples(rng, n_objects, _NATURAL_DATES, NATURAL_MIX, (5.0, 30.0), sensor, n_average)
+    c, k, t = _object_samples(rng, n_objects, _NATURAL_DATES, NATURAL_MIX, (5.0, 30.0), sensor, n_average,
+                             NATURAL_GROUND_MIX)
     objects = SampleSet(c, np.zeros(n_objects, bool), k, t)
     return objects.concat(sim_sky(seed=seed, n_sky=n_sky, sensor=sensor, n_average=n_average), name="sim_natural")
 
@@ -277,7 +291,8 @@ def sim_artificial(*, seed: int, n_objects: int = 124, n_sky: int = 233,
     """
     sensor = sensor or LogSensorModel()
     rng = np.random.default_rng([seed, 2])
-    c, k, t = _object_samples(rng, n_objects, _ARTIFICIAL_DATES, ARTIFICIAL_MIX, (0.5, 2.0), sensor, n_average)
+    c, k, t = _object_samples(rng, n_objects, _ARTIFICIAL_DATES, ARTIFICIAL_MIX, (0.5, 2.0), sensor, n_average,
+                             ARTIFICIAL_GROUND_MIX)
     objects = SampleSet(c, np.zeros(n_objects, bool), k, t)
     return objects.concat(sim_sky(seed=seed, n_sky=n_sky, sensor=sensor, n_average=n_average), name="sim_artificial")
 
