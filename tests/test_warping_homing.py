@@ -142,7 +142,7 @@ def test_thesis_presets_fit_the_typed_config(preset, cls):
     cfg = OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(cls.Config), raw))
     assert cfg.n_alpha == cfg.n_psi == 72 and cfg.image_size == [346, 50]
     assert cfg.scales == pytest.approx([0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8])
-    method = cls(cfg, geometry=PanoramaGeometry.square_pixels(692, 100))
+    method = cls(cfg, geometry=PanoramaGeometry.square_pixels(692, 100), raw_horizon_radius_px=80.5)
     assert method.prepare(np.zeros((100, 692), np.float32))["snap"].shape == (9, 49, 346)
 
 

@@ -344,6 +344,8 @@ def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0)
     supervisor = getattr(world, "supervisor", None)
     if daylight is None and supervisor is None:
         return None
+    if getattr(world, "capture_scene", None) is not None:
+        raise ValueError("a world has either World.capture_scene or a recording session (daylight, supervisor)")
     if getattr(world.scene, "sky", None) is not None:
         raise ValueError("recording-session changes (daylight, supervisor) are modelled for indoor worlds only "
                          "(a compiled scene renders without the world's sky)")
@@ -438,7 +440,12 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     for k in it:
         i, j = positions[k]
         x, y, z = world.cell_position(i, j)
-        scene = world.scene if scene_at is None else scene_at(k)
+        if scene_at is not None:  # the recording session of a living room (daylight, supervisor)
+            scene = scene_at(k)
+        elif getattr(world, "capture_scene", None) is not None:  # the light of the capture (sim_uni)
+            scene = world.capture_scene(int(i), int(j))
+        else:
+            scene = world.scene
         radiance = render_raw_frame(scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
                                     heading=float(dheads[k]), layout=setup.layout, threads=threads)
         if scene_at is not None:  # a CompiledScene renders without the scene's exposure

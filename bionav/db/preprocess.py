@@ -56,6 +56,7 @@ from bionav.homing.imageops import (
     check_image_size,
     edge_filter,
     equalize_histogram,
+    panorama_cutoff_from_raw,
     resize_images,
 )
 
@@ -117,30 +118,6 @@ def _normalise_step(step) -> dict:
             raise UserError("preprocessing op 'resize' needs size: [W, H].")
         step["size"] = list(check_image_size(step["size"], name="resize size"))
     return {"op": op, **step}
-
-
-def panorama_cutoff_from_raw(cutoff: float, *, width: int, raw_horizon_radius_px: float) -> float:
-    """A Butterworth cutoff relative to the raw frame's Nyquist frequency, as one relative to a panorama's.
-
-    ``cutoff_panorama = cutoff * 2 pi r_h / W``: a frequency of ``cutoff / 2``
-    cycles per raw pixel on the raw horizon circle (radius ``r_h`` pixels) is
-    ``pi r_h cutoff`` cycles per revolution, whatever the panorama width ``W``.
-
-    Parameters
-    ----------
-    cutoff : float
-        Relative to the raw frame's Nyquist frequency (thesis 5.2.1: bw1 0.03, bw2 0.015).
-    width : int
-        Panorama width ``W`` in pixels (columns per 360 degrees).
-    raw_horizon_radius_px : float
-        Radius of the horizon circle in the raw frame, pixels.
-
-    Returns
-    -------
-    float
-        Cutoff relative to the panorama's Nyquist frequency (0.5 cycles per pixel).
-    """
-    return float(cutoff) * 2.0 * np.pi * float(raw_horizon_radius_px) / int(width)
 
 
 def preprocess_images(images: np.ndarray, steps, *, raw_horizon_radius_px: float | None = None) -> np.ndarray:

@@ -157,7 +157,7 @@ SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
               _lazy("bionav.world.worlds.living", "build_living_kitchen"), "semi-automatic"),
         _spec("sim_uni", (10, 17), 1.0, 170, "normal-view",
               "outdoors at a university entrance: buildings, trees, sky and sun",
-              _lazy("bionav.world.worlds.outdoor", "build_campus"), "outdoor-odometry"),
+              _lazy("bionav.world.worlds.outdoor", "build_uni"), "outdoor-odometry"),
     ]
 }
 
@@ -332,6 +332,8 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
             if getattr(world, what, None) is not None:
                 params[what] = dataclasses.asdict(getattr(world, what))
+        if "capture_light" in world.info:  # light changing during the capture (sim_uni)
+            params["capture_light"] = world.info["capture_light"]
     key = cache_key(params)
     cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     tag = "" if realism == "ideal" else "-camera"

@@ -70,6 +70,15 @@ def _from_arrays(data: dict[str, np.ndarray]) -> Any:
     return cls(**data)
 
 
+def _extra(method: Any, signature: Any) -> Any:
+    """What else the prepared result depends on: the signature's config, the raw horizon radius if set."""
+    extra = getattr(signature, "config", None)
+    radius = getattr(method, "raw_horizon_radius_px", None)
+    if radius is not None and getattr(method.config, "butterworth_relative_to", "panorama") == "raw":
+        extra = [_plain(extra), float(radius)]
+    return extra
+
+
 class PreparedCache:
     """Directory of cached per-image results for one method configuration.
 
@@ -115,7 +124,7 @@ class PreparedCache:
         key = prepared_key(
             self.method_name, method.config, method.geometry, image,
             version=str(getattr(method, "cache_version", "1")),
-            extra=getattr(signature, "config", None),
+            extra=_extra(method, signature),
         )
         value = self.get(key)
         if value is not None:

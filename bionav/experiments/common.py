@@ -63,16 +63,29 @@ def worker_pool(workers: int, *, initializer=None, initargs: tuple = ()):
     pool.join()
 
 
-def make_homing(cfg: DictConfig, ctx, geometry):
-    """Instantiate ``cfg.homing`` (and ``cfg.signature`` for methods that take one)."""
+def make_homing(cfg: DictConfig, ctx, geometry, *, raw_horizon_radius_px: float | None = None):
+    """Instantiate ``cfg.homing`` (and ``cfg.signature`` for methods that take one).
+
+    Methods that take ``raw_horizon_radius_px`` (filters defined on the raw
+    camera frame, e.g. the warping methods' ``butterworth_relative_to=raw``)
+    get the database's (``db.meta["raw_horizon_radius_px"]``), else the
+    ultra-wide-view mirror's, as the preprocessing chain (:mod:`bionav.db.preprocess`).
+    """
     import inspect
 
     from bionav import registry
 
     cls = registry.load_plugin("homing", str(cfg.homing.name))
     kwargs: dict[str, Any] = {"geometry": geometry}
-    if "signature" in inspect.signature(cls.__init__).parameters and cfg.get("signature"):
+    params = inspect.signature(cls.__init__).parameters
+    if "signature" in params and cfg.get("signature"):
         kwargs["signature"] = ctx.plugin("signature", cfg.signature)
+    if "raw_horizon_radius_px" in params:
+        if raw_horizon_radius_px is None:
+            from bionav.db.camera import raw_horizon_radius
+
+            raw_horizon_radius_px = raw_horizon_radius("ultra-wide")
+        kwargs["raw_horizon_radius_px"] = float(raw_horizon_radius_px)
     return ctx.plugin("homing", cfg.homing, **kwargs)
 
 

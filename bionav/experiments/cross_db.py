@@ -85,7 +85,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                 f"cross_db needs one grid and image geometry for the whole family, but {name} differs from "
                 f"{names[0]} ({db.grid_shape} vs {first.grid_shape}); choose databases of one family."
             )
-    method = make_homing(cfg, ctx, first.geometry)
+    method = make_homing(cfg, ctx, first.geometry, raw_horizon_radius_px=first.meta.get("raw_horizon_radius_px"))
     cache = prepared_cache(cfg)
     prepared = [prepare_images(method, list(db.images), workers=int(cfg.workers), cache=cache) for db in dbs]
     stride = max(1, int(exp.snapshot_stride))

@@ -60,7 +60,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
 
     exp = experiment_config(cfg, "grid_homing")
     db = load_configured_database(cfg)
-    method = make_homing(cfg, ctx, db.geometry)
+    method = make_homing(cfg, ctx, db.geometry, raw_horizon_radius_px=db.meta.get("raw_horizon_radius_px"))
     snapshots = None if exp.snapshots is None else list(exp.snapshots)
     if snapshots is not None and max(snapshots) >= len(db):
         from bionav.errors import UserError

@@ -154,6 +154,30 @@ def butterworth_response(fx, fy, *, order: int, cutoff: float) -> np.ndarray:
     return 1.0 / np.sqrt(1.0 + (rho / cutoff) ** (2 * order))
 
 
+def panorama_cutoff_from_raw(cutoff: float, *, width: int, raw_horizon_radius_px: float) -> float:
+    """A Butterworth cutoff relative to the raw frame's Nyquist frequency, as one relative to a panorama's.
+
+    ``cutoff_panorama = cutoff * 2 pi r_h / W``: a frequency of ``cutoff / 2``
+    cycles per raw pixel on the raw horizon circle (radius ``r_h`` pixels) is
+    ``pi r_h cutoff`` cycles per revolution, whatever the panorama width ``W``.
+
+    Parameters
+    ----------
+    cutoff : float
+        Relative to the raw frame's Nyquist frequency (thesis 5.2.1: bw1 0.03, bw2 0.015).
+    width : int
+        Panorama width ``W`` in pixels (columns per 360 degrees).
+    raw_horizon_radius_px : float
+        Radius of the horizon circle in the raw frame, pixels.
+
+    Returns
+    -------
+    float
+        Cutoff relative to the panorama's Nyquist frequency (0.5 cycles per pixel).
+    """
+    return float(cutoff) * 2.0 * np.pi * float(raw_horizon_radius_px) / int(width)
+
+
 def butterworth_lowpass(images, *, cutoff: float, order: int = 1, passes: int = 1,
                         clip: tuple[float, float] | None = (0.0, 1.0)) -> np.ndarray:
     """Butterworth low-pass filter of panoramas in the frequency domain.

@@ -31,8 +31,7 @@ def _compiled(scene: Scene | CompiledScene) -> CompiledScene:
     if isinstance(scene, CompiledScene):
         return scene
     cached = scene.info.get("_compiled")
-    sig = (len(scene.textures), len(scene.materials), len(scene.boxes), len(scene.frusta),
-           len(scene.ellipsoids), len(scene.lights), id(scene.ambient))
+    sig = scene.compile_key()
     if cached is None or cached[0] != sig:
         cached = (sig, scene.compile())
         scene.info["_compiled"] = cached

@@ -45,14 +45,49 @@ def _check_common(name: str, cfg) -> None:
         raise UserError(f"homing.butterworth_order={cfg.butterworth_order} must be >= 1 (the thesis uses 3)")
 
 
+#: what ``homing.butterworth_cutoff`` is relative to: the loaded panorama's Nyquist frequency, or the raw
+#: camera frame's (thesis 5.1.4: the raw frames were filtered with cutoff 0.1 before unfolding)
+BUTTERWORTH_RELATIVE_TO = ("panorama", "raw")
+
+
+def panorama_cutoff(method: HomingMethod, width: int) -> float | None:
+    """The warping method's Butterworth cutoff relative to a ``width``-pixel panorama's Nyquist frequency.
+
+    With ``butterworth_relative_to=raw`` the configured cutoff is relative to
+    the raw camera frame's Nyquist frequency and is converted by
+    :func:`bionav.homing.imageops.panorama_cutoff_from_raw` (the conversion of
+    the preprocessing presets bw1/bw2) with the database's raw horizon radius
+    (``raw_horizon_radius_px``, passed by the experiment; the ultra-wide-view
+    mirror's when the database names none), so the filter keeps the same
+    angular detail at every panorama width. None when the filter is off. The result may exceed 1 (nothing is
+    removed below the panorama's Nyquist frequency).
+    """
+    cfg = method.config
+    if cfg.butterworth_cutoff is None:
+        return None
+    if getattr(cfg, "butterworth_relative_to", "panorama") != "raw":
+        return float(cfg.butterworth_cutoff)
+    from bionav.homing.imageops import panorama_cutoff_from_raw
+
+    radius = getattr(method, "raw_horizon_radius_px", None)
+    if radius is None:
+        raise UserError(
+            f"homing.butterworth_relative_to=raw needs the raw frame's horizon radius, which {method.name} was "
+            "not given; run it through an experiment (python -m bionav experiment=grid_homing ...), which "
+            "passes the database's, or set homing.butterworth_relative_to=panorama"
+        )
+    return panorama_cutoff_from_raw(cfg.butterworth_cutoff, width=int(width), raw_horizon_radius_px=radius)
+
+
 def _prepare_image(method: HomingMethod, image):
     from bionav.homing.imageops import butterworth_lowpass, resize_panorama
 
     cfg = method.config
     img = _grey(image)
-    if cfg.butterworth_cutoff is not None:
+    cutoff = panorama_cutoff(method, img.shape[1])
+    if cutoff is not None:
         # the warping methods' filter: applied twice (power response), float64 transform, no clipping
-        img = butterworth_lowpass(img.astype(np.float64), cutoff=cfg.butterworth_cutoff, order=cfg.butterworth_order,
+        img = butterworth_lowpass(img.astype(np.float64), cutoff=cutoff, order=cfg.butterworth_order,
                                   passes=2, clip=None)
     geometry = method.geometry
     if img.shape != (geometry.height, geometry.width):
@@ -65,8 +100,9 @@ class _PlaneWarping(HomingMethod):
 
     requires_alignment = False
 
-    def __init__(self, config: Any, *, geometry) -> None:
+    def __init__(self, config: Any, *, geometry, raw_horizon_radius_px: float | None = None) -> None:
         super().__init__(config, geometry=geometry)
+        self.raw_horizon_radius_px = None if raw_horizon_radius_px is None else float(raw_horizon_radius_px)
         self._check()
         self._template = None
         self._template_width = None
@@ -173,6 +209,9 @@ class MinWarping(_PlaneWarping):
         butterworth_cutoff: relative cutoff of a Butterworth low-pass applied before
             resizing; null switches it off (thesis: 0.1, order 3).
         butterworth_order: order of that filter.
+        butterworth_relative_to: panorama (the cutoff is relative to the loaded panorama's Nyquist
+            frequency) or raw (relative to the raw camera frame's, as the thesis' 0.1: the same
+            angular detail at every db.image_size; see bionav.homing.imageops.panorama_cutoff_from_raw).
         n_alpha, n_psi: search steps over 360 degrees for movement direction and rotation.
         scales: scale factors of the planes; null = 2 ** ((k - 4) / 4), k = 0..8.
         thresholds: upper scale thresholds per plane; null = by threshold_rule.
@@ -193,6 +232,7 @@ class MinWarping(_PlaneWarping):
         image_size: list[int] | None = bounded([288, 50], length=2, item=Range(ge=8, le=8192))
         butterworth_cutoff: float | None = bounded(None, gt=0.0, le=1.0)
         butterworth_order: int = bounded(3, ge=1, le=10)
+        butterworth_relative_to: str = bounded("panorama", choices=BUTTERWORTH_RELATIVE_TO)
         n_alpha: int = bounded(96, ge=4, le=4096)
         n_psi: int = bounded(96, ge=4, le=4096)
         scales: list[float] | None = bounded(None, gt=0.0, le=100.0)
@@ -263,6 +303,7 @@ class Warping2D(_PlaneWarping):
         image_size: list[int] | None = bounded([288, 50], length=2, item=Range(ge=8, le=8192))
         butterworth_cutoff: float | None = bounded(None, gt=0.0, le=1.0)
         butterworth_order: int = bounded(3, ge=1, le=10)
+        butterworth_relative_to: str = bounded("panorama", choices=BUTTERWORTH_RELATIVE_TO)
         n_alpha: int = bounded(96, ge=4, le=4096)
         n_psi: int = bounded(96, ge=4, le=4096)
         n_rho: int = bounded(20, ge=1, le=1000)
@@ -323,7 +364,8 @@ class Warping1D(HomingMethod):
         """Parameters of 1D warping.
 
         image_size: [W, H] the panorama is resized to before the strip is taken.
-        butterworth_cutoff, butterworth_order: optional low-pass before resizing.
+        butterworth_cutoff, butterworth_order, butterworth_relative_to: optional low-pass before
+            resizing (see :class:`MinWarping.Config`).
         strip_rows: rows around the horizon averaged into the strip.
         n_alpha, n_psi, n_rho: search steps; rho_max: largest distance ratio.
         """
@@ -331,14 +373,16 @@ class Warping1D(HomingMethod):
         image_size: list[int] | None = bounded([288, 50], length=2, item=Range(ge=8, le=8192))
         butterworth_cutoff: float | None = bounded(None, gt=0.0, le=1.0)
         butterworth_order: int = bounded(3, ge=1, le=10)
+        butterworth_relative_to: str = bounded("panorama", choices=BUTTERWORTH_RELATIVE_TO)
         strip_rows: int = bounded(5, ge=1, le=8192)
         n_alpha: int = bounded(36, ge=4, le=4096)
         n_psi: int = bounded(36, ge=4, le=4096)
         n_rho: int = bounded(36, ge=1, le=1000)
         rho_max: float = bounded(0.95, ge=0.0, lt=1.0)
 
-    def __init__(self, config: Any, *, geometry) -> None:
+    def __init__(self, config: Any, *, geometry, raw_horizon_radius_px: float | None = None) -> None:
         super().__init__(config, geometry=geometry)
+        self.raw_horizon_radius_px = None if raw_horizon_radius_px is None else float(raw_horizon_radius_px)
         cfg = self.config
         _check_common(self.name, cfg)
         if cfg.strip_rows < 1:

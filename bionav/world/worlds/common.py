@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import zlib
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -320,6 +321,11 @@ class World:
         camera model of the stand-ins (:func:`bionav.db.camera.camera_images`)
         tilts every capture by a Gaussian draw of this size unless
         ``db.pose_error.tilt_sigma_deg`` is given.
+    capture_scene : callable, optional
+        ``capture_scene(i, j) -> Scene``: the world as lit when cell ``(i, j)``
+        was captured, for worlds whose light changed during the capture (the
+        outdoor *uni*: sun, clouds). The camera model renders every capture
+        with it; ``None`` (and ``db.realism=ideal``) use ``scene``.
     """
 
     scene: Scene
@@ -333,6 +339,7 @@ class World:
     floor_tilt_deg: float = 0.0
     daylight: Daylight | None = None
     supervisor: Supervisor | None = None
+    capture_scene: Callable[[int, int], Scene] | None = None
 
     def __post_init__(self) -> None:
         if self.cells is None:
