@@ -10,7 +10,7 @@ from bionav.light.sun import parse_time, sun_position
 from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.render import render_panorama
 from bionav.world.worlds import outdoor
-from bionav.world.worlds.outdoor import (CaptureLight, CloudField, build_campus, build_uni, capture_order)
+from bionav.world.worlds.outdoor import CaptureLight, CloudField, build_campus, build_uni, capture_order
 
 
 @pytest.fixture(scope="module")

@@ -23,8 +23,8 @@ or stretches it over the whole face (``fit=True``, posters and pictures).
 
 from __future__ import annotations
 
-import hashlib
 import dataclasses
+import hashlib
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
