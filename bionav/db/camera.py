@@ -127,6 +127,42 @@ def pose_offsets(cells, *, position_sigma_m: float, heading_sigma_deg: float, se
     return draw[:, :2] * float(position_sigma_m), draw[:, 2] * math.radians(float(heading_sigma_deg))
 
 
+def lane_heading_drift(cells, *, drift_sigma_deg: float, seed: int, db_seed: int = 0) -> np.ndarray:
+    """Odometry's heading drift at grid ``cells``: a random walk over the turns between lanes.
+
+    The robot drives its lanes along the grid's ``j`` axis, lane ``i`` after
+    lane ``i - 1`` (as :meth:`bionav.world.worlds.common.Daylight.capture_fraction`
+    and :func:`bionav.world.worlds.outdoor.capture_order`); each turn between two
+    lanes adds a Gaussian heading error (std ``drift_sigma_deg``) that stays
+    with all later lanes, since correcting the position does not correct the
+    heading. Lane 0 has no drift. A lane's drift depends only on the seeds and
+    the lane, not on which cells are rendered.
+
+    Parameters
+    ----------
+    cells : array_like, shape (N, 2), int
+        Grid cells ``(i, j)``; ``i`` is the lane.
+    drift_sigma_deg : float
+        Standard deviation of the heading change per lane turn, degrees.
+    seed, db_seed : int
+        ``db.pose_error.seed`` and ``db.seed``.
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        Heading errors in radians (counter-clockwise), to be added to those of :func:`pose_offsets`.
+    """
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    if len(cells) == 0 or float(drift_sigma_deg) == 0.0:
+        return np.zeros(len(cells))
+    lanes = np.arange(1, int(cells[:, 0].max()) + 1)
+    steps = np.array([np.random.default_rng(np.random.SeedSequence(
+        [int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF, 0x64726674, int(lane)])).standard_normal()
+        for lane in lanes])
+    walk = np.concatenate([[0.0], np.cumsum(steps)])
+    return walk[np.clip(cells[:, 0], 0, None)] * math.radians(float(drift_sigma_deg))
+
+
 def noise_rng(seed: int, cell) -> np.random.Generator:
     """The generator of the sensor noise of the image at grid ``cell = (i, j)`` (``seed`` = ``db.seed``)."""
     return np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x63616D65, int(cell[0]),
@@ -157,10 +193,14 @@ def tilt_offsets(cells, *, tilt_sigma_deg: float, seed: int, db_seed: int = 0) -
 
 
 def resolve_pose_error(pose_error: PoseErrorConfig, world) -> PoseErrorConfig:
-    """``pose_error`` with ``tilt_sigma_deg=None`` replaced by the world's floor (``World.floor_tilt_deg``)."""
-    if pose_error.tilt_sigma_deg is not None:
-        return pose_error
-    return dataclasses.replace(pose_error, tilt_sigma_deg=float(getattr(world, "floor_tilt_deg", 0.0)))
+    """``pose_error`` with ``tilt_sigma_deg=None`` and ``heading_drift_deg=None`` replaced by the world's floor
+    (``World.floor_tilt_deg``, ``World.heading_drift_deg``)."""
+    if pose_error.tilt_sigma_deg is None:
+        pose_error = dataclasses.replace(pose_error, tilt_sigma_deg=float(getattr(world, "floor_tilt_deg", 0.0)))
+    if pose_error.heading_drift_deg is None:
+        pose_error = dataclasses.replace(pose_error,
+                                         heading_drift_deg=float(getattr(world, "heading_drift_deg", 0.0)))
+    return pose_error
 
 
 def tilted_row_radii(setup: "CameraSetup", geometry: PanoramaGeometry, tilt) -> np.ndarray:
@@ -426,6 +466,8 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     offsets, dheads = pose_offsets(positions, position_sigma_m=float(pose_error.position_sigma_m),
                                    heading_sigma_deg=float(pose_error.heading_sigma_deg),
                                    seed=int(pose_error.seed), db_seed=int(seed))
+    dheads = dheads + lane_heading_drift(positions, drift_sigma_deg=float(pose_error.heading_drift_deg),
+                                         seed=int(pose_error.seed), db_seed=int(seed))
     tilts = tilt_offsets(positions, tilt_sigma_deg=float(pose_error.tilt_sigma_deg), seed=int(pose_error.seed),
                          db_seed=int(seed))
     setup = camera_setup(camera, geometry, native_size=native_size,

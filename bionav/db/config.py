@@ -67,13 +67,18 @@ class PoseErrorConfig:
     (std ``heading_sigma_deg``) and tilt (std ``tilt_sigma_deg`` about each
     horizontal axis; ``null``: the world's floor, ``World.floor_tilt_deg``); the
     database still reports the nominal grid (the ground truth of the real
-    databases is the nominal grid too). Drawn from ``seed`` (together with
+    databases is the nominal grid too). ``heading_drift_deg`` adds odometry's
+    heading drift: a Gaussian heading change (std ``heading_drift_deg``) at each
+    turn between two lanes, accumulated along the lanes (a random walk; a
+    position correction does not remove it); ``null``: the world's floor,
+    ``World.heading_drift_deg``. Drawn from ``seed`` (together with
     ``db.seed``).
     """
 
     position_sigma_m: float = bounded(0.02, ge=0.0, le=10.0)
     heading_sigma_deg: float = bounded(1.5, ge=0.0, le=180.0)
     tilt_sigma_deg: Optional[float] = bounded(None, ge=0.0, le=20.0)
+    heading_drift_deg: Optional[float] = bounded(None, ge=0.0, le=45.0)
     seed: int = bounded(0, ge=0, le=2**32 - 1)
 
 

@@ -327,8 +327,11 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         camera, pose_error = _camera_configs(spec, camera, pose_error, geometry)
         pose_error = resolve_pose_error(pose_error, world)  # tilt_sigma_deg=None: the world's floor
         del params["noise"]
+        pose_key = dataclasses.asdict(pose_error)
+        if pose_key["heading_drift_deg"] == 0.0:  # no drift: the key (and cache) of the stand-ins before the drift
+            del pose_key["heading_drift_deg"]
         params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
-                      pose_error=dataclasses.asdict(pose_error), native_size=list(spec.native_size))
+                      pose_error=pose_key, native_size=list(spec.native_size))
         for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
             if getattr(world, what, None) is not None:
                 params[what] = dataclasses.asdict(getattr(world, what))

@@ -321,6 +321,13 @@ class World:
         camera model of the stand-ins (:func:`bionav.db.camera.camera_images`)
         tilts every capture by a Gaussian draw of this size unless
         ``db.pose_error.tilt_sigma_deg`` is given.
+    heading_drift_deg : float
+        Standard deviation in degrees of the robot's heading change at each
+        turn between two lanes that its odometry did not see (wheel slip;
+        more on carpet pile than on hard floors). The camera model adds the
+        accumulated drift to every capture's heading
+        (:func:`bionav.db.camera.lane_heading_drift`) unless
+        ``db.pose_error.heading_drift_deg`` is given.
     capture_scene : callable, optional
         ``capture_scene(i, j) -> Scene``: the world as lit when cell ``(i, j)``
         was captured, for worlds whose light changed during the capture (the
@@ -337,6 +344,7 @@ class World:
     free_area: tuple[float, float, float, float] | None = None
     info: dict = field(default_factory=dict)
     floor_tilt_deg: float = 0.0
+    heading_drift_deg: float = 0.0
     daylight: Daylight | None = None
     supervisor: Supervisor | None = None
     capture_scene: Callable[[int, int], Scene] | None = None

@@ -27,7 +27,11 @@ CAMERA_HEIGHT = 0.6
 CLUTTER_GAP = 0.2
 #: Camera tilt std (degrees) in the living rooms (World.floor_tilt_deg): the robot rocks on its caster
 #: over the rug and carpet pile under the moeller1 grid, less on the kitchen tiles and parquet of roeben1.
-FLOOR_TILT_DEG = {"living": 1.3, "kitchen": 1.2}
+FLOOR_TILT_DEG = {"living": 0.3, "kitchen": 0.8}
+#: Heading drift std (degrees) per lane turn (World.heading_drift_deg): the Pioneer's wheels slip when it
+#: turns on the spot, more on the rug and carpet pile under the moeller1 grid than on roeben1's tiles and
+#: parquet; the supervisor corrected the positions, not the headings (thesis 3.1, Kreft 2007).
+HEADING_DRIFT_DEG = {"living": 12.0, "kitchen": 6.0}
 #: Contrast of the painted walls (texture value range; real painted walls are nearly uniform).
 WALL_TEXTURE = (0.7, 0.8)
 #: Seconds per image of the supervised recording (drive, semi-automatic position correction, capture):
@@ -183,6 +187,7 @@ def build_living_room(seed: int = 0) -> World:
                         cloud_images=CLOUD_IMAGES, sky_lights=(sky,), panes=panes, lane_axis=1)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 22),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["living"],
+                 heading_drift_deg=HEADING_DRIFT_DEG["living"],
                  daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
                                                           jitter_m=SUPERVISOR_JITTER, lane_axis=1))
 
@@ -274,5 +279,6 @@ def build_living_kitchen(seed: int = 0) -> World:
                         cloud_images=CLOUD_IMAGES, sky_lights=(), panes=panes, lane_axis=1)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"],
+                 heading_drift_deg=HEADING_DRIFT_DEG["kitchen"],
                  daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
                                                           jitter_m=SUPERVISOR_JITTER, lane_axis=1))
