@@ -97,9 +97,9 @@ def test_the_world_floor_sets_the_tilt_unless_the_config_does():
     assert pe.tilt_sigma_deg is None and resolve_pose_error(pe, world).tilt_sigma_deg == 1.7
     pe0 = pose_error_config_for("odometry", tilt_sigma_deg=0.0)
     assert resolve_pose_error(pe0, world).tilt_sigma_deg == 0.0
-    # the hard floors of lab, hall and paving tilt the robot no more than the living rooms' floors
+    # every stand-in states a tilt of at least the mast sway of a stopped robot
     tilt = {n: get_spec(n).builder(0).floor_tilt_deg for n in SYNTHETIC_DATABASES}
-    assert max(tilt["sim_original"], tilt["sim_hall1"], tilt["sim_uni"]) <= min(tilt["sim_moeller1"], tilt["sim_roeben1"])
+    assert min(tilt.values()) >= 0.3
     assert all(0.0 <= v <= 3.0 for v in tilt.values())
 
 

@@ -32,7 +32,7 @@ CAMERA_HEIGHT = 0.8
 #: Least distance in metres between a tree and the capture area (thesis 3.1: distant buildings and trees).
 TREE_CLEARANCE = 7.0
 #: Camera tilt std (degrees) of the four-wheeled robot on the level paving (joints, mast sway; World.floor_tilt_deg).
-FLOOR_TILT_DEG = 0.3
+FLOOR_TILT_DEG = 0.35
 #: Value range of the paving texture (worn grey slabs, low contrast in the building's shadow).
 PAVING_TEXTURE = (0.45, 0.6)
 
