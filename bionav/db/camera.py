@@ -93,6 +93,21 @@ def pose_error_config_for(kind: str, **overrides) -> PoseErrorConfig:
     return PoseErrorConfig(**{**POSE_ERRORS[kind], **overrides})
 
 
+def _seeded_normals(keys, n: int, *, seed: int, db_seed: int, tag: int) -> np.ndarray:
+    """``n`` standard normal draws per row of ``keys`` (M, k) ints, each row from its own stream.
+
+    The stream of a row is ``SeedSequence([seed, db_seed, tag, *row])`` (seeds
+    taken modulo 2**32), so a draw depends only on its key and the seeds, not
+    on which other keys are drawn. Returns shape ``(M, n)``.
+    """
+    keys = np.asarray(keys, dtype=np.int64)
+    head = [int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF, int(tag)]
+    draw = np.empty((len(keys), int(n)))
+    for k, key in enumerate(keys):
+        draw[k] = np.random.default_rng(np.random.SeedSequence([*head, *map(int, key)])).standard_normal(int(n))
+    return draw
+
+
 def pose_offsets(cells, *, position_sigma_m: float, heading_sigma_deg: float, seed: int,
                  db_seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Gaussian capture-pose errors of the images at grid ``cells``.
@@ -119,11 +134,7 @@ def pose_offsets(cells, *, position_sigma_m: float, heading_sigma_deg: float, se
         Heading errors in radians (counter-clockwise).
     """
     cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
-    draw = np.empty((len(cells), 3))
-    for k, (i, j) in enumerate(cells):
-        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF,
-                                                            0x706F7365, int(i), int(j)]))
-        draw[k] = rng.standard_normal(3)
+    draw = _seeded_normals(cells, 3, seed=seed, db_seed=db_seed, tag=0x706F7365)
     return draw[:, :2] * float(position_sigma_m), draw[:, 2] * math.radians(float(heading_sigma_deg))
 
 
@@ -156,9 +167,7 @@ def lane_heading_drift(cells, *, drift_sigma_deg: float, seed: int, db_seed: int
     if len(cells) == 0 or float(drift_sigma_deg) == 0.0:
         return np.zeros(len(cells))
     lanes = np.arange(1, int(cells[:, 0].max()) + 1)
-    steps = np.array([np.random.default_rng(np.random.SeedSequence(
-        [int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF, 0x64726674, int(lane)])).standard_normal()
-        for lane in lanes])
+    steps = _seeded_normals(lanes[:, None], 1, seed=seed, db_seed=db_seed, tag=0x64726674)[:, 0]
     walk = np.concatenate([[0.0], np.cumsum(steps)])
     return walk[np.clip(cells[:, 0], 0, None)] * math.radians(float(drift_sigma_deg))
 
@@ -184,11 +193,7 @@ def tilt_offsets(cells, *, tilt_sigma_deg: float, seed: int, db_seed: int = 0) -
         angle) is raised by ``t_a cos(phi) + t_b sin(phi)`` (small-angle tilt).
     """
     cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
-    draw = np.empty((len(cells), 2))
-    for k, (i, j) in enumerate(cells):
-        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, int(db_seed) & 0xFFFFFFFF,
-                                                            0x74696C74, int(i), int(j)]))
-        draw[k] = rng.standard_normal(2)
+    draw = _seeded_normals(cells, 2, seed=seed, db_seed=db_seed, tag=0x74696C74)
     return draw * math.radians(float(tilt_sigma_deg))
 
 
