@@ -142,8 +142,8 @@ def lane_heading_drift(cells, *, drift_sigma_deg: float, seed: int, db_seed: int
     """Odometry's heading drift at grid ``cells``: a random walk over the turns between lanes.
 
     The robot drives its lanes along the grid's ``j`` axis, lane ``i`` after
-    lane ``i - 1`` (as :meth:`bionav.world.worlds.common.Daylight.capture_fraction`
-    and :func:`bionav.world.worlds.outdoor.capture_order`); each turn between two
+    lane ``i - 1`` (:func:`bionav.world.worlds.common.lane_order` with
+    ``lane_axis=1``); each turn between two
     lanes adds a Gaussian heading error (std ``drift_sigma_deg``) that stays
     with all later lanes, since correcting the position does not correct the
     heading. Lane 0 has no drift. A lane's drift depends only on the seeds and

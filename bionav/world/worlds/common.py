@@ -23,6 +23,31 @@ def stream(seed: int, name: str) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, zlib.crc32(name.encode())]))
 
 
+def lane_order(grid_shape: tuple[int, int], *, lane_axis: int = 1) -> np.ndarray:
+    """Capture index of every grid cell when a robot drives boustrophedon lanes.
+
+    Lanes run along grid axis ``lane_axis`` and follow each other along the
+    other axis (lane 0 first), in alternate directions: lane 0 from index 0 up,
+    lane 1 back down, and so on.
+
+    Parameters
+    ----------
+    grid_shape : (int, int)
+        ``(nx, ny)``.
+    lane_axis : int
+        Grid axis (0: ``i``, 1: ``j``) along which the lanes run.
+
+    Returns
+    -------
+    ndarray, shape (nx, ny), int
+        0, 1, 2 ... ``nx * ny - 1`` in driving order.
+    """
+    ii, jj = np.meshgrid(np.arange(grid_shape[0]), np.arange(grid_shape[1]), indexing="ij")
+    along, across = (jj, ii) if lane_axis == 1 else (ii, jj)
+    n_along = int(grid_shape[lane_axis])
+    return across * n_along + np.where(across % 2 == 0, along, n_along - 1 - along)
+
+
 @dataclass(frozen=True)
 class Daylight:
     """Daylight through a room's windows while a database was being recorded.
@@ -102,11 +127,8 @@ class Daylight:
             0 for the first cell of the first lane, 1 for the last cell of the last lane.
         """
         cells = np.asarray(cells, np.int64).reshape(-1, 2)
-        along, across = (cells[:, 1], cells[:, 0]) if self.lane_axis == 1 else (cells[:, 0], cells[:, 1])
-        n_along = int(grid_shape[self.lane_axis])
-        n_across = int(grid_shape[1 - self.lane_axis])
-        step = np.where(across % 2 == 0, along, n_along - 1 - along)
-        return (across * n_along + step) / max(n_along * n_across - 1, 1)
+        order = lane_order(grid_shape, lane_axis=self.lane_axis)
+        return order[cells[:, 0], cells[:, 1]] / max(order.size - 1, 1)
 
     def conditions(self, cells: np.ndarray, grid_shape: tuple[int, int], *, seed: int) -> dict:
         """Sun direction, cloud transmission and skylight factor at each cell's capture.

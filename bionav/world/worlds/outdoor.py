@@ -23,7 +23,7 @@ from bionav.light.simple_sky import SKY_GAIN, SUN_GAIN, SimpleSky
 from bionav.world import textures as tx
 from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.scene import Scene, SkyFunction
-from bionav.world.worlds.common import World, stream
+from bionav.world.worlds.common import World, lane_order, stream
 from bionav.world.worlds.furniture import tree
 
 GRID_SHAPE = (10, 17)
@@ -57,7 +57,7 @@ CLOUD_SUN_TRANSMITTANCE = 0.15
 
 
 def capture_order(cells: np.ndarray) -> np.ndarray:
-    """Capture index of every existing grid cell: lanes along y, one after the other, in alternate directions.
+    """Capture index of every existing grid cell (:func:`~bionav.world.worlds.common.lane_order`, lanes along y).
 
     Parameters
     ----------
@@ -70,13 +70,7 @@ def capture_order(cells: np.ndarray) -> np.ndarray:
     """
     cells = np.asarray(cells, bool)
     order = np.full(cells.shape, -1, np.int64)
-    k = 0
-    for i in range(cells.shape[0]):
-        lane = range(cells.shape[1]) if i % 2 == 0 else range(cells.shape[1] - 1, -1, -1)
-        for j in lane:
-            if cells[i, j]:
-                order[i, j] = k
-                k += 1
+    order[cells] = np.argsort(np.argsort(lane_order(cells.shape, lane_axis=1)[cells]))
     return order
 
 
