@@ -37,6 +37,15 @@ def petal_bins(wl, refl_percent, centres, half_width=2.5):
     return out
 
 
+def write_table(name: str, comment: str, header, rows) -> None:
+    """Write ``OUT / name``: one ``# comment`` line, the CSV header, then the (already formatted) rows."""
+    with open(OUT / name, "w", newline="") as fh:
+        fh.write(f"# {comment}\n")
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows(rows)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bumbleview", type=Path, required=True, help="folder with xmpl_data.csv etc.")
@@ -46,27 +55,23 @@ def main() -> None:
     from colour.plotting.datasets import astm_g_173 as g
 
     wl = sorted(w for w in g.DATA_ASTMG173_ETR if 280.0 <= w <= 1200.0)
-    with open(OUT / "astm_g173.csv", "w", newline="") as fh:
-        fh.write("# ASTM G173-03 reference solar spectra (NREL, derived from SMARTS 2.9.2), W m^-2 nm^-1; "
-                 "via colour-science (BSD-3). See README.md.\n")
-        w = csv.writer(fh)
-        w.writerow(["wavelength_nm", "extraterrestrial", "global_tilt", "direct_circumsolar"])
-        for x in wl:
-            w.writerow([f"{x:g}", f"{g.DATA_ASTMG173_ETR[x]:.6g}", f"{g.DATA_ASTMG173_GLOBAL_TILT[x]:.6g}",
-                        f"{g.DATA_ASTMG173_DIRECT_CIRCUMSOLAR[x]:.6g}"])
+    write_table("astm_g173.csv", "ASTM G173-03 reference solar spectra (NREL, derived from SMARTS 2.9.2), "
+                "W m^-2 nm^-1; via colour-science (BSD-3). See README.md.",
+                ["wavelength_nm", "extraterrestrial", "global_tilt", "direct_circumsolar"],
+                ([f"{x:g}", f"{g.DATA_ASTMG173_ETR[x]:.6g}", f"{g.DATA_ASTMG173_GLOBAL_TILT[x]:.6g}",
+                  f"{g.DATA_ASTMG173_DIRECT_CIRCUMSOLAR[x]:.6g}"] for x in wl))
 
     from pvlib.spectrum.spectrl2 import _SPECTRL2_COEFFS as c
 
     sel = (c["wavelength"] >= 300) & (c["wavelength"] <= 1200)
-    with open(OUT / "bird_riordan_absorption.csv", "w", newline="") as fh:
-        fh.write("# Absorption coefficients of ozone (1/cm of column in atm-cm), water vapour (1/cm of precipitable "
-                 "water) and uniformly mixed gases (O2, CO2; per air mass), Bird & Riordan (1986) after Leckner "
-                 "(1978); via pvlib (BSD-3). See README.md.\n")
-        w = csv.writer(fh)
-        w.writerow(["wavelength_nm", "ozone", "water_vapor", "mixed_gases"])
-        for x, a, b, u in zip(c["wavelength"][sel], c["ozone_absorption"][sel], c["water_vapor_absorption"][sel],
-                              c["mixed_absorption"][sel]):
-            w.writerow([f"{x:g}", f"{a:.6g}", f"{b:.6g}", f"{u:.6g}"])
+    write_table("bird_riordan_absorption.csv",
+                "Absorption coefficients of ozone (1/cm of column in atm-cm), water vapour (1/cm of precipitable "
+                "water) and uniformly mixed gases (O2, CO2; per air mass), Bird & Riordan (1986) after Leckner "
+                "(1978); via pvlib (BSD-3). See README.md.",
+                ["wavelength_nm", "ozone", "water_vapor", "mixed_gases"],
+                ([f"{x:g}", f"{a:.6g}", f"{b:.6g}", f"{u:.6g}"]
+                 for x, a, b, u in zip(c["wavelength"][sel], c["ozone_absorption"][sel],
+                                       c["water_vapor_absorption"][sel], c["mixed_absorption"][sel])))
 
     src = args.bumbleview
     data = np.loadtxt(src / "xmpl_data.csv", delimiter=",")
@@ -74,32 +79,22 @@ def main() -> None:
         names = ["_".join(row[:3]) + f"_{row[3]}" for row in csv.reader(fh) if row]
     centres = np.arange(300.0, 701.0, 5.0)
     bins = petal_bins(data[:, 0], data[:, 1:], centres)
-    with open(OUT / "petals.csv", "w", newline="") as fh:
-        fh.write("# 120 petal reflectances (fraction), means of 5-nm bins of bumbleview 0.2.8 xmpl_data.csv "
-                 "(MIT, LICENSE_bumbleview). See README.md.\n")
-        w = csv.writer(fh)
-        w.writerow(["wavelength_nm", *names])
-        for x, row in zip(centres, bins):
-            w.writerow([f"{x:g}", *(f"{v:.5f}" for v in row)])
+    write_table("petals.csv", "120 petal reflectances (fraction), means of 5-nm bins of bumbleview 0.2.8 "
+                "xmpl_data.csv (MIT, LICENSE_bumbleview). See README.md.",
+                ["wavelength_nm", *names],
+                ([f"{x:g}", *(f"{v:.5f}" for v in row)] for x, row in zip(centres, bins)))
 
     leaf = np.loadtxt(src / "background_green_leaf.csv", delimiter=",")
     leaf = leaf[leaf[:, 0] <= 700.0]
-    with open(OUT / "green_leaf.csv", "w", newline="") as fh:
-        fh.write("# green-leaf reflectance (fraction) 300-700 nm, bumbleview 0.2.8 background_green_leaf.csv "
-                 "(MIT, LICENSE_bumbleview); its zero rows 705-750 nm are padding and dropped. See README.md.\n")
-        w = csv.writer(fh)
-        w.writerow(["wavelength_nm", "reflectance"])
-        for x, v in leaf:
-            w.writerow([f"{x:g}", f"{v:.4f}"])
+    write_table("green_leaf.csv", "green-leaf reflectance (fraction) 300-700 nm, bumbleview 0.2.8 "
+                "background_green_leaf.csv (MIT, LICENSE_bumbleview); its zero rows 705-750 nm are padding and "
+                "dropped. See README.md.",
+                ["wavelength_nm", "reflectance"], ([f"{x:g}", f"{v:.4f}"] for x, v in leaf))
 
     d65 = np.loadtxt(src / "d65_standards.csv", delimiter=",")
-    with open(OUT / "d65.csv", "w", newline="") as fh:
-        fh.write("# CIE standard illuminant D65 (relative) as shipped by bumbleview 0.2.8 d65_standards.csv "
-                 "(MIT, LICENSE_bumbleview). See README.md.\n")
-        w = csv.writer(fh)
-        w.writerow(["wavelength_nm", "relative_power"])
-        for x, v in d65:
-            w.writerow([f"{x:g}", f"{v:.6g}"])
+    write_table("d65.csv", "CIE standard illuminant D65 (relative) as shipped by bumbleview 0.2.8 d65_standards.csv "
+                "(MIT, LICENSE_bumbleview). See README.md.",
+                ["wavelength_nm", "relative_power"], ([f"{x:g}", f"{v:.6g}"] for x, v in d65))
     shutil.copyfile(src / "LICENSE", OUT / "LICENSE_bumbleview")
 
 
