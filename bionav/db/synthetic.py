@@ -335,6 +335,8 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
             if getattr(world, what, None) is not None:
                 params[what] = dataclasses.asdict(getattr(world, what))
+        if getattr(world, "light_level", 1.0) != 1.0:  # a dim scene; 1 keeps the key of the other worlds
+            params["light_level"] = float(world.light_level)
         if "capture_light" in world.info:  # light changing during the capture (sim_uni)
             params["capture_light"] = world.info["capture_light"]
     key = cache_key(params)
