@@ -146,7 +146,7 @@ SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
         _spec("sim_winlit", (10, 17), 0.3, 170, "ultra-wide",
               "the laboratory with only the window-side light band on", _lab("winlit")),
         _spec("sim_hall1", (10, 20), 0.5, 170, "ultra-wide",
-              "a large, dim, achromatic hall with pillars (cells missing around obstacles)",
+              "a large, dim, achromatic hall at night (cells missing under a kiosk)",
               _lazy("bionav.world.worlds.hall", "build_hall", part=1)),
         _spec("sim_hall2", (10, 20), 0.5, 170, "ultra-wide", "another part of the hall",
               _lazy("bionav.world.worlds.hall", "build_hall", part=2)),

@@ -170,7 +170,7 @@ TINY = Preset(
 STANDINS = dataclasses.replace(
     QUICK,
     name="standins",
-    summary=("the stand-in hardness checks of issue 18 (about 2 minutes on two idle cores once the stand-ins "
+    summary=("the stand-in hardness checks of issue 18 (about 4 minutes on two idle cores once the stand-ins "
              "are in the render cache; the first run renders them)"),
     snapshots=12,
     sift_size=(1122, 162),
