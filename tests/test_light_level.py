@@ -85,8 +85,8 @@ def test_only_the_night_hall_is_dim_and_bad_levels_are_refused():
 
 
 def test_the_kiosk_takes_the_hall_grid_corner_and_no_obstacle_stands_inside_the_grid():
-    from bionav.world.render import render_depth
     from bionav.geometry import PanoramaGeometry
+    from bionav.world.render import render_depth
 
     geo = PanoramaGeometry.square_pixels(180, 3)
     for part in ("sim_hall1", "sim_hall2"):

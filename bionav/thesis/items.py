@@ -1349,7 +1349,8 @@ def _ranking(res: RunResult) -> dict[str, dict[str, str]] | None:
 
 @item("standins", "Stand-in hardness",
       "the checks of issue 18 across items: table 5.3 per database RR* within 0.10 and AAE* within 0.10 rad; "
-      "each warping method's RR* above SIFT's on hall1 (table 5.4; on table 5.3's snapshots and draws); warping's mean RR* over doorlit <-> winlit "
+      "each warping method's RR* above SIFT's on hall1 (table 5.4; on table 5.3's snapshots and draws); "
+      "warping's mean RR* over doorlit <-> winlit "
       f"at least {CROSS_LIGHT_MARGIN} below SIFT's (fig. 5.6); parameter homing: uni's best RR* below original's "
       "and hall1's, rotation-invariant signatures ranked below the rotation-variant ones on average (per "
       "database), Spearman rho of each database's ranking against the thesis (reported)")
