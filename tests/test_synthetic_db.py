@@ -72,7 +72,7 @@ def test_world_grid_cells_and_free_cameras(name):
         assert not _inside_any_solid(w.scene, w.cell_position(i, j)), (name, i, j)
 
 
-def test_hall_misses_the_cells_nearest_its_obstacles():
+def test_hall_misses_the_cells_under_its_kiosk():
     w = get_spec("sim_hall1").builder(0)
     missing = np.argwhere(~w.cells)
     assert len(missing) == 30

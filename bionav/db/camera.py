@@ -13,7 +13,8 @@ on the real robots (thesis 3.1). The sensor model, in the order light meets it:
 3. automatic exposure: the mean level of the unfolded annulus is driven to
    ``ae_target`` by the exposure time (at most ``max_exposure`` times the
    world's nominal exposure), then by analogue gain (at most ``max_gain``);
-   dark scenes stay dark and get noisier;
+   dark scenes stay dark and get noisier (a world's ``light_level`` below 1,
+   the night hall, scales the light before the sensor);
 4. photon shot noise (``full_well_e`` electrons at full scale, Poisson,
    approximated as Gaussian) and read noise (``read_noise_e`` electrons), both
    amplified by the gain; clipping at full scale; 8-bit quantisation;
@@ -484,6 +485,7 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     if progress is not None:
         it = progress(it)
     scene_at = capture_scenes(world, positions, seed=int(pose_error.seed), db_seed=int(seed))
+    light_level = float(getattr(world, "light_level", 1.0))
     for k in it:
         i, j = positions[k]
         x, y, z = world.cell_position(i, j)
@@ -497,6 +499,8 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
                                     heading=float(dheads[k]), layout=setup.layout, threads=threads)
         if scene_at is not None:  # a CompiledScene renders without the scene's exposure
             radiance *= float(world.scene.exposure)
+        if light_level != 1.0:  # a dim scene (the night hall): the automatic exposure has to make up for it
+            radiance *= light_level
         raw = sensor_frame(radiance, setup, rng=noise_rng(seed, (i, j)))
         out[k] = unfold_frame(raw, setup, geometry, tilt=tilts[k])
         if raws is not None:

@@ -146,7 +146,7 @@ SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
         _spec("sim_winlit", (10, 17), 0.3, 170, "ultra-wide",
               "the laboratory with only the window-side light band on", _lab("winlit")),
         _spec("sim_hall1", (10, 20), 0.5, 170, "ultra-wide",
-              "a large, dim, achromatic hall with pillars (cells missing around obstacles)",
+              "a large, dim, achromatic hall at night (cells missing under a kiosk)",
               _lazy("bionav.world.worlds.hall", "build_hall", part=1)),
         _spec("sim_hall2", (10, 20), 0.5, 170, "ultra-wide", "another part of the hall",
               _lazy("bionav.world.worlds.hall", "build_hall", part=2)),
@@ -335,6 +335,8 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
             if getattr(world, what, None) is not None:
                 params[what] = dataclasses.asdict(getattr(world, what))
+        if getattr(world, "light_level", 1.0) != 1.0:  # a dim scene; 1 keeps the key of the other worlds
+            params["light_level"] = float(world.light_level)
         if "capture_light" in world.info:  # light changing during the capture (sim_uni)
             params["capture_light"] = world.info["capture_light"]
     key = cache_key(params)

@@ -170,7 +170,7 @@ TINY = Preset(
 STANDINS = dataclasses.replace(
     QUICK,
     name="standins",
-    summary=("the stand-in hardness checks of issue 18 (about 2 minutes on two idle cores once the stand-ins "
+    summary=("the stand-in hardness checks of issue 18 (about 4 minutes on two idle cores once the stand-ins "
              "are in the render cache; the first run renders them)"),
     snapshots=12,
     sift_size=(1122, 162),
@@ -185,7 +185,8 @@ STANDINS = dataclasses.replace(
         "SIFT homing (table 5.3): 12 snapshots per database (evenly spread over the images) instead of all, "
         "every image a current view; 1122 x 162 as the thesis; each database measured on 3 draws of the "
         "capture session (db.pose_error.seed=0,1,2: pose errors, floor tilts, clouds), compared by the mean",
-        "table 5.4: the thesis' parameters (warping2d_thesis, minwarping_thesis), 3 snapshots per database",
+        "table 5.4: the thesis' parameters (warping2d_thesis, minwarping_thesis), 3 snapshots per database; "
+        "the stand-in check compares them with SIFT on hall1 on the 12 snapshots and 3 draws of table 5.3",
         "fig. 5.6: doorlit and winlit only, 4 snapshots per database (stride 9), SIFT homing at the native "
         "561 x 81, the fast 2D-warping preset (homing=warping2d)",
         "tables 5.5-5.7: the reduced parameter grid experiment.grid=ci (one image size, no preprocessing, "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import math
 import zlib
 from dataclasses import dataclass, field
 from typing import Callable
@@ -350,6 +351,14 @@ class World:
         accumulated drift to every capture's heading
         (:func:`bionav.db.camera.lane_heading_drift`) unless
         ``db.pose_error.heading_drift_deg`` is given.
+    light_level : float
+        Light reaching the camera, relative to the light at which the
+        scene's nominal exposure (``scene.exposure``) renders it at normal
+        brightness; dimensionless, > 0. The camera model multiplies the
+        radiance by it before the sensor, whose automatic exposure then
+        compensates within ``max_exposure`` x ``max_gain`` and adds the noise
+        of a dim scene (:func:`bionav.db.camera.camera_images`).
+        ``db.realism=ideal`` ignores it. 1 for every world but the night hall.
     capture_scene : callable, optional
         ``capture_scene(i, j) -> Scene``: the world as lit when cell ``(i, j)``
         was captured, for worlds whose light changed during the capture (the
@@ -367,11 +376,14 @@ class World:
     info: dict = field(default_factory=dict)
     floor_tilt_deg: float = 0.0
     heading_drift_deg: float = 0.0
+    light_level: float = 1.0
     daylight: Daylight | None = None
     supervisor: Supervisor | None = None
     capture_scene: Callable[[int, int], Scene] | None = None
 
     def __post_init__(self) -> None:
+        if not (math.isfinite(self.light_level) and self.light_level > 0):
+            raise ValueError(f"World.light_level must be a finite number > 0, got {self.light_level!r}")
         if self.cells is None:
             self.cells = np.ones(self.grid_shape, bool)
 
