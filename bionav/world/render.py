@@ -28,14 +28,7 @@ def _run_threads(threads: int | None, kernel, *args) -> None:
 
 
 def _compiled(scene: Scene | CompiledScene) -> CompiledScene:
-    if isinstance(scene, CompiledScene):
-        return scene
-    cached = scene.info.get("_compiled")
-    sig = scene.compile_key()
-    if cached is None or cached[0] != sig:
-        cached = (sig, scene.compile())
-        scene.info["_compiled"] = cached
-    return cached[1]
+    return scene if isinstance(scene, CompiledScene) else scene.compiled()
 
 
 def ray_grid(geometry: PanoramaGeometry, heading: float = 0.0, *, supersample: int = 1):

@@ -332,23 +332,32 @@ class Scene:
         -------
         Scene
         """
-        base = self.info.get("_compiled")
-        if base is None or base[0] != self.compile_key():
-            base = (self.compile_key(), self.compile())
-            self.info["_compiled"] = base
+        base = self.compiled()
         new = dataclasses.replace(self, lights=list(self.lights if lights is None else lights),
                                   ambient=self.ambient if ambient is None else ambient,
                                   sky=self.sky if sky is None else sky, info=dict(self.info))
-        c = new.n_channels
-        lp, lpow = pack_lights(new.lights, c)
-        amb = new.ambient
-        compiled = dataclasses.replace(
-            base[1], light_params=lp, light_power=lpow,
-            ambient_up=np.broadcast_to(np.asarray(amb.up, float).reshape(-1), (c,)).copy(),
-            ambient_down=np.broadcast_to(np.asarray(amb.down, float).reshape(-1), (c,)).copy(),
-            shadow_grids=None, shadow_starts=None, shadow_items=None)
+        compiled = dataclasses.replace(base, **new._light_arrays(), shadow_grids=None, shadow_starts=None,
+                                       shadow_items=None)
         new.info["_compiled"] = (new.compile_key(), compiled)
         return new
+
+    def compiled(self) -> CompiledScene:
+        """The compiled arrays (:meth:`compile`), cached in ``info["_compiled"]`` until :meth:`compile_key` changes."""
+        cached = self.info.get("_compiled")
+        key = self.compile_key()
+        if cached is None or cached[0] != key:
+            cached = (key, self.compile())
+            self.info["_compiled"] = cached
+        return cached[1]
+
+    def _light_arrays(self) -> dict:
+        """The lights' and the ambient term's packed arrays (the light fields of :class:`CompiledScene`)."""
+        c = self.n_channels
+        lp, lpow = pack_lights(self.lights, c)
+        amb = self.ambient
+        return {"light_params": lp, "light_power": lpow,
+                "ambient_up": np.broadcast_to(np.asarray(amb.up, float).reshape(-1), (c,)).copy(),
+                "ambient_down": np.broadcast_to(np.asarray(amb.down, float).reshape(-1), (c,)).copy()}
 
     # ------------------------------------------------------------------ compile
     def compile(self) -> CompiledScene:
@@ -371,8 +380,6 @@ class Scene:
             if arr.size and (arr.min() < 0 or arr.max() >= n_mat):
                 raise ValueError("a primitive refers to an unknown material")
         tex = np.concatenate([np.concatenate([lv.ravel() for lv in mip_pyramid(t)]) for t in self.textures])
-        lp, lpow = pack_lights(self.lights, c)
-        amb = self.ambient
         return CompiledScene(
             boxes=boxes, box_mats=box_mats, frusta=frusta, frustum_mats=frustum_mats,
             ellipsoids=ell, ellipsoid_mats=ell_mats,
@@ -382,7 +389,5 @@ class Scene:
             mat_albedo=np.array([m.albedo for m in mats], np.float64).reshape(n_mat, c),
             mat_emission=np.array([m.emission for m in mats], np.float64).reshape(n_mat, c),
             tex_data=tex.astype(np.float32), tex_size=TEXTURE_SIZE,
-            light_params=lp, light_power=lpow,
-            ambient_up=np.broadcast_to(np.asarray(amb.up, float).reshape(-1), (c,)).copy(),
-            ambient_down=np.broadcast_to(np.asarray(amb.down, float).reshape(-1), (c,)).copy(),
+            **self._light_arrays(),
         )

@@ -78,8 +78,12 @@ def _sofa(scene: Scene, r: np.random.Generator, *, x: float, y: float, yaw: floa
 
 
 def _window(scene: Scene, r: np.random.Generator, *, wall_x: float | None, wall_y: float | None, centre: float,
-            width: float, lx: float, ly: float, open_fraction: float = 0.6) -> int:
-    """A bright window with curtains drawn to both sides, on an x- or y-wall; returns the pane's material."""
+            width: float, lx: float, ly: float, open_fraction: float = 0.6) -> tuple[int, tuple]:
+    """A bright window with curtains drawn to both sides, on an x- or y-wall.
+
+    Returns the pane's material and the opening as :class:`~bionav.world.worlds.common.Daylight`
+    takes it: ``(wall, u0, u1, z0, z1)``.
+    """
     pane = scene.material(texture=tx.window_view(r), fit=True, albedo=0.2, emission=1.6)
     curtain = scene.material(texture=tx.curtain(r, folds=5, lo=0.4, hi=0.85), albedo=0.8, scale=(0.8, 2.0))
     cw = width * (1 - open_fraction) / 2 + 0.15
@@ -99,7 +103,8 @@ def _window(scene: Scene, r: np.random.Generator, *, wall_x: float | None, wall_
             a = centre + sgn * (width / 2 + 0.15)
             b = a - sgn * cw
             scene.box((min(a, b), cy0, 0.05), (max(a, b), cy1, 2.35), curtain)
-    return pane
+    wall = ("x0" if wall_x == 0 else "x1") if wall_x is not None else ("y0" if wall_y == 0 else "y1")
+    return pane, (wall, centre - width / 2, centre + width / 2, 0.9, 2.2)
 
 
 def _floor_lamp(scene: Scene, r: np.random.Generator, *, x: float, y: float) -> None:
@@ -159,9 +164,8 @@ def build_living_room(seed: int = 0) -> World:
     scene.frustum((gx0 - CLUTTER_GAP - 0.15, gy1 - 0.3), 0.0, 0.35, 0.15, 0.18, material=basket)
     rug = scene.material(texture=tx.poster(r, n_shapes=20), fit=True, albedo=0.7)
     scene.box((gx0 - 0.9, gy0 + 0.2, 0.0), (gx1 + 0.2, gy1 - 0.2, 0.012), rug, shadow=False)
-    panes = (_window(scene, r, wall_x=None, wall_y=0.0, centre=lx * 0.6, width=1.4, lx=lx, ly=ly),
-             _window(scene, r, wall_x=lx, wall_y=None, centre=ly * 0.2, width=1.0, lx=lx, ly=ly))
-    windows = (("y0", lx * 0.6 - 0.7, lx * 0.6 + 0.7, 0.9, 2.2), ("x1", ly * 0.2 - 0.5, ly * 0.2 + 0.5, 0.9, 2.2))
+    panes, windows = zip(_window(scene, r, wall_x=None, wall_y=0.0, centre=lx * 0.6, width=1.4, lx=lx, ly=ly),
+                         _window(scene, r, wall_x=lx, wall_y=None, centre=ly * 0.2, width=1.0, lx=lx, ly=ly))
     door = scene.material(texture=tx.panel(r, nx=1, ny=3), fit=True, albedo=0.85)
     scene.box((0.0, ly - 1.3, 0.0), (0.04, ly - 0.45, 2.05), door, shadow=False)
     radiator = scene.material(texture=tx.stripes(r, n=14, lo=0.55, hi=0.95), albedo=0.9, scale=(1.0, 0.5))
@@ -255,9 +259,8 @@ def build_living_kitchen(seed: int = 0) -> World:
     potted_plant(scene, stream(seed, "kitchen/plant"), x=lx - 0.4, y=ly - 0.4, height=1.5, crown=0.35,
                  min_leaf_z=0.7)
     _floor_lamp(scene, r, x=0.35, y=ly - 0.5)
-    panes = (_window(scene, r, wall_x=lx, wall_y=None, centre=1.5, width=1.2, lx=lx, ly=ly),
-             _window(scene, r, wall_x=lx, wall_y=None, centre=ly - 3.8, width=1.4, lx=lx, ly=ly))
-    windows = (("x1", 1.5 - 0.6, 1.5 + 0.6, 0.9, 2.2), ("x1", ly - 3.8 - 0.7, ly - 3.8 + 0.7, 0.9, 2.2))
+    panes, windows = zip(_window(scene, r, wall_x=lx, wall_y=None, centre=1.5, width=1.2, lx=lx, ly=ly),
+                         _window(scene, r, wall_x=lx, wall_y=None, centre=ly - 3.8, width=1.4, lx=lx, ly=ly))
     door = scene.material(texture=tx.panel(r, nx=1, ny=3), fit=True, albedo=0.85)
     scene.box((0.0, ly - 2.6, 0.0), (0.04, ly - 1.75, 2.05), door, shadow=False)
     for wall, pos in (("west", 4.2), ("north", lx * 0.6), ("east", ly - 0.9), ("south", 3.4)):
