@@ -312,25 +312,39 @@ def _grid_table(ctx: Context, out: Outcome, specs: list[RunSpec], dbs: Sequence[
     n = max(1, len(draws))
     values = {"aae": [], "mae": [], "rr": []}
     for d, db in enumerate(dbs):
-        group = specs[d * n:(d + 1) * n]
-        results = [ctx.result(spec) for spec in group]
-        for res in results:
-            if not res.ok:
-                out.missing.append(f"{label} on {db}: {why_missing(res)}")
+        results = _results(ctx, out, specs[d * n:(d + 1) * n], f"{label} on {db}")
         for key, tol in (("aae", TOL_ANGLE), ("mae", TOL_ANGLE), ("rr", TOL_RR)):
             thesis = ref[key][list(ref["databases"]).index(db)]
-            got_all = [metric(res, key) for res in results]
-            note = ""
-            if n == 1:
-                got = got_all[0]
-            else:
-                got = None if any(g is None for g in got_all) else float(np.mean(got_all))
-                note = (f"mean of {n} pose-error draws (db.pose_error.seed="
-                        + ", ".join(f"{s}: {fmt(g, 3)}" for s, g in zip(draws, got_all))
-                        + ("" if got is None else f"; spread (std) {float(np.std(got_all, ddof=1)):.3f}") + ")")
+            got, note = _mean_over_draws(results, key, draws)
             values[key].append(got)
             out.rows.append(Row(f"{label} {key.upper()}* {db}", thesis, got, tol, note))
     return values
+
+
+def _results(ctx: Context, out: Outcome, specs: Sequence[RunSpec], what: str) -> list[RunResult]:
+    """The results of ``specs``; each run that did not complete is listed in ``out.missing`` as ``what``."""
+    results = [ctx.result(spec) for spec in specs]
+    for res in results:
+        if not res.ok:
+            out.missing.append(f"{what}: {why_missing(res)}")
+    return results
+
+
+def _mean_over_draws(results: Sequence[RunResult], key: str, draws: Sequence[int]) -> tuple[Any, str]:
+    """A metric over the runs of one configuration, one run per pose-error draw, and its note.
+
+    One run: its value and no note. Several: the mean (None if any draw is
+    missing) and a note listing every draw and the spread (sample standard
+    deviation) across them.
+    """
+    got_all = [metric(res, key) for res in results]
+    if len(results) == 1:
+        return got_all[0], ""
+    got = None if any(g is None for g in got_all) else float(np.mean(got_all))
+    note = (f"mean of {len(results)} pose-error draws (db.pose_error.seed="
+            + ", ".join(f"{s}: {fmt(g, 3)}" for s, g in zip(draws, got_all))
+            + ("" if got is None else f"; spread (std) {float(np.std(got_all, ddof=1)):.3f}") + ")")
+    return got, note
 
 
 def _draw_args(preset: Preset) -> list[list[str]]:
@@ -1385,15 +1399,8 @@ class _StandIns:
                                     ", ".join(f"{db} {fmt(g)} vs {w}" for db, g, w in diffs)))
         sift_hall = v["rr"][THESIS_DBS.index("hall1")]
         for k, h in enumerate(p.warping):
-            runs = [ctx.result(spec) for spec in warp_specs[k * n_draws:(k + 1) * n_draws]]
-            for res in runs:
-                if not res.ok:
-                    out.missing.append(f"{h} on hall1: {why_missing(res)}")
-            vals = [metric(res, "rr") for res in runs]
-            w = None if any(x is None for x in vals) else float(np.mean(vals))
-            note = "" if n_draws == 1 or w is None else (
-                f"mean of {n_draws} pose-error draws, the table 5.3 snapshots ("
-                + ", ".join(f"db.pose_error.seed={d}: {x:.3f}" for d, x in zip(p.pose_draws, vals)) + ")")
+            runs = _results(ctx, out, warp_specs[k * n_draws:(k + 1) * n_draws], f"{h} on hall1")
+            w, note = _mean_over_draws(runs, "rr", p.pose_draws)  # on the table 5.3 snapshots and draws
             out.rows.append(Row(f"{h} RR* hall1", load_reference_item("table5_4")["rr"][1], w, TOL_RR, note=note))
             out.checks.append(Check(f"table 5.4: {h}'s RR* on hall1 above SIFT homing's{mean}",
                                     None if w is None or sift_hall is None else bool(w > sift_hall),
