@@ -282,3 +282,40 @@ def test_a_multirun_is_complete_only_when_hydra_finished_it(tmp_path):
     (tmp_path / "1" / "metrics.json").write_text(json.dumps({"status": "failed"}))
     assert _sweep_metrics(tmp_path) == {"status": "failed", "n_jobs": 2, "n_completed": 1,
                                         "error": "1 of 2 jobs completed"}
+
+
+def _write_significance(path: Path, crit: str, unmarked: set[frozenset[str]]) -> None:
+    """A bootstrap significance table: every pair marked at 0.1 % except the ``unmarked`` ones."""
+    from bionav.thesis.items import FEATURES
+
+    with open(path / f"significance_{crit}.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([crit, *FEATURES])
+        for a in FEATURES:
+            w.writerow([a, *("" if a == b or frozenset((a, b)) in unmarked else "0.001" for b in FEATURES)])
+
+
+@pytest.mark.parametrize("tied", [True, False])
+def test_table6_5_checks_the_discussion_claims_on_the_pairwise_bootstrap(tmp_path, tied):
+    """Thesis 6.3.4: UV-IR and UV-B do not differ in J, UV-IR differs from every other contrast; one check each."""
+    from bionav.thesis.items import Context
+    from bionav.thesis.presets import PRESETS
+    from bionav.thesis.runs import RunResult
+
+    item = REGISTRY["table6_5"]
+    preset = PRESETS["quick"]
+    (spec,) = item.runs(preset)
+    uv = ("UV-B", "UV-G", "UV-R", "UV-IR")
+    _write_significance(tmp_path, "J", {frozenset(("UV-IR", "UV-B" if tied else "UV-R"))})
+    _write_significance(tmp_path, "J_sigma", {frozenset(("UV-G", "UV-B"))})
+    _write_significance(tmp_path, "n_f", {frozenset((a, b)) for a in uv for b in uv}
+                        | {frozenset((a, b)) for a in ("B-G", "B-R", "B-IR") for b in ("B-G", "B-R", "B-IR")})
+    res = RunResult(spec, tmp_path, {"status": "completed"})
+    ctx = Context(preset, tmp_path, load_reference()["table6_5"], {spec.key: res})
+    checks = {c.rule: c for c in item.evaluate(ctx, [spec]).checks}
+    assert checks["UV-IR, UV-B do not differ significantly in J"].passed is tied
+    differs = checks["UV-IR differs significantly (at 5 %) from every contrast but UV-B in J"]
+    assert differs.passed is tied and differs.detail == ("not significant: none" if tied else "not significant: UV-R")
+    assert checks["UV-G, UV-B do not differ significantly in J_sigma"].passed is True
+    assert checks["UV-B, UV-G, UV-R, UV-IR do not differ significantly in n_f"].passed is True
+    assert checks["B-G, B-R, B-IR do not differ significantly in n_f"].passed is True

@@ -987,6 +987,14 @@ def _significance(res: RunResult, crit: str) -> dict[tuple[str, str], str] | Non
     return out
 
 
+def _not_different(sig: dict[tuple[str, str], str], group: Sequence[str], crit: str) -> Check:
+    """The thesis' claim that the features of ``group`` do not differ significantly (no mark at 5 %) in ``crit``."""
+    pairs = [(a, b) for i, a in enumerate(group) for b in group[i + 1:]]
+    marks = {f"{a}/{b}": sig.get((a, b), "?") for a, b in pairs}
+    return Check(f"{', '.join(group)} do not differ significantly in {crit}", all(m == "o" for m in marks.values()),
+                 ", ".join(f"{k}: {v}" for k, v in marks.items()))
+
+
 @item("table6_3", "Table 6.3",
       "the table is not in the transcribed text: the claims of the discussion 6.2.4 are checked on bionav's "
       "bootstrap (each a check): pairs named 'not significantly different' in J have no mark at 5 %",
@@ -1005,22 +1013,24 @@ class _Table63:
             out.missing.append("no significance_J.csv: " + why_missing(res) if not res.ok else
                                "the run wrote no significance_J.csv (experiment.n_resamples=0?)")
             return out
-        groups = [("UV-IR", "B-IR"), ("UV-G", "B-R", "G-IR"), ("UV-B", "B-G", "G-R", "R-IR"), SINGLES]
-        for g in groups:
-            pairs = [(a, b) for i, a in enumerate(g) for b in g[i + 1:]]
-            marks = {f"{a}/{b}": sig.get((a, b), "?") for a, b in pairs}
-            out.checks.append(Check(f"{', '.join(g)} do not differ significantly in J",
-                                    all(m == "o" for m in marks.values()),
-                                    ", ".join(f"{k}: {v}" for k, v in marks.items())))
+        for g in [("UV-IR", "B-IR"), ("UV-G", "B-R", "G-IR"), ("UV-B", "B-G", "G-R", "R-IR"), SINGLES]:
+            out.checks.append(_not_different(sig, g, "J"))
         if (res.dir / "significance.md").is_file():
             shutil.copyfile(res.dir / "significance.md", ctx.out / "table6_3.md")
             out.tables.append("table6_3.md")
         return out
 
 
+# thesis 6.3.4: groups of contrasts of the artificial samples that "do not differ significantly", per criterion
+_DISCUSSION_6_3_4 = {"J": [("UV-IR", "UV-B")], "J_sigma": [("UV-G", "UV-B")],
+                     "n_f": [("UV-B", "UV-G", "UV-R", "UV-IR"), ("B-G", "B-R", "B-IR")]}
+
+
 @item("table6_5", "Table 6.5",
       "per criterion and feature: bionav's significance mark of the difference to 'All' equals the thesis' "
-      "(***, **, *, o); one check each", aliases=("6.5",))
+      "(***, **, *, o); one check each; and the claims of the discussion 6.3.4 (UV-IR and UV-B do not differ in J, "
+      "UV-IR differs from every other contrast in J, UV-G and UV-B do not differ in J_sigma, the UV contrasts and "
+      "the B contrasts do not differ among themselves in n_f)", aliases=("6.5",))
 class _Table65:
     @staticmethod
     def runs(p: Preset) -> list[RunSpec]:
@@ -1041,6 +1051,15 @@ class _Table65:
                 out.checks.append(Check(f"{crit}: {f} vs All marked {mark}", None if got is None else got == mark,
                                         f"bionav: {got}"))
                 out.rows.append(Row(f"{crit}: {f} vs All", mark, got))
+            for group in _DISCUSSION_6_3_4.get(crit, ()):
+                out.checks.append(_not_different(sig, group, crit))
+            if crit == "J":
+                others = [f for f in FEATURES if f not in ("UV-IR", "UV-B")]
+                marks = {f: sig.get(("UV-IR", f), "?") for f in others}
+                out.checks.append(Check("UV-IR differs significantly (at 5 %) from every contrast but UV-B in J",
+                                        all(m not in ("o", "?") for m in marks.values()),
+                                        "not significant: " + (", ".join(f for f, m in marks.items() if m == "o")
+                                                               or "none")))
         if res.dir is not None and (res.dir / "significance.md").is_file():
             shutil.copyfile(res.dir / "significance.md", ctx.out / "table6_5.md")
             out.tables.append("table6_5.md")
