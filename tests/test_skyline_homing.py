@@ -29,6 +29,15 @@ def test_representations():
     np.testing.assert_array_equal(sky, [[0, 0], [1, 1]])
     with pytest.raises(ValueError, match="unknown representation"):
         representation_image(counts, "UV-X")
+    # local thresholds: a dusk image, everything 1700 counts darker, is all "object" to the learned border,
+    # while each image of a stack gets its own border along the direction
+    stack = np.stack([img, img - 1700.0])
+    learned = representation_image(stack, "skyline:UV", discriminants={"UV": lda})
+    np.testing.assert_array_equal(learned[1], [[1, 1], [1, 1]])
+    local = representation_image(stack, "skyline:UV", discriminants={"UV": lda}, threshold="local")
+    np.testing.assert_array_equal(local, [[[0, 0], [1, 1]], [[0, 0], [1, 1]]])
+    with pytest.raises(ValueError, match="learned, local"):
+        representation_image(img, "skyline:UV", discriminants={"UV": lda}, threshold="global")
 
 
 def test_skyline_homing_tiny(tmp_path):
@@ -89,3 +98,22 @@ def test_campus_world_in_five_bands():
     assert counts.shape == (1, 10, 60, 5) and 0.05 < is_sky.mean() < 0.95
     uv_ir = counts[0, ..., 0] - counts[0, ..., 4]
     assert uv_ir[is_sky[0]].mean() > uv_ir[~is_sky[0]].mean() + 300  # sky is UV-rich, the world is not
+
+
+def test_local_skylines_through_the_command_keep_homing_across_the_day(tmp_path):
+    """``experiment=skyline_homing experiment.separation=local``: changed light homes as well as the same light."""
+    import json
+
+    from helpers import run_bionav
+
+    args = ["experiment=skyline_homing", "homing=mfdid", "experiment.grid=[5,5]", "experiment.image_width=60",
+            "experiment.image_height=10", "experiment.representations=[skyline:UV-IR]", "experiment.square_test=false",
+            "experiment.plots=false"]
+    m = {}
+    for border in ("learned", "local"):
+        r = run_bionav(*args, f"experiment.separation={border}", f"hydra.run.dir={tmp_path / border}", cwd=tmp_path)
+        assert r.returncode == 0, r.stderr[-2000:]
+        m[border] = json.loads((tmp_path / border / "metrics.json").read_text())
+    changed = {b: m[b]["rr"]["skyline:UV-IR"] for b in m}
+    assert changed["local"] > changed["learned"] + 0.03, changed
+    assert changed["local"] >= m["local"]["rr_same"]["skyline:UV-IR"] - 0.02, m["local"]

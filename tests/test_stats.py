@@ -12,6 +12,7 @@ from bionav.stats import (
     jackknife,
     min_error_threshold,
     min_errors,
+    otsu_threshold,
     paired_bootstrap_difference,
     pairwise_significance,
     stars,
@@ -120,6 +121,38 @@ def test_threshold_minimises_errors_vs_brute_force():
         pred = y > thr.threshold
         assert np.count_nonzero(pred != lab) == ref
 
+
+
+def _brute_force_otsu(y):
+    """Between-class variance of every split between distinct values, by definition (a plain loop)."""
+    best, best_t = -1.0, None
+    values = np.unique(y)
+    for lo, hi in zip(values[:-1], values[1:]):
+        t = 0.5 * (lo + hi)
+        a, b = y[y <= t], y[y > t]
+        between = len(a) / len(y) * len(b) / len(y) * (a.mean() - b.mean()) ** 2
+        if between > best + 1e-12:
+            best, best_t = between, t
+    return best_t
+
+
+def test_otsu_threshold_matches_the_definition_and_splits_two_groups():
+    rng = np.random.default_rng(7)
+    for _ in range(40):
+        y = rng.integers(0, 12, size=int(rng.integers(2, 60))).astype(float)  # many ties
+        if np.ptp(y) == 0:
+            continue
+        assert otsu_threshold(y) == pytest.approx(_brute_force_otsu(y))
+    # two well separated groups of unequal size: the border lies in the gap, exactly midway between the edges
+    y = np.r_[rng.normal(0.0, 1.0, 300).clip(-3, 3), rng.normal(20.0, 1.0, 40).clip(17, 23)]
+    t = otsu_threshold(y)
+    assert y[y < 10].max() < t < y[y > 10].min()
+    assert t == pytest.approx(0.5 * (y[y < 10].max() + y[y > 10].min()))
+    # equivariant under a positive affine map, whatever the array shape
+    assert otsu_threshold(3.0 * y.reshape(20, 17) - 5.0) == pytest.approx(3.0 * t - 5.0)
+    for bad in ([1.0], [2.0, 2.0, 2.0], [0.0, np.nan, 1.0], [0.0, np.inf]):
+        with pytest.raises(ValueError):
+            otsu_threshold(bad)
 
 def test_jackknife_of_mean_is_standard_error():
     rng = np.random.default_rng(5)

@@ -129,6 +129,9 @@ class ContrastScanConfig:
     n_pan, pan_step_deg, pan_centre_deg, n_tilt, tilt_step_deg, tilt_start_deg : the scan grid
         (thesis 6.4.1: 113 pan x 26 tilt steps of 2 and 3 degrees); tilt = elevation of the optical axis.
     sigma : receptor noise of the J_sigma separation lines, counts.
+    separation : class border of the sky/object separation on each line's direction: ``learned`` (the thesis'
+        threshold from the labelled samples) or ``local`` (Otsu's threshold of each scan; beyond the thesis, for
+        light the samples did not cover, e.g. dusk; bionav.spectral.scan.image_discriminant).
     """
 
     name: str = "contrast_scan"
@@ -149,6 +152,7 @@ class ContrastScanConfig:
     tilt_start_deg: float = bounded(-45.0, ge=-90.0, le=90.0)
     plots: bool = True
     sigma: float = bounded(30.0, gt=0.0, le=1e6)
+    separation: str = bounded("learned", choices=("learned", "local"))
     learn: LearnSamplesConfig = field(default_factory=LearnSamplesConfig)
 
 
@@ -181,6 +185,8 @@ class SkylineHomingConfig:
     snapshot_stride : every k-th cell along x and y is a snapshot.
     square_test, square_side_m : thesis 6.5.2, corners of a square.
     sigma : receptor noise of the J_sigma skyline lines.
+    separation : class border of the skylines: ``learned`` (the samples' threshold) or ``local`` (Otsu's threshold
+        of each panorama; bionav.spectral.scan.image_discriminant).
     """
 
     name: str = "skyline_homing"
@@ -203,6 +209,7 @@ class SkylineHomingConfig:
     square_test: bool = True
     square_side_m: float = bounded(2.0, gt=0.0, le=1000.0)
     sigma: float = bounded(30.0, gt=0.0, le=1e6)
+    separation: str = bounded("learned", choices=("learned", "local"))
     plots: bool = True
     learn: LearnSamplesConfig = field(default_factory=LearnSamplesConfig)
 

@@ -16,8 +16,11 @@ first scan, before and after sky/object separation with the ``J_sigma`` lines
 learned on natural samples (figs. 6.10-6.15, D.3-D.6; ``stability.csv``),
 and the raw scans in ``scans.npz``. Metrics: ``logMSEvar`` and
 ``logMSEvar_separated`` per feature (mean over the later scans),
-``sky_accuracy`` per feature where the true sky is known (simulation), and
-summary scalars.
+``sky_accuracy`` per feature where the true sky is known (simulation; with
+``sky_recall`` and ``object_recall`` per feature and scan), and summary scalars.
+``experiment.separation=local`` places each line's class border per scan
+(Otsu's threshold along the learned direction) instead of at the learned
+threshold; see :func:`bionav.spectral.scan.image_discriminant`.
 """
 
 from __future__ import annotations
@@ -162,7 +165,8 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     names = list(CHANNELS) + list(dual_contrasts())
     np.savez_compressed(ctx.dir / "scans.npz", counts=scans, times=np.array([t.isoformat() for t in times]),
                         pans=grid.pans, tilts=grid.tilts)
-    rows = stability_series(scans[..., :5], disc, names=names)
+    border = str(exp.separation)
+    rows = stability_series(scans[..., :5], disc, names=names, threshold=border)
     with open(ctx.dir / "stability.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=["scan", "time", "feature", "separated", *MEASURES])
         w.writeheader()
@@ -170,7 +174,7 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
             w.writerow({**r, "time": times[r["scan"]].isoformat()})
     hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
     if bool(exp.plots):
-        _plots(scans, times, hours, rows, disc, names, ctx.plots)
+        _plots(scans, times, hours, rows, disc, names, ctx.plots, border)
     metrics: dict = {"n_scans": int(len(scans)), "n_readings": int(scans.shape[0] * scans.shape[1] * scans.shape[2])}
     if len(scans) > 1:
         for sep, key in ((False, "logMSEvar"), (True, "logMSEvar_separated")):
@@ -180,12 +184,15 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
             metrics[f"{key}_single_mean"] = _finite_mean([per[n] for n in CHANNELS])
             metrics[f"{key}_dual_mean"] = _finite_mean([per[n] for n in dual_contrasts()])
     if truths is not None:
-        acc = {}
-        for n in names:
-            acc[n] = float(np.mean([np.mean(separation_images(s[..., :5], {n: disc[n]})[n] == tr)
-                                    for s, tr in zip(scans, truths)]))
+        seps = [separation_images(s[..., :5], {n: disc[n] for n in names}, threshold=border) for s in scans]
+        acc = {n: float(np.mean([np.mean(sp[n] == tr) for sp, tr in zip(seps, truths)])) for n in names}
         metrics["sky_accuracy"] = acc
         metrics["best_sky_accuracy_feature"] = max(acc, key=acc.get)
+        # per scan: the fraction of the true sky called sky, and of the true objects called objects
+        metrics["sky_recall"] = {n: [float(np.mean(sp[n][tr])) if tr.any() else None for sp, tr in zip(seps, truths)]
+                                 for n in names}
+        metrics["object_recall"] = {n: [float(np.mean(~sp[n][~tr])) if (~tr).any() else None
+                                        for sp, tr in zip(seps, truths)] for n in names}
     return metrics
 
 
@@ -203,9 +210,9 @@ def _finite_mean(values) -> float:
     return float(np.mean(finite)) if finite else float("nan")
 
 
-def _plots(scans, times, hours, rows, disc, names, plots):
+def _plots(scans, times, hours, rows, disc, names, plots, border):
     from bionav.experiments import spectral_plots as sp
-    from bionav.spectral.scan import separation_images
+    from bionav.spectral.scan import image_discriminant, separation_images
 
     labels = [t.strftime("%H:%M") for t in times]
     (plots / "scans").mkdir(exist_ok=True)
@@ -213,11 +220,14 @@ def _plots(scans, times, hours, rows, disc, names, plots):
         sp.plot_channel_images(scans[k], plots / "scans" / f"channels_{k:02d}.png", title=f"scan {k}: {labels[k]}")
     for k, tag in ((0, "first"), (len(scans) - 1, "last")):
         sp.plot_contrast_images(scans[k], plots / f"contrasts_{tag}.png", title=f"dual-channel contrasts, {labels[k]}")
-        seps = separation_images(scans[k, ..., :5], {n: disc[n] for n in names})
+        seps = separation_images(scans[k, ..., :5], {n: disc[n] for n in names}, threshold=border)
         sp.plot_separation_images(seps, plots / f"separation_{tag}.png",
-                                  title=f"sky (black) / objects (white), J_sigma lines of natural samples, {labels[k]}")
+                                  title=f"sky (black) / objects (white), J_sigma lines of natural samples "
+                                        f"({border} threshold), {labels[k]}")
         sp.plot_separated_scatter(scans[k], seps["UV-IR"], disc["UV-IR"], plots / f"separated_uv_ir_{tag}.png",
-                                  title=f"UV-IR pixels classified, {labels[k]}")
+                                  title=f"UV-IR pixels classified, {labels[k]}",
+                                  local=(image_discriminant(scans[k, ..., :5], "UV-IR", disc["UV-IR"], threshold=border)
+                                         if border == "local" else None))
     if len(scans) > 1:
         sp.plot_stability(rows, hours[1:], plots / "stability.png", separated=False)
         sp.plot_stability(rows, hours[1:], plots / "stability_separated.png", separated=True)

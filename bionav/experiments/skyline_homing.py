@@ -148,6 +148,7 @@ def run(cfg, ctx) -> dict:
     extent = max(nx - 1, ny - 1) * spacing
     sensor_model = LogSensorModel(noise_counts=float(exp.noise_counts))
     disc = learn_discriminants(load_samples(exp.learn), sigma=float(exp.sigma))
+    border = str(exp.separation)
 
     gx, gy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     positions = np.c_[gx.ravel(), gy.ravel()]
@@ -193,7 +194,7 @@ def run(cfg, ctx) -> dict:
     for rep in ctx.progress(reps, desc="representations"):
         dbs, prepared = [], []
         for c in counts:
-            imgs = representation_image(c, rep, discriminants=disc)
+            imgs = representation_image(c, rep, discriminants=disc, threshold=border)
             db = ImageDatabase(name=rep, images=imgs, positions=positions, grid_shape=(nx, ny), geometry=geometry,
                                spacing_m=spacing)
             dbs.append(db)
@@ -211,7 +212,7 @@ def run(cfg, ctx) -> dict:
                              "aae": q.aae, "mae": q.mae, "rr": q.rr})
                 ctx.log.write(CELL_TOPIC, rows[-1], schema_name="bionav.SkylineHomingCell")
         if do_square:
-            sq_dbs = [ImageDatabase(name=rep, images=representation_image(s, rep, discriminants=disc),
+            sq_dbs = [ImageDatabase(name=rep, images=representation_image(s, rep, discriminants=disc, threshold=border),
                                     positions=square_cells, grid_shape=(2, 2), geometry=geometry, spacing_m=side)
                       for s in squares]
             for i in range(n):
@@ -253,7 +254,7 @@ def run(cfg, ctx) -> dict:
         if n > 1:
             metrics["square_aae_changed"] = {r: mean(square[r], off) for r in reps}
     if bool(exp.plots):
-        _plots(ctx.plots, counts, disc, reps, names, metrics, results, geometry)
+        _plots(ctx.plots, counts, disc, reps, names, metrics, results, geometry, border)
     return metrics
 
 
@@ -265,7 +266,7 @@ def _write_csv(path, rows, fields):
             w.writerow({k: (f"{v:.6f}" if isinstance(v, float) else v) for k, v in r.items()})
 
 
-def _plots(plots, counts, disc, reps, names, metrics, results, geometry):
+def _plots(plots, counts, disc, reps, names, metrics, results, geometry, border):
     plt = pyplot()
 
     from bionav.spectral.representations import representation_image
@@ -299,7 +300,8 @@ def _plots(plots, counts, disc, reps, names, metrics, results, geometry):
     fig, axes = plt.subplots(len(reps), len(names), figsize=(3.2 * len(names), 0.9 * len(reps) + 0.5), squeeze=False)
     for i, r in enumerate(reps):
         for j, nm in enumerate(names):
-            axes[i, j].imshow(representation_image(counts[j][0], r, discriminants=disc), cmap="gray", vmin=0, vmax=1,
+            axes[i, j].imshow(representation_image(counts[j][0], r, discriminants=disc, threshold=border), cmap="gray",
+                              vmin=0, vmax=1,
                               aspect="auto", interpolation="nearest")
             axes[i, j].set_xticks([])
             axes[i, j].set_yticks([])

@@ -154,8 +154,11 @@ def plot_separation_images(separations: dict, path, *, title="") -> Path:
     return _image_grid({n: ~v for n, v in separations.items()}, path, title=title, cols=5)
 
 
-def plot_separated_scatter(counts, is_sky, lda, path, *, title="", channels=(0, 4)) -> Path:
-    """Pixels of a scan in a two-channel plane coloured by their classification (figs. 6.16/6.17)."""
+def plot_separated_scatter(counts, is_sky, lda, path, *, title="", channels=(0, 4), local=None) -> Path:
+    """Pixels of a scan in a two-channel plane coloured by their classification (figs. 6.16/6.17).
+
+    ``lda`` is the learned border (dashed); ``local``, if given, the scan's own border on its direction (solid).
+    """
     plt = pyplot()
     x = counts[..., channels[0]].ravel()
     y = counts[..., channels[1]].ravel()
@@ -166,6 +169,8 @@ def plot_separated_scatter(counts, is_sky, lda, path, *, title="", channels=(0, 
     ax.set_xlabel("UV [counts]")
     ax.set_ylabel("IR [counts]")
     _border(ax, lda, "--", "J_sigma border")
+    if local is not None:
+        _border(ax, local, "-", "local border (this scan)")
     ax.legend(fontsize=7)
     if title:
         ax.set_title(title, fontsize=9)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from bionav.light.bands import CHANNELS, dual_contrasts, feature_subsets
+from bionav.spectral.scan import sky_mask
 
 SKYLINE_PREFIX = "skyline:"
 
@@ -35,7 +36,7 @@ def check_representation(name: str) -> str:
 
 
 def representation_image(counts, name: str, *, discriminants: dict | None = None,
-                         full_scale: float = 4095.0) -> np.ndarray:
+                         full_scale: float = 4095.0, threshold: str = "learned") -> np.ndarray:
     """One representation of a five-channel count image.
 
     Parameters
@@ -48,6 +49,10 @@ def representation_image(counts, name: str, *, discriminants: dict | None = None
         Feature -> fitted :class:`bionav.stats.LinearDiscriminant`; needed for skylines.
     full_scale : float
         ADC full scale.
+    threshold : {"learned", "local"}
+        Class border of a skyline (:func:`bionav.spectral.scan.image_discriminant`); with
+        ``"local"`` every image (the last three axes ``(H, W, 5)`` of ``counts``)
+        gets its own threshold.
 
     Returns
     -------
@@ -63,7 +68,10 @@ def representation_image(counts, name: str, *, discriminants: dict | None = None
     feature = name[len(SKYLINE_PREFIX):]
     if not discriminants or feature not in discriminants:
         raise ValueError(f"representation {name!r} needs a discriminant for feature {feature!r}")
-    sub = list(feature_subsets()[feature])
-    x = c[..., sub].reshape(-1, len(sub))
-    sky = discriminants[feature].predict(x).reshape(c.shape[:-1])
+    d = discriminants[feature]
+    if threshold == "local" and c.ndim > 3:  # a stack of images: each its own threshold
+        flat = c.reshape((-1,) + c.shape[-3:])
+        sky = np.stack([sky_mask(im, feature, d, threshold=threshold) for im in flat]).reshape(c.shape[:-1])
+    else:
+        sky = sky_mask(c, feature, d, threshold=threshold)
     return (~sky).astype(np.float32)

@@ -7,18 +7,25 @@ grows with the pan angle, i.e. counter-clockwise, as in bionav's canonical
 panoramas). Contrast images are differences of two channel images (log
 signals); separation images classify every pixel as sky or object with a
 linear discriminant learned on labelled samples (thesis: ``J_sigma`` lines of
-the natural samples).
+the natural samples), at the learned threshold (``threshold="learned"``, the
+thesis' "global" separation) or at a threshold adapted to each image along the
+learned direction (``threshold="local"``, beyond the thesis; see
+:func:`image_discriminant`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
 
 from bionav.light.bands import CHANNELS, dual_contrasts, feature_subsets
 from bionav.spectral.stability import stability_measures
+from bionav.stats.threshold import otsu_threshold
+
+#: How a separation image places the class border on the discriminant's direction.
+THRESHOLDS = ("learned", "local")
 
 #: The 14 scan times of the thesis' one-day dataset (Wed 17 June 2009, appendix D.3), local time.
 ONE_DAY_TIMES = (
@@ -166,7 +173,74 @@ def feature_images(counts) -> dict[str, np.ndarray]:
     return out
 
 
-def separation_images(counts, discriminants: dict) -> dict[str, np.ndarray]:
+def image_discriminant(counts, feature: str, discriminant, *, threshold: str = "learned"):
+    """The discriminant that separates one image: the learned one, or its direction with the image's own threshold.
+
+    Parameters
+    ----------
+    counts : array_like, shape (..., >=5)
+        Channel counts UV, B, G, R, IR (log signals) of one image (any pixel shape).
+    feature : str
+        ``"UV"``, ``"UV-IR"``, ``"all"``, ... (:func:`bionav.light.bands.feature_subsets`).
+    discriminant : bionav.stats.LinearDiscriminant
+        Fitted on that feature's channels, sky = class 1 (above the threshold).
+    threshold : {"learned", "local"}
+        ``"learned"``: the discriminant's own threshold, learned on labelled
+        samples (the thesis' separation; Differt & Moeller's "global" one).
+        ``"local"``: the learned *direction*, with the threshold chosen on this
+        image alone by Otsu's criterion (:func:`bionav.stats.otsu_threshold`), so
+        that it follows the light of the moment -- at dusk the whole scene,
+        sky and objects, moves along the direction, and a day-time threshold
+        calls the reddened sky near a low sun an object. Differt & Moeller
+        (2016), doi:10.3390/s16101614, found such per-image ("local")
+        thresholds more reliable than fixed ("global") ones for skylines
+        recorded over whole days. It assumes the image shows both sky and
+        objects (a panoramic scan does); an image of one value keeps the
+        learned threshold.
+
+    Returns
+    -------
+    bionav.stats.LinearDiscriminant
+        ``discriminant`` itself, or a copy with the image's threshold.
+    """
+    if threshold not in THRESHOLDS:
+        raise ValueError(f"threshold must be one of {', '.join(THRESHOLDS)}, got {threshold!r}")
+    if threshold == "learned":
+        return discriminant
+    c = np.asarray(counts, dtype=float)
+    sub = list(feature_subsets()[feature])
+    y = discriminant.project(c[..., sub].reshape(-1, len(sub)))
+    if y.size < 2 or np.ptp(y) == 0:
+        return discriminant
+    return replace(discriminant, threshold=otsu_threshold(y))
+
+
+def sky_mask(counts, feature: str, discriminant, *, threshold: str = "learned") -> np.ndarray:
+    """Sky/object classification of one image by one feature's linear discriminant.
+
+    Parameters
+    ----------
+    counts : array_like, shape (..., >=5)
+        Channel counts of one image (any pixel shape).
+    feature : str
+        The discriminant's feature (:func:`bionav.light.bands.feature_subsets`).
+    discriminant : bionav.stats.LinearDiscriminant
+        Sky = class 1.
+    threshold : {"learned", "local"}
+        The class border on the discriminant's direction (:func:`image_discriminant`).
+
+    Returns
+    -------
+    ndarray of bool, shape ``counts.shape[:-1]``
+        True where classified as sky.
+    """
+    c = np.asarray(counts, dtype=float)
+    sub = list(feature_subsets()[feature])
+    d = image_discriminant(c, feature, discriminant, threshold=threshold)
+    return d.predict(c[..., sub].reshape(-1, len(sub))).reshape(c.shape[:-1])
+
+
+def separation_images(counts, discriminants: dict, *, threshold: str = "learned") -> dict[str, np.ndarray]:
     """Sky/object classification of every pixel per feature.
 
     Parameters
@@ -176,6 +250,8 @@ def separation_images(counts, discriminants: dict) -> dict[str, np.ndarray]:
         Feature name -> fitted :class:`bionav.stats.LinearDiscriminant` (sky =
         class 1) on that feature's channels (see
         :func:`bionav.light.bands.feature_subsets`).
+    threshold : {"learned", "local"}
+        The class border on each discriminant's direction (:func:`image_discriminant`).
 
     Returns
     -------
@@ -183,15 +259,11 @@ def separation_images(counts, discriminants: dict) -> dict[str, np.ndarray]:
         Feature name -> bool image ``(H, W)``, True where classified as sky.
     """
     c = np.asarray(counts, dtype=float)
-    subsets = feature_subsets()
-    out = {}
-    for name, lda in discriminants.items():
-        x = c[..., list(subsets[name])].reshape(-1, len(subsets[name]))
-        out[name] = lda.predict(x).reshape(c.shape[:2])
-    return out
+    return {name: sky_mask(c, name, lda, threshold=threshold) for name, lda in discriminants.items()}
 
 
-def stability_series(scans, discriminants: dict | None = None, *, names=None) -> list[dict]:
+def stability_series(scans, discriminants: dict | None = None, *, names=None,
+                     threshold: str = "learned") -> list[dict]:
     """Stability measures of every feature of every scan against the first scan (thesis 6.4.2/6.4.3).
 
     Parameters
@@ -203,6 +275,8 @@ def stability_series(scans, discriminants: dict | None = None, *, names=None) ->
         also computed on the separation images (sky 0, object 1).
     names : sequence of str, optional
         Features to evaluate; default the 5 channels and 10 dual contrasts.
+    threshold : {"learned", "local"}
+        Class border of the separation images (:func:`image_discriminant`).
 
     Returns
     -------
@@ -213,11 +287,13 @@ def stability_series(scans, discriminants: dict | None = None, *, names=None) ->
     scans = np.asarray(scans, dtype=float)
     ref = feature_images(scans[0])
     names = list(names or ref)
-    ref_sep = separation_images(scans[0], {n: discriminants[n] for n in names}) if discriminants else None
+    ref_sep = (separation_images(scans[0], {n: discriminants[n] for n in names}, threshold=threshold)
+               if discriminants else None)
     rows = []
     for k in range(1, len(scans)):
         cur = feature_images(scans[k])
-        cur_sep = separation_images(scans[k], {n: discriminants[n] for n in names}) if discriminants else None
+        cur_sep = (separation_images(scans[k], {n: discriminants[n] for n in names}, threshold=threshold)
+                   if discriminants else None)
         for n in names:
             rows.append({"scan": k, "feature": n, "separated": False, **stability_measures(ref[n], cur[n])})
             if discriminants:

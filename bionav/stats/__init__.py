@@ -3,7 +3,8 @@
 * Fisher's linear discriminant, with and without receptor noise
   (:func:`fisher_lda`, :func:`fisher_criterion`, :func:`optimal_criterion`).
 * The minimum-misclassification threshold on a projection
-  (:func:`min_error_threshold`, batched :func:`min_errors`).
+  (:func:`min_error_threshold`, batched :func:`min_errors`) and the unsupervised
+  two-group threshold of Otsu (:func:`otsu_threshold`).
 * Jackknife standard errors (:func:`jackknife`).
 * Bootstrap: one-sample intervals (:func:`bootstrap_interval`), the paired
   comparison of two methods with BCa intervals (:func:`paired_bootstrap_difference`),
@@ -29,7 +30,7 @@ from bionav.stats.lda import (
 )
 from bionav.stats.lda_bootstrap import LdaBootstrap, bootstrap_lda
 from bionav.stats.significance import pairwise_significance
-from bionav.stats.threshold import Threshold, min_error_threshold, min_errors
+from bionav.stats.threshold import Threshold, min_error_threshold, min_errors, otsu_threshold
 
 __all__ = [
     "SIGNIFICANCE_LEVELS",
@@ -48,6 +49,7 @@ __all__ = [
     "min_error_threshold",
     "min_errors",
     "optimal_criterion",
+    "otsu_threshold",
     "pairwise_significance",
     "paired_bootstrap_difference",
     "stars",
