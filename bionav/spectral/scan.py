@@ -203,16 +203,30 @@ def image_discriminant(counts, feature: str, discriminant, *, threshold: str = "
     bionav.stats.LinearDiscriminant
         ``discriminant`` itself, or a copy with the image's threshold.
     """
+    if _check_threshold(threshold) == "learned":
+        return discriminant
+    y, _ = _projection(counts, feature, discriminant)
+    return replace(discriminant, threshold=_border(y, discriminant, threshold))
+
+
+def _check_threshold(threshold: str) -> str:
     if threshold not in THRESHOLDS:
         raise ValueError(f"threshold must be one of {', '.join(THRESHOLDS)}, got {threshold!r}")
-    if threshold == "learned":
-        return discriminant
+    return threshold
+
+
+def _projection(counts, feature: str, discriminant) -> tuple[np.ndarray, tuple[int, ...]]:
+    """Every pixel projected on the discriminant's direction, flat, and the pixel shape."""
     c = np.asarray(counts, dtype=float)
     sub = list(feature_subsets()[feature])
-    y = discriminant.project(c[..., sub].reshape(-1, len(sub)))
-    if y.size < 2 or np.ptp(y) == 0:
-        return discriminant
-    return replace(discriminant, threshold=otsu_threshold(y))
+    return discriminant.project(c[..., sub].reshape(-1, len(sub))), c.shape[:-1]
+
+
+def _border(y: np.ndarray, discriminant, threshold: str) -> float:
+    """The learned threshold, or Otsu's of the projected pixels ``y`` (the learned one if ``y`` is constant)."""
+    if threshold == "local" and y.size > 1 and np.ptp(y) > 0:
+        return otsu_threshold(y)
+    return float(discriminant.threshold)
 
 
 def sky_mask(counts, feature: str, discriminant, *, threshold: str = "learned") -> np.ndarray:
@@ -234,10 +248,8 @@ def sky_mask(counts, feature: str, discriminant, *, threshold: str = "learned") 
     ndarray of bool, shape ``counts.shape[:-1]``
         True where classified as sky.
     """
-    c = np.asarray(counts, dtype=float)
-    sub = list(feature_subsets()[feature])
-    d = image_discriminant(c, feature, discriminant, threshold=threshold)
-    return d.predict(c[..., sub].reshape(-1, len(sub))).reshape(c.shape[:-1])
+    y, shape = _projection(counts, feature, discriminant)
+    return (y > _border(y, discriminant, _check_threshold(threshold))).reshape(shape)
 
 
 def separation_images(counts, discriminants: dict, *, threshold: str = "learned") -> dict[str, np.ndarray]:
