@@ -165,8 +165,9 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     names = list(CHANNELS) + list(dual_contrasts())
     np.savez_compressed(ctx.dir / "scans.npz", counts=scans, times=np.array([t.isoformat() for t in times]),
                         pans=grid.pans, tilts=grid.tilts)
-    border = str(exp.separation)
-    rows = stability_series(scans[..., :5], disc, names=names, threshold=border)
+    # every scan's separation images, once: for the stability after separation, the plots and the accuracy
+    seps = [separation_images(s[..., :5], {n: disc[n] for n in names}, threshold=str(exp.separation)) for s in scans]
+    rows = stability_series(scans[..., :5], seps, names=names)
     with open(ctx.dir / "stability.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=["scan", "time", "feature", "separated", *MEASURES])
         w.writeheader()
@@ -174,7 +175,7 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
             w.writerow({**r, "time": times[r["scan"]].isoformat()})
     hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
     if bool(exp.plots):
-        _plots(scans, times, hours, rows, disc, names, ctx.plots, border)
+        _plots(scans, times, hours, rows, disc, seps, ctx.plots, str(exp.separation))
     metrics: dict = {"n_scans": int(len(scans)), "n_readings": int(scans.shape[0] * scans.shape[1] * scans.shape[2])}
     if len(scans) > 1:
         for sep, key in ((False, "logMSEvar"), (True, "logMSEvar_separated")):
@@ -184,7 +185,6 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
             metrics[f"{key}_single_mean"] = _finite_mean([per[n] for n in CHANNELS])
             metrics[f"{key}_dual_mean"] = _finite_mean([per[n] for n in dual_contrasts()])
     if truths is not None:
-        seps = [separation_images(s[..., :5], {n: disc[n] for n in names}, threshold=border) for s in scans]
         acc = {n: float(np.mean([np.mean(sp[n] == tr) for sp, tr in zip(seps, truths)])) for n in names}
         metrics["sky_accuracy"] = acc
         metrics["best_sky_accuracy_feature"] = max(acc, key=acc.get)
@@ -210,9 +210,9 @@ def _finite_mean(values) -> float:
     return float(np.mean(finite)) if finite else float("nan")
 
 
-def _plots(scans, times, hours, rows, disc, names, plots, border):
+def _plots(scans, times, hours, rows, disc, seps, plots, border):
     from bionav.experiments import spectral_plots as sp
-    from bionav.spectral.scan import image_discriminant, separation_images
+    from bionav.spectral.scan import image_discriminant
 
     labels = [t.strftime("%H:%M") for t in times]
     (plots / "scans").mkdir(exist_ok=True)
@@ -220,11 +220,10 @@ def _plots(scans, times, hours, rows, disc, names, plots, border):
         sp.plot_channel_images(scans[k], plots / "scans" / f"channels_{k:02d}.png", title=f"scan {k}: {labels[k]}")
     for k, tag in ((0, "first"), (len(scans) - 1, "last")):
         sp.plot_contrast_images(scans[k], plots / f"contrasts_{tag}.png", title=f"dual-channel contrasts, {labels[k]}")
-        seps = separation_images(scans[k, ..., :5], {n: disc[n] for n in names}, threshold=border)
-        sp.plot_separation_images(seps, plots / f"separation_{tag}.png",
+        sp.plot_separation_images(seps[k], plots / f"separation_{tag}.png",
                                   title=f"sky (black) / objects (white), J_sigma lines of natural samples "
                                         f"({border} threshold), {labels[k]}")
-        sp.plot_separated_scatter(scans[k], seps["UV-IR"], disc["UV-IR"], plots / f"separated_uv_ir_{tag}.png",
+        sp.plot_separated_scatter(scans[k], seps[k]["UV-IR"], disc["UV-IR"], plots / f"separated_uv_ir_{tag}.png",
                                   title=f"UV-IR pixels classified, {labels[k]}",
                                   local=(image_discriminant(scans[k, ..., :5], "UV-IR", disc["UV-IR"], threshold=border)
                                          if border == "local" else None))

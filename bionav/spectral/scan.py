@@ -274,21 +274,19 @@ def separation_images(counts, discriminants: dict, *, threshold: str = "learned"
     return {name: sky_mask(c, name, lda, threshold=threshold) for name, lda in discriminants.items()}
 
 
-def stability_series(scans, discriminants: dict | None = None, *, names=None,
-                     threshold: str = "learned") -> list[dict]:
+def stability_series(scans, separations=None, *, names=None) -> list[dict]:
     """Stability measures of every feature of every scan against the first scan (thesis 6.4.2/6.4.3).
 
     Parameters
     ----------
     scans : array_like, shape (T, H, W, >=5)
         Channel counts of T scans of one scene, the first is the reference.
-    discriminants : dict, optional
-        Feature -> discriminant (sky = class 1); when given, the measures are
-        also computed on the separation images (sky 0, object 1).
+    separations : sequence of dict, optional
+        Per scan, feature -> bool sky image ``(H, W)`` (:func:`separation_images`);
+        when given, the measures are also computed on the separation images
+        (sky 0, object 1) of every feature in ``names``.
     names : sequence of str, optional
         Features to evaluate; default the 5 channels and 10 dual contrasts.
-    threshold : {"learned", "local"}
-        Class border of the separation images (:func:`image_discriminant`).
 
     Returns
     -------
@@ -297,19 +295,17 @@ def stability_series(scans, discriminants: dict | None = None, *, names=None,
         ``separated`` and the seven measures of :func:`~bionav.spectral.stability.stability_measures`.
     """
     scans = np.asarray(scans, dtype=float)
+    if separations is not None and len(separations) != len(scans):
+        raise ValueError(f"{len(separations)} separations for {len(scans)} scans")
     ref = feature_images(scans[0])
     names = list(names or ref)
-    ref_sep = (separation_images(scans[0], {n: discriminants[n] for n in names}, threshold=threshold)
-               if discriminants else None)
     rows = []
     for k in range(1, len(scans)):
         cur = feature_images(scans[k])
-        cur_sep = (separation_images(scans[k], {n: discriminants[n] for n in names}, threshold=threshold)
-                   if discriminants else None)
         for n in names:
             rows.append({"scan": k, "feature": n, "separated": False, **stability_measures(ref[n], cur[n])})
-            if discriminants:
-                a = (~ref_sep[n]).astype(float)
-                b = (~cur_sep[n]).astype(float)
+            if separations is not None:
+                a = (~separations[0][n]).astype(float)
+                b = (~separations[k][n]).astype(float)
                 rows.append({"scan": k, "feature": n, "separated": True, **stability_measures(a, b)})
     return rows
