@@ -290,6 +290,20 @@ def _terminate(signum, frame) -> None:  # noqa: ARG001
     raise KeyboardInterrupt
 
 
+def _completion_query(hydra_main) -> None:
+    """Hydra's answer to a completion query, without bionav's internal groups."""
+    import contextlib
+    import io
+
+    from bionav.completion import without_internal
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        hydra_main()
+    text = out.getvalue()
+    print(without_internal(text) if text.strip() else text, end="\n" if text.strip() else "")
+
+
 def limit_blas_threads() -> None:
     """One BLAS thread per worker: bionav parallelises over image pairs itself.
 
@@ -312,10 +326,27 @@ def main(argv: list[str] | None = None) -> None:
         print(BASH_SCRIPT, end="")
         return
     rewrite_query_line()
+    if any(a in ("-sc", "--shell-completion") for a in argv) and "query=bash" in argv:
+        from bionav.completion import quick_choices
+
+        choices = quick_choices()
+        if choices is not None:
+            print(" ".join(choices))
+            return
     try:
         from bionav.config import register_configs
 
         names = register_configs()
+        from bionav.clihelp import help_text, wants_help
+
+        if wants_help(argv) and "--hydra-help" not in argv:  # Hydra's own help copies its repository per group
+            try:
+                print(help_text(argv), end="")
+            except UserError:
+                raise
+            except Exception as exc:  # a bad override: Hydra's composition message
+                raise UserError(composition_message(exc, [a for a in argv if not a.startswith("-")])) from None
+            return
         output_dirs: list[tuple[Path, bool]] = []
         completion = any(a in ("-sc", "--shell-completion") for a in argv)  # `query=...` is not an override
         if not completion and not any(
@@ -346,7 +377,10 @@ def main(argv: list[str] | None = None) -> None:
     except ValueError:  # not the main thread
         pass
     try:
-        hydra_main()
+        if completion and any(a.startswith("query=") for a in argv):
+            _completion_query(hydra_main)
+        else:
+            hydra_main()
     except KeyboardInterrupt:
         if multirun:
             _interrupted_sweep()

@@ -56,3 +56,40 @@ def rewrite_query_line(environ: dict | None = None) -> None:
     point = env.get("COMP_POINT")
     if point is not None and point.isdigit():
         env["COMP_POINT"] = str(max(len("bionav"), int(point) - (match.end() - len("bionav"))))
+
+
+#: config groups that exist for bionav's own wiring (typed schemas), never typed by users
+INTERNAL_GROUPS = ("experiment_schema", "db_schema", "recordings_schema")
+_GROUP_WORD = re.compile(r"([+~]?)([A-Za-z_]\w*)=([^=,]*)")
+
+
+def quick_choices(environ: dict | None = None) -> list[str] | None:
+    """Choices for a ``group=prefix`` word, answered without Hydra (None: ask Hydra).
+
+    The options are bionav's YAML presets and the plugins' entry points
+    (:func:`bionav.clihelp.groups_and_options`); nothing is composed and no plugin is imported
+    (but the sensors), so a TAB after ``homing=`` answers in a fraction of a second.
+    """
+    env = os.environ if environ is None else environ
+    line = env.get("COMP_LINE", "")
+    point = env.get("COMP_POINT")
+    if point is not None and point.isdigit():
+        line = line[: int(point)]
+    if not line or line[-1].isspace():
+        return None
+    match = _GROUP_WORD.fullmatch(line.split()[-1])
+    if match is None:
+        return None
+    from bionav.clihelp import groups_and_options
+
+    sign, group, prefix = match.groups()
+    options = groups_and_options(only=group).get(group)
+    if options is None:
+        return None
+    return [f"{sign}{group}={o}" for o in options if o.startswith(prefix)]
+
+
+def without_internal(choices: str) -> str:
+    """Hydra's completion output less bionav's internal groups (:data:`INTERNAL_GROUPS`)."""
+    words = [w for w in choices.split() if not w.lstrip("+~").startswith(INTERNAL_GROUPS)]
+    return " ".join(words)

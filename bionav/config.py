@@ -14,42 +14,20 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import warnings
-from pathlib import Path
 from typing import Any, Sequence
 
 from hydra.core.config_search_path import ConfigSearchPath
 from hydra.core.config_store import ConfigStore
 from hydra.core.plugins import Plugins
+from hydra.plugins.config_source import ConfigResult, ConfigSource
 from hydra.plugins.search_path_plugin import SearchPathPlugin
 from omegaconf import DictConfig, OmegaConf
 
 from bionav import registry
+from bionav.registry import config_dirs  # noqa: F401  (its home is the registry; re-exported for the Hydra wiring)
 
 #: config groups users select plugins in
 PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
-
-
-def config_dirs() -> list[tuple[str, Path]]:
-    """Folders of YAML configs, one per ``bionav.configs`` entry point: ``(name, folder)``.
-
-    A package is located with ``importlib.resources``; bionav's own configs
-    are the package ``bionav.conf`` (the folder ``bionav/conf/``).
-    """
-    import importlib.util
-    from importlib.resources import files
-
-    out = []
-    for name, package, _dist in registry.config_packages():
-        folder = None
-        try:
-            if importlib.util.find_spec(package) is not None:
-                folder = Path(str(files(package)))
-        except ModuleNotFoundError:
-            folder = None
-        if folder is not None and folder.is_dir():
-            out.append((name, folder))
-    return out
 
 
 class BionavSearchPathPlugin(SearchPathPlugin):
@@ -68,6 +46,8 @@ class BionavSearchPathPlugin(SearchPathPlugin):
         for name, folder in dirs:
             if f"file://{folder}" not in present:
                 search_path.append(provider=f"bionav-{name}", path=f"file://{folder}")
+        if f"{PluginConfigSource.scheme()}://" not in present:
+            search_path.append(provider="bionav-plugins", path=f"{PluginConfigSource.scheme()}://")
 
 
 def plugin_node_class(name: str, config_cls: type) -> type:
@@ -90,16 +70,84 @@ class BrokenPluginNode:
     broken: bool = True
 
 
+class PluginConfigSource(ConfigSource):
+    """Hydra config source of the plugins' typed configs, loaded only when selected.
+
+    Hydra asks this source which groups and options exist (answered from the entry points,
+    :func:`bionav.registry.names_by_group`, without importing plugin modules) and, when a
+    plugin is selected (``homing=sift`` or a default), for its node: only then is the plugin's
+    module imported and its ``Config`` dataclass turned into a structured config with a
+    ``name`` field (:func:`plugin_node_class`). A plugin that fails to load, or whose name two
+    distributions claim, gives :class:`BrokenPluginNode`, so that selecting it raises its
+    message from :func:`plugin_config`, and listing is never broken by it.
+    """
+
+    def __init__(self, provider: str, path: str) -> None:
+        super().__init__(provider=provider, path=path)
+
+    @staticmethod
+    def scheme() -> str:
+        return "bionav-plugins"
+
+    def available(self) -> bool:
+        return True
+
+    @staticmethod
+    def _split(config_path: str) -> tuple[str, str]:
+        path = config_path.strip("/")
+        if path.endswith(".yaml"):
+            path = path[: -len(".yaml")]
+        group, _, name = path.rpartition("/")
+        return group, name
+
+    def is_group(self, config_path: str) -> bool:
+        path = config_path.strip("/")
+        return path == "" or registry.kind_of_group(path) is not None
+
+    def is_config(self, config_path: str) -> bool:
+        group, name = self._split(config_path)
+        return registry.kind_of_group(group) is not None and name in registry.names_by_group().get(group, ())
+
+    def list(self, config_path: str, results_filter: Any) -> list[str]:
+        from hydra.core.object_type import ObjectType
+
+        path = config_path.strip("/")
+        if path == "":
+            groups = [g for g in PLUGIN_GROUPS]
+            return sorted(groups) if results_filter in (None, ObjectType.GROUP) else []
+        if registry.kind_of_group(path) is None or results_filter == ObjectType.GROUP:
+            return []
+        return sorted(registry.names_by_group().get(path, ()))
+
+    def load_config(self, config_path: str) -> ConfigResult:
+        group, name = self._split(config_path)
+        kind = registry.kind_of_group(group)
+        provider = self.provider
+        try:
+            cls = registry.load_plugin(kind, name)
+        except registry.PluginError:  # broken or conflicting: selecting it raises its message later
+            node = OmegaConf.structured(BrokenPluginNode(name=name))
+        else:
+            entry = registry.entry_points_of(kind).get(name)
+            provider = entry.distribution if entry is not None else provider
+            node = OmegaConf.structured(plugin_node_class(name, cls.Config))
+        return ConfigResult(config=node, path=f"{self.scheme()}://{self.path}", provider=provider,
+                            header={"package": None})
+
+
 @functools.cache
 def register_configs() -> dict[str, list[str]]:
-    """Register the search-path plugin and all plugin configs (once per process).
+    """Register the search-path plugin, the plugin config source and the schemas (once per process).
+
+    Plugins are not imported here (:class:`PluginConfigSource` loads the one selected).
 
     Returns
     -------
     dict
-        Config group -> names of the plugins stored in it (broken ones included).
+        Config group -> names of the plugins selectable in it (broken ones included).
     """
     Plugins.instance().register(BionavSearchPathPlugin)
+    Plugins.instance().register(PluginConfigSource)
     store = ConfigStore.instance()
     # typed schemas of config nodes, registered by the rooms that own them (entry points
     # ``bionav.schemas``); e.g. every db preset is merged onto ``db_schema``
@@ -114,20 +162,7 @@ def register_configs() -> dict[str, list[str]]:
             store.store(name=name, node=schema, provider="bionav")
         else:  # a registration function: experiment_schema/<name>, hydra/launcher=submitit_slurm, ...
             schema(store)
-    names: dict[str, list[str]] = {group: [] for group in PLUGIN_GROUPS}
-    for kind in registry.GROUPS:
-        with warnings.catch_warnings():
-            warnings.simplefilter("default", registry.PluginWarning)
-            loaded = registry.plugins_of(kind)
-        for name, plugin in loaded.items():
-            for group in plugin.config_groups:
-                names.setdefault(group, []).append(name)
-                if plugin.cls is None:
-                    store.store(group=group, name=name, node=BrokenPluginNode(name=name), provider="bionav")
-                    continue
-                node_cls = plugin_node_class(name, plugin.cls.Config)
-                store.store(group=group, name=name, node=node_cls, provider=plugin.entry.distribution)
-    return names
+    return registry.names_by_group()
 
 
 def config_options(group: str) -> list[str]:
@@ -139,13 +174,16 @@ def config_options(group: str) -> list[str]:
     return sorted(options)
 
 
-def compose(overrides: Sequence[str] = (), *, config_name: str = "config") -> DictConfig:
+def compose(overrides: Sequence[str] = (), *, config_name: str = "config",
+            return_hydra_config: bool = False) -> DictConfig:
     """Compose bionav's configuration outside the command line (tests, tools).
 
     Parameters
     ----------
     overrides : sequence of str
         Hydra overrides such as ``["homing=mfdid", "db.seed=3"]``.
+    return_hydra_config : bool
+        Keep the ``hydra`` node (help texts, run directories).
     """
     from hydra import compose as hydra_compose
     from hydra import initialize_config_dir
@@ -155,7 +193,8 @@ def compose(overrides: Sequence[str] = (), *, config_name: str = "config") -> Di
     GlobalHydra.instance().clear()
     own = dict(config_dirs())["bionav"]
     with initialize_config_dir(config_dir=str(own), version_base="1.3"):
-        return hydra_compose(config_name=config_name, overrides=list(overrides))
+        return hydra_compose(config_name=config_name, overrides=list(overrides),
+                             return_hydra_config=return_hydra_config)
 
 
 def plugin_config(kind: str, node: Any, *, key: str | None = None) -> Any:

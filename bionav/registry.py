@@ -21,6 +21,7 @@ import functools
 import importlib.metadata as importlib_metadata
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from bionav.errors import PluginError
@@ -122,6 +123,7 @@ def clear_cache() -> None:
     _scan.cache_clear()
     entry_points_of.cache_clear()
     _load_entry.cache_clear()
+    _names_by_group.cache_clear()
 
 
 @functools.cache
@@ -247,6 +249,58 @@ def load_plugin(kind: str, name_or_class: str | type) -> type:
     return plugin.cls
 
 
+#: plugin kinds whose classes may choose their config group (``config_group``); every other kind's
+#: plugins are selected in the group named like the kind, so they are listed without importing them
+KINDS_WITH_OWN_GROUPS = frozenset({"sensor"})
+
+
+def names_in_group(group: str) -> list[str]:
+    """Names of the plugins selectable in config group ``group`` (empty: not a plugin group).
+
+    Only a group of a kind in :data:`KINDS_WITH_OWN_GROUPS` (``sensor``, ``pantilt``) imports
+    plugin modules; ``homing``, ``signature``, ... are answered from the entry points alone.
+    """
+    kind = kind_of_group(group)
+    if kind is None:
+        return []
+    if kind not in KINDS_WITH_OWN_GROUPS:
+        return sorted(entry_points_of(kind))
+    return list(_names_by_group().get(group, ()))
+
+
+def names_by_group() -> dict[str, list[str]]:
+    """Config group -> names of the plugins selected in it, without importing plugins where possible.
+
+    Plugins of kinds other than :data:`KINDS_WITH_OWN_GROUPS` are listed from their entry points
+    alone (their group is their kind); sensor plugins are imported, since each class says whether it
+    is a ``sensor``, a ``pantilt`` or both. Broken and conflicting plugins are listed too (selecting
+    one raises its message). The result is computed once per process.
+    """
+    return {group: list(names) for group, names in _names_by_group().items()}
+
+
+@functools.cache
+def _names_by_group() -> dict[str, tuple[str, ...]]:
+    out: dict[str, list[str]] = {}
+    for kind in GROUPS:
+        if kind in KINDS_WITH_OWN_GROUPS:
+            for name, plugin in plugins_of(kind, warn=False).items():
+                for group in plugin.config_groups:
+                    out.setdefault(group, []).append(name)
+        else:
+            out.setdefault(kind, []).extend(entry_points_of(kind))
+    return {group: tuple(sorted(set(names))) for group, names in out.items()}
+
+
+def kind_of_group(group: str) -> str | None:
+    """The plugin kind whose plugins are selected in config group ``group`` (None: not a plugin group)."""
+    if group in GROUPS:
+        return group
+    if group == "pantilt":
+        return "sensor"
+    return None
+
+
 def config_packages() -> list[tuple[str, str, str]]:
     """Config packages declared in ``bionav.configs``: ``(name, package, distribution)``.
 
@@ -258,6 +312,28 @@ def config_packages() -> list[tuple[str, str, str]]:
         dist, _ = _distribution_of(ep)
         out.append((ep.name, ep.value, dist))
     out.sort(key=lambda item: (item[0] != "bionav", item[0]))
+    return out
+
+
+def config_dirs() -> list[tuple[str, Path]]:
+    """Folders of YAML configs, one per ``bionav.configs`` entry point: ``(name, folder)``.
+
+    A package is located with ``importlib.resources``; bionav's own configs
+    are the package ``bionav.conf`` (the folder ``bionav/conf/``).
+    """
+    import importlib.util
+    from importlib.resources import files
+
+    out = []
+    for name, package, _dist in config_packages():
+        folder = None
+        try:
+            if importlib.util.find_spec(package) is not None:
+                folder = Path(str(files(package)))
+        except ModuleNotFoundError:
+            folder = None
+        if folder is not None and folder.is_dir():
+            out.append((name, folder))
     return out
 
 
