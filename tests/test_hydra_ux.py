@@ -1,5 +1,6 @@
 """Hydra UX: --help lists each config group once; bash completion works for `python -m bionav`."""
 
+import json
 import os
 import re
 import shutil
@@ -69,3 +70,43 @@ def test_installed_bash_completion_completes_python_m_bionav(tmp_path):
                           env=dict(os.environ, BIONAV_CACHE=str(tmp_path / "cache")))
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.split() == ["db=sim_hall1", "db=sim_hall2"]
+
+
+def _imported_modules(args: list[str], tmp_path) -> set[str]:
+    """Modules imported by bionav's command line ``ARGS`` (run in a fresh interpreter)."""
+    out = tmp_path / "modules.json"
+    code = ("import json, sys\nfrom bionav.cli import main\ntry:\n    main(%r)\nexcept SystemExit as exc:\n"
+            "    assert not exc.code, exc.code\nopen(%r, 'w').write(json.dumps(sorted(sys.modules)))\n"
+            % (list(args), str(out)))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, BIONAV_CACHE=str(tmp_path / "cache")))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return set(json.loads(out.read_text()))
+
+
+def test_plugins_are_imported_only_when_selected(tmp_path):
+    """Issue 28 item 3: entry points are listed without importing plugin modules."""
+    listed = _imported_modules(["--help"], tmp_path)  # lists every plugin, shows the default config (sift)
+    plugins = {m for m in listed if m.startswith(("bionav.plugins.homing.", "bionav.plugins.signatures.",
+                                                   "bionav.plugins.controllers.", "bionav.plugins.decoders."))}
+    assert plugins == {"bionav.plugins.homing.sift"}, plugins
+    composed = _imported_modules(["homing=mfdid", "--cfg", "job"], tmp_path)
+    assert "bionav.plugins.homing.mfdid" in composed
+    assert "bionav.plugins.homing.sift" not in composed and "bionav.plugins.homing.warping" not in composed
+
+
+def test_internal_groups_are_not_offered(tmp_path):
+    proc = run_bionav("--help", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "experiment_schema" not in proc.stdout and "db_schema" not in proc.stdout
+    assert not [c for c in _complete("python -m bionav ", tmp_path) if "schema" in c]
+    assert _complete("python -m bionav pantilt=", tmp_path) == ["pantilt=ptu46", "pantilt=replay", "pantilt=sim"]
+
+
+def test_help_shows_the_config_of_the_overrides_and_refuses_bad_ones(tmp_path):
+    proc = run_bionav("homing=mfdid", "--help", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    config = proc.stdout.split("== Config ==", 1)[1]
+    assert "name: mfdid" in config and "name: sift" not in config
+    bad = run_bionav("homing=nope", "--help", cwd=tmp_path)
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr and "homing/nope" in bad.stderr
