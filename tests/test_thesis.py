@@ -319,3 +319,43 @@ def test_table6_5_checks_the_discussion_claims_on_the_pairwise_bootstrap(tmp_pat
     assert checks["UV-G, UV-B do not differ significantly in J_sigma"].passed is True
     assert checks["UV-B, UV-G, UV-R, UV-IR do not differ significantly in n_f"].passed is True
     assert checks["B-G, B-R, B-IR do not differ significantly in n_f"].passed is True
+
+
+def test_run_pool_renders_each_database_once_before_its_other_runs(tmp_path, monkeypatch):
+    """Issue 29: runs go at once on --jobs slots, but a database's first run renders it alone."""
+    import threading
+    import time as _time
+
+    from bionav.thesis import runs as runs_mod
+
+    events, lock = [], threading.Lock()
+
+    def fake_execute(spec, out, *, env=None, launcher=(), extra=()):
+        with lock:
+            events.append(("start", spec.key, _time.monotonic()))
+        _time.sleep(0.2)
+        with lock:
+            events.append(("end", spec.key, _time.monotonic()))
+        return runs_mod.RunResult(spec, tmp_path, {"status": "completed"}, None, 0.2, cpu_seconds=0.2)
+
+    monkeypatch.setattr(runs_mod, "execute_local", fake_execute)
+    specs = [runs_mod.RunSpec((f"db={db}", f"homing={h}")) for db in ("sim_a", "sim_b") for h in ("sift", "mfdid", "hiss")]
+    runner = runs_mod.Runner(out=tmp_path, jobs=3, echo=lambda s: None)
+    t0 = _time.monotonic()
+    results = runner.run_all(specs)
+    wall = _time.monotonic() - t0
+    assert set(results) == {s.key for s in specs} and all(r.ok for r in results.values())
+    start = {k: t for e, k, t in events if e == "start"}
+    end = {k: t for e, k, t in events if e == "end"}
+    for db in ("sim_a", "sim_b"):
+        mine = sorted((s.key for s in specs if f"db={db}" in s.overrides), key=start.get)
+        first = mine[0]
+        assert all(start[k] >= end[first] for k in mine[1:]), db  # the render comes first
+    assert max(sum(1 for k in start if start[k] <= t < end[k]) for t in start.values()) <= 3  # never over --jobs
+    assert wall < 6 * 0.2  # overlapping, not one after the other (6 runs x 0.2 s)
+
+
+def test_jobs_out_of_range_is_one_clear_message(tmp_path):
+    proc = run_bionav("--preset", "tiny", "--only", "table3_1", "--jobs", "0", "--out", str(tmp_path / "r"),
+                      cwd=tmp_path, module="bionav.thesis")
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr and "--jobs 0" in proc.stderr

@@ -36,6 +36,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run through a Hydra launcher (joblib, submitit_slurm, submitit_local, ...) as multiruns")
     p.add_argument("--launcher-arg", action="append", default=[], metavar="KEY=VALUE",
                    help="extra launcher override, e.g. hydra.launcher.partition=cpu (repeatable)")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="runs at once without a launcher (default: the number of CPUs; 1: one after the other)")
     p.add_argument("--dry-run", action="store_true", help="print the bionav commands and write nothing")
     p.add_argument("--report-only", action="store_true", help="run nothing; report from the runs already in DIR")
     return p
@@ -76,7 +78,7 @@ def run(args) -> int:
     from bionav.thesis.presets import PRESETS, PUBLIC_PRESETS
     from bionav.thesis.reference import load_reference
     from bionav.thesis.report import Section, markdown_to_html, report_markdown, verdict_counts, write_csv
-    from bionav.thesis.runs import Runner, tool_env
+    from bionav.thesis.runs import Runner, tool_env, usable_cpus
 
     started = time.time()
     load_start = _loadavg()
@@ -98,8 +100,12 @@ def run(args) -> int:
     ref_all = load_reference()
     specs = {it.id: it.runs(preset) for it in items}
     launcher = _launcher_overrides(args.launcher, args.launcher_arg)
+    jobs = usable_cpus() if args.jobs is None else args.jobs
+    if not 1 <= jobs <= 4096:
+        raise UserError(f"--jobs {args.jobs} is out of range; give 1 (one run after the other) up to the number "
+                        f"of runs to execute at once, e.g. --jobs {usable_cpus()}.")
     runner = Runner(out=out, launcher=launcher, dry_run=args.dry_run, echo=lambda s: print(s, flush=True),
-                    env=tool_env())
+                    env=tool_env(), jobs=jobs)
     all_specs = [s for ss in specs.values() for s in ss]
     if args.report_only:
         from bionav.thesis.runs import RunResult, index_runs, read_json
@@ -156,6 +162,8 @@ def argv_for_display(args) -> list[str]:
     if args.only:
         words.append(f"--only {args.only}")
     words.append(f"--out {args.out}")
+    if args.jobs is not None:
+        words.append(f"--jobs {args.jobs}")
     if args.launcher:
         words.append(f"--launcher {args.launcher}")
     words += [f"--launcher-arg {a}" for a in args.launcher_arg]

@@ -205,20 +205,24 @@ def _move_aside(path: Path) -> None:
 
 
 def execute_local(spec: RunSpec, out: Path, *, env: Mapping[str, str] | None = None,
-                  launcher: Sequence[str] = ()) -> RunResult:
-    """Run one spec as a subprocess of ``python -m bionav`` into ``OUT/runs/<group>/<slug>``."""
+                  launcher: Sequence[str] = (), extra: Sequence[str] = ()) -> RunResult:
+    """Run one spec as a subprocess of ``python -m bionav`` into ``OUT/runs/<group>/<slug>``.
+
+    ``extra`` overrides are appended to the command without changing the run's identity
+    (only :data:`NEUTRAL_KEYS`, e.g. ``workers=1`` when several runs share the cores).
+    The CPU time is the child's own (``os.wait4``), so it is exact also when runs overlap.
+    """
     run_dir = Path(out) / "runs" / spec.group / spec.slug
     if not spec.multirun:
         _move_aside(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
     log_path = run_dir.parent / f"{spec.slug}.log"
     started = time.time()
-    cpu0 = _children_cpu()
     with open(log_path, "w") as fh:
-        proc = subprocess.run(spec.command(run_dir, launcher=launcher), stdout=fh, stderr=subprocess.STDOUT,
-                              env=dict(env) if env is not None else None)
+        proc = subprocess.Popen([*spec.command(run_dir, launcher=launcher), *extra], stdout=fh,
+                                stderr=subprocess.STDOUT, env=dict(env) if env is not None else None)
+        returncode, cpu = _wait_with_cpu(proc)
     seconds = time.time() - started
-    cpu = _children_cpu() - cpu0
     if spec.multirun:
         metrics = _sweep_metrics(run_dir)
         if metrics["status"] == "completed":
@@ -226,17 +230,22 @@ def execute_local(spec: RunSpec, out: Path, *, env: Mapping[str, str] | None = N
     else:
         metrics = read_json(run_dir / "metrics.json")
     error = None
-    if proc.returncode != 0 or not metrics or metrics.get("status") != "completed":
+    if returncode != 0 or not metrics or metrics.get("status") != "completed":
         error = _last_error(log_path, metrics)
     return RunResult(spec, run_dir, metrics, error, seconds, cpu_seconds=cpu)
 
 
-def _children_cpu() -> float:
-    """User + system CPU seconds of the finished child processes (``resource.getrusage``)."""
-    import resource
-
-    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return ru.ru_utime + ru.ru_stime
+def _wait_with_cpu(proc: subprocess.Popen) -> tuple[int, float]:
+    """Wait for ``proc``; its exit status and the user + system CPU seconds of it and its children."""
+    try:
+        _pid, status, usage = os.wait4(proc.pid, 0)
+    except ChildProcessError:  # reaped elsewhere: no usage known
+        return proc.wait(), 0.0
+    except BaseException:  # Ctrl-C: the child got it too; reap it
+        proc.wait()
+        raise
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    return proc.returncode, usage.ru_utime + usage.ru_stime
 
 
 def _last_error(log_path: Path, metrics: dict | None) -> str:
@@ -308,6 +317,10 @@ class Runner:
         empty: run locally one after the other.
     dry_run : bool
         Only print the commands.
+    jobs : int
+        Runs executed at once without a launcher (1: one after the other). Runs of one
+        database wait until its first run has rendered it (the render cache), and each run
+        gets ``workers = max(1, cores // jobs)``, so the cores are shared, not oversubscribed.
     """
 
     out: Path
@@ -315,6 +328,7 @@ class Runner:
     dry_run: bool = False
     echo: Callable[[str], None] = print
     env: dict | None = None
+    jobs: int = 1
 
     def run_all(self, specs: Sequence[RunSpec]) -> dict[str, RunResult]:
         unique: dict[str, RunSpec] = {}
@@ -339,6 +353,8 @@ class Runner:
         return results
 
     def _run_local(self, todo: Sequence[RunSpec]) -> dict[str, RunResult]:
+        if self.jobs > 1 and not self.dry_run and len(todo) > 1:
+            return self._run_pool(todo)
         results = {}
         for i, spec in enumerate(todo, 1):
             run_dir = self.out / "runs" / spec.group / spec.slug
@@ -358,6 +374,44 @@ class Runner:
             self.echo(f"    {'done' if res.ok else 'FAILED: ' + str(res.error)} in {res.seconds:.0f} s "
                       f"(CPU {res.cpu_seconds:.0f} s)")
             results[spec.key] = res
+        return results
+
+    def _run_pool(self, todo: Sequence[RunSpec]) -> dict[str, RunResult]:
+        """Run ``todo`` on :attr:`jobs` slots; a database's first run goes before its other runs."""
+        from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+
+        cores = usable_cpus()
+        extra = [f"workers={max(1, cores // self.jobs)}"]
+        waiting = list(todo)
+        rendering: set[tuple[str, ...]] = set()  # databases whose first run is running
+        rendered: set[tuple[str, ...]] = set()  # databases with a finished run (cached renders)
+        results: dict[str, RunResult] = {}
+        active: dict = {}
+        started = 0
+        with ThreadPoolExecutor(max_workers=self.jobs) as pool:
+            while waiting or active:
+                while len(active) < self.jobs:
+                    pick = next((sp for sp in waiting if render_key(sp) in rendered
+                                 or render_key(sp) not in rendering), None)
+                    if pick is None:
+                        break
+                    waiting.remove(pick)
+                    if render_key(pick) not in rendered:
+                        rendering.add(render_key(pick))
+                    started += 1
+                    run_dir = self.out / "runs" / pick.group / pick.slug
+                    shown = " ".join(_quote(c) for c in pick.command(run_dir)[1:])
+                    self.echo(f"[{started}/{len(todo)}] python {shown}")
+                    active[pool.submit(execute_local, pick, self.out, env=self.env, extra=extra)] = pick
+                done, _ = wait(list(active), return_when=FIRST_COMPLETED)
+                for future in done:
+                    spec = active.pop(future)
+                    res = future.result()
+                    rendering.discard(render_key(spec))
+                    rendered.add(render_key(spec))
+                    self.echo(f"    {spec.slug}: {'done' if res.ok else 'FAILED: ' + str(res.error)} in "
+                              f"{res.seconds:.0f} s (CPU {res.cpu_seconds:.0f} s)")
+                    results[spec.key] = res
         return results
 
     def _run_launcher(self, todo: Sequence[RunSpec]) -> dict[str, RunResult]:
@@ -397,6 +451,23 @@ class Runner:
                 metrics = _sweep_metrics(d) if spec.multirun else read_json(d / "metrics.json")
                 results[spec.key] = RunResult(spec, d, metrics)
         return results
+
+
+def usable_cpus() -> int:
+    """CPUs this process may run on (its affinity mask, e.g. a SLURM allocation), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def render_key(spec: RunSpec) -> tuple[str, ...]:
+    """What a run renders: its database overrides (``db=...``, ``db.*=...``, ``data=...``).
+
+    Runs with equal keys share the cached renders of their databases, so the pool lets the
+    first of them render before the others start.
+    """
+    return tuple(sorted(o for o in spec.overrides if o.split("=", 1)[0].split(".", 1)[0] in ("db", "data")))
 
 
 def _quote(arg: str) -> str:
