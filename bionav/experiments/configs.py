@@ -34,6 +34,9 @@ class GridHomingConfig:
     step_length, success_radius : agent step and success radius, grid units (thesis 3.2.3).
     n_quiver_plots : quiver plots of home-vector fields for this many snapshots.
     snapshots : only these snapshot indices (None = all); handy for quick looks.
+    block : ``[i, n]``: only every n-th of those snapshots, starting at the i-th (0 <= i < n): one
+        task of a run split into n; ``python -m bionav.experiments.grid_homing_merge`` joins the
+        tasks into the unsplit run's files, with identical measures.
     """
 
     name: str = "grid_homing"
@@ -41,6 +44,7 @@ class GridHomingConfig:
     success_radius: float = bounded(1.0, **_RADIUS)
     n_quiver_plots: int = bounded(4, ge=0, le=1000)
     snapshots: Optional[list[int]] = bounded(None, length=(1, 1_000_000), item=Range(ge=0, le=10**8))
+    block: Optional[list[int]] = bounded(None, length=(2, 2), item=Range(ge=0, le=10**6))
 
 
 @dataclass

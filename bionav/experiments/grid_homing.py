@@ -28,6 +28,8 @@ HOME_VECTOR_SCHEMA = {
         "angles": {"type": "array", "description": "home directions, radians CCW in the grid frame (null: none)"},
         "ae": {"type": "array", "description": "angular errors, radians"},
         "success": {"type": "array", "description": "agent reached the snapshot"},
+        "compass_error": {"type": ["array", "null"],
+                          "description": "estimated minus true rotation, radians (null: no compass)"},
     },
 }
 
@@ -55,6 +57,22 @@ def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:
             w.writerow([int(x), int(y), f"{a:.6f}", f"{m:.6f}", f"{r:.6f}"])
 
 
+def _block_of(block, snapshots: list[int] | None, n_images: int) -> list[int] | None:
+    """The snapshot indices of task ``block = [i, n]`` (every n-th from the i-th), or ``snapshots``."""
+    if block is None:
+        return snapshots
+    from bionav.errors import UserError
+
+    i, n = (int(v) for v in block)
+    base = list(range(n_images)) if snapshots is None else snapshots
+    if n < 1 or not 0 <= i < n:
+        raise UserError(f"bad value experiment.block=[{i}, {n}]: give [i, n] with 0 <= i < n (task i of n).")
+    if i >= len(base):
+        raise UserError(f"experiment.block=[{i}, {n}] selects no snapshot: there are {len(base)}; split into at most "
+                        f"{len(base)} tasks.")
+    return base[i::n]
+
+
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.homing_plots import plot_home_vector_field, plot_per_snapshot_maps
 
@@ -69,6 +87,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             f"bad value experiment.snapshots={snapshots}: database {db.name!r} has {len(db)} images, so the "
             f"snapshot indices must be 0..{len(db) - 1}; drop the larger ones (null = every image)."
         )
+
+    snapshots = _block_of(exp.block, snapshots, len(db))
 
     def log_row(si: int, angles: np.ndarray, compass: np.ndarray) -> None:
         """Each snapshot's home vectors as soon as they are computed (a crash loses no finished row)."""
@@ -103,6 +123,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                 "angles": _finite_or_none(hv.angles[row]),
                 "ae": _finite_or_none(ae[row]),
                 "success": success[row],
+                "compass_error": None if hv.compass_error is None else _finite_or_none(hv.compass_error[row]),
             },
             schema_name="bionav.HomeVectorField",
             schema=HOME_VECTOR_SCHEMA,
@@ -138,6 +159,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "n_pairs": hv.n_pairs,
         "ms_per_home_vector": hv.ms_per_home_vector,
     }
+    if exp.block is not None:
+        metrics["block"] = [int(v) for v in exp.block]
     metrics.update({f"{k}_per_image": v for k, v in hv.prepared_stats.items()})
     if hv.compass_error is not None:
         metrics["compass_aae"] = float(np.nanmean(np.abs(hv.compass_error)))

@@ -52,6 +52,20 @@ class RunSpec:
     overrides: tuple[str, ...]
     multirun: bool = False
     group: str = "misc"
+    blocks: int = 1
+
+    def tasks(self) -> list["RunSpec"]:
+        """The independent tasks of this run: ``blocks`` grid-homing runs by snapshots, or the run itself.
+
+        A grid-homing run with ``blocks = n > 1`` splits into ``experiment.block=[i,n]`` runs
+        (:mod:`bionav.experiments.grid_homing`) that :meth:`Runner.run_all` executes like any
+        run (each reused on its own when completed) and then merges into this run's directory
+        (``python -m bionav.experiments.grid_homing_merge``), with identical measures.
+        """
+        if self.blocks <= 1 or self.multirun:
+            return [self]
+        return [RunSpec((*self.overrides, f"experiment.block=[{i},{self.blocks}]"), group=f"{self.group}-tasks")
+                for i in range(self.blocks)]
 
     @property
     def key(self) -> str:
@@ -331,9 +345,44 @@ class Runner:
     jobs: int = 1
 
     def run_all(self, specs: Sequence[RunSpec]) -> dict[str, RunResult]:
+        """Execute every spec not yet completed under :attr:`out`; split runs go as their tasks."""
         unique: dict[str, RunSpec] = {}
         for s in specs:
             unique.setdefault(s.key, s)
+        index = index_runs(self.out)
+        split = {k: s for k, s in unique.items() if len(s.tasks()) > 1 and k not in index}
+        flat = {k: s for k, s in unique.items() if k not in split}
+        for s in split.values():
+            for t in s.tasks():
+                flat.setdefault(t.key, t)
+        results = self._run_unique(flat)
+        for key, spec in split.items():
+            results[key] = self._merge(spec, [results[t.key] for t in spec.tasks()])
+        return {k: results[k] for k in unique}
+
+    def _merge(self, spec: RunSpec, parts: list[RunResult]) -> RunResult:
+        """Join a split run's task results into its own run directory."""
+        run_dir = self.out / "runs" / spec.group / spec.slug
+        failed = [p for p in parts if not p.ok]
+        cpu = sum(p.cpu_seconds or 0.0 for p in parts)
+        seconds = sum(p.seconds or 0.0 for p in parts)
+        if self.dry_run:
+            return RunResult(spec, None, None, "dry run")
+        if failed:
+            return RunResult(spec, None, None, f"{len(failed)} of {len(parts)} tasks failed: {failed[0].error}",
+                             seconds, cpu_seconds=cpu)
+        _move_aside(run_dir)
+        run_dir.parent.mkdir(parents=True, exist_ok=True)
+        cmd = [sys.executable, "-m", "bionav.experiments.grid_homing_merge", str(run_dir), *(str(p.dir) for p in parts)]
+        proc = subprocess.run(cmd, capture_output=True, text=True, env=self.env)
+        metrics = read_json(run_dir / "metrics.json")
+        if proc.returncode != 0 or not metrics or metrics.get("status") != "completed":
+            return RunResult(spec, None, None, f"merging its {len(parts)} tasks failed: "
+                             f"{(proc.stderr.strip().splitlines() or ['no message'])[-1]}", seconds, cpu_seconds=cpu)
+        self.echo(f"    merged {len(parts)} tasks into {run_dir}")
+        return RunResult(spec, run_dir, metrics, None, seconds, cpu_seconds=cpu)
+
+    def _run_unique(self, unique: Mapping[str, RunSpec]) -> dict[str, RunResult]:
         index = index_runs(self.out)
         results: dict[str, RunResult] = {}
         todo = []

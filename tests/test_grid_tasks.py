@@ -1,0 +1,71 @@
+"""Issue 29 item 1: a grid-homing run split into tasks by snapshots gives the unsplit run's results.
+
+The tasks (``experiment.block=[i,n]``) run through ``python -m bionav`` on the thesis runner's
+pool, ``python -m bionav.experiments.grid_homing_merge`` joins them; AAE*, MAE*, RR*, the
+compass AAE, the pair count and per_snapshot.csv must equal the unsplit run's exactly.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from helpers import run_bionav
+from test_db_roundtrip_homing import round_room
+
+from bionav.db.export import export_database
+from bionav.thesis.runs import Runner, RunSpec, index_runs, tool_env
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def folder_db(tmp_path_factory) -> list[str]:
+    """The round room (19 cells, one missing) exported as a Vardy folder: its db overrides."""
+    return export_database(round_room(), tmp_path_factory.mktemp("grid_tasks") / "db")
+
+
+def test_split_run_merges_to_the_unsplit_results(folder_db, tmp_path):
+    overrides = (*folder_db, "homing=minwarping")
+    whole = run_bionav(*overrides, f"hydra.run.dir={tmp_path / 'whole'}", "workers=1", cwd=tmp_path)
+    assert whole.returncode == 0, whole.stderr[-2000:]
+    expected = json.loads((tmp_path / "whole" / "metrics.json").read_text())
+
+    out = tmp_path / "report"
+    runner = Runner(out=out, jobs=2, echo=lambda s: None, env=tool_env())
+    spec = RunSpec(overrides, group="grid", blocks=3)
+    result = runner.run_all([spec])[spec.key]
+    assert result.ok, result.error
+    merged = json.loads((result.dir / "metrics.json").read_text())
+    for key in ("aae", "mae", "rr", "compass_aae", "n_pairs", "n_images", "homing", "db"):
+        assert merged[key] == expected[key], key  # bit for bit: the same numbers in the same order
+    assert merged["tasks"] == 3
+    assert (result.dir / "per_snapshot.csv").read_text() == (tmp_path / "whole" / "per_snapshot.csv").read_text()
+    assert (result.dir / "plots" / "per_snapshot.png").is_file()
+    assert index_runs(out)[spec.key] == result.dir  # the merged directory reads as the unsplit run
+
+    # a lost task reruns alone: delete one task's results, run again
+    tasks = sorted((out / "runs" / "grid-tasks").glob("*/metrics.json"))
+    assert len(tasks) == 3
+    tasks[1].unlink()
+    for d in out.rglob("metrics.json"):
+        if d.parent == result.dir:
+            d.unlink()  # the merged run too, so that the runner has to rebuild it
+    lines = []
+    again = Runner(out=out, jobs=2, echo=lines.append, env=tool_env()).run_all([spec])[spec.key]
+    assert again.ok and json.loads((again.dir / "metrics.json").read_text())["aae"] == expected["aae"]
+    assert any("2 found completed" in line and "1 to run" in line for line in lines), lines
+
+
+def test_merge_refuses_an_incomplete_split(folder_db, tmp_path):
+    overrides = (*folder_db, "homing=mfdid")
+    for i in (0, 2):
+        proc = run_bionav(*overrides, f"experiment.block=[{i},3]", f"hydra.run.dir={tmp_path / f'b{i}'}",
+                          cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+    merge = run_bionav(str(tmp_path / "m"), str(tmp_path / "b0"), str(tmp_path / "b2"), cwd=tmp_path,
+                       module="bionav.experiments.grid_homing_merge")
+    assert merge.returncode == 2 and "Traceback" not in merge.stderr
+    assert "missing or mixed blocks [(1, 3)]" in merge.stderr
+    bad = run_bionav(*overrides, "experiment.block=[3,3]", f"hydra.run.dir={tmp_path / 'bad'}", cwd=tmp_path)
+    assert bad.returncode != 0 and "Traceback" not in bad.stderr and "0 <= i < n" in bad.stderr
