@@ -143,13 +143,14 @@ def size_arg(size: Sequence[int] | None) -> list[str]:
 
 
 def grid_spec(db: str, *, homing: str = "sift", size=None, preprocess: Sequence[str] = (),
-              snapshots: int | None = None, extra: Sequence[str] = ()) -> RunSpec:
-    """A grid-homing run (``experiment=grid_homing``)."""
+              snapshots: int | None = None, extra: Sequence[str] = (), blocks: Mapping[str, int] | None = None
+              ) -> RunSpec:
+    """A grid-homing run (``experiment=grid_homing``), split into ``blocks[homing]`` tasks (default 1)."""
     ov = ["experiment=grid_homing", f"db={db}", f"homing={homing}", *size_arg(size), *preprocess]
     snaps = snapshot_list(db, snapshots)
     if snaps is not None:
         ov.append(f"experiment.snapshots=[{','.join(map(str, snaps))}]")
-    return RunSpec(tuple([*ov, *extra]), group="grid_homing")
+    return RunSpec(tuple([*ov, *extra]), group="grid_homing", blocks=int((blocks or {}).get(homing, 1)))
 
 
 def cutoff_preprocess(cutoff: float, *, equalize: bool = True) -> list[str]:
@@ -358,7 +359,8 @@ def _draw_args(preset: Preset) -> list[list[str]]:
 class _Table53:
     @staticmethod
     def runs(preset: Preset) -> list[RunSpec]:
-        return [grid_spec(f"sim_{db}", size=preset.sift_size, snapshots=preset.snapshots, extra=extra)
+        return [grid_spec(f"sim_{db}", size=preset.sift_size, snapshots=preset.snapshots, extra=extra,
+                          blocks=preset.grid_blocks)
                 for db in THESIS_DBS for extra in _draw_args(preset)]
 
     @staticmethod
@@ -383,7 +385,8 @@ class _Table53:
 class _Table54:
     @staticmethod
     def runs(preset: Preset) -> list[RunSpec]:
-        specs = [grid_spec(f"sim_{db}", homing=h, size=preset.warping_size, snapshots=preset.warping_snapshots)
+        specs = [grid_spec(f"sim_{db}", homing=h, size=preset.warping_size, snapshots=preset.warping_snapshots,
+                           blocks=preset.grid_blocks)
                  for h in preset.warping for db in THESIS_DBS]
         return specs + _Table53.runs(preset)
 
@@ -417,7 +420,8 @@ class _Table54:
 
 
 def _fig54_runs(preset: Preset) -> list[RunSpec]:
-    return [grid_spec("sim_original", size=s, preprocess=cutoff_preprocess(c), snapshots=preset.snapshots)
+    return [grid_spec("sim_original", size=s, preprocess=cutoff_preprocess(c), snapshots=preset.snapshots,
+                      blocks=preset.grid_blocks)
             for s in preset.fig54_sizes for c in preset.fig54_cutoffs]
 
 
@@ -507,7 +511,8 @@ class _Fig55:
     @staticmethod
     def runs(preset: Preset) -> list[RunSpec]:
         return [grid_spec("sim_original", size=s, preprocess=cutoff_preprocess(1.0, equalize=eq),
-                          snapshots=preset.snapshots) for eq in (False, True) for s in preset.fig55_sizes]
+                          snapshots=preset.snapshots, blocks=preset.grid_blocks)
+                for eq in (False, True) for s in preset.fig55_sizes]
 
     @staticmethod
     def evaluate(ctx: Context, specs: list[RunSpec]) -> Outcome:
@@ -719,7 +724,8 @@ def _b_runs(table: str):
 
         ref = load_reference()[table]
         extra = [] if ref["combine"] == "average" else ["homing.combine=max"]
-        return [grid_spec(f"sim_{db}", size=s, snapshots=preset.snapshots, extra=extra)
+        return [grid_spec(f"sim_{db}", size=s, snapshots=preset.snapshots, extra=extra,
+                          blocks=preset.grid_blocks)
                 for db in ref["dbs"] for s in preset.b_sizes]
 
     return runs
@@ -1392,7 +1398,8 @@ class _StandIns:
     def runs(preset: Preset) -> list[RunSpec]:
         sift = _Table53.runs(preset)
         # warping on hall1 paired with SIFT's table 5.3 runs: the same snapshots and pose-error draws
-        warp = [grid_spec("sim_hall1", homing=h, size=preset.warping_size, snapshots=preset.snapshots, extra=extra)
+        warp = [grid_spec("sim_hall1", homing=h, size=preset.warping_size, snapshots=preset.snapshots, extra=extra,
+                          blocks=preset.grid_blocks)
                 for h in preset.warping for extra in _draw_args(preset)]
         cross = [_cross_spec(preset, h) for h in preset.cross_db_homing]
         params = [_param_spec(preset, db) for db in PARAM_DBS]

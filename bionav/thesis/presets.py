@@ -56,6 +56,10 @@ class Preset:
     #: the capture session (pose errors, floor tilts, clouds) and the mean is compared with the thesis
     #: (empty: one run with the config's draw)
     pose_draws: tuple[int, ...] = ()
+    #: tasks per grid-homing run by homing method (``experiment.block``; missing: 1): a run of all
+    #: snapshots with the thesis' warping parameters needs about 16 CPU hours (docs/thesis.md), so it
+    #: goes as 64 tasks of about 15 minutes each that a launcher spreads over cores and nodes
+    grid_blocks: dict = field(default_factory=dict)
     reductions: tuple[str, ...] = ()
 
 
@@ -84,6 +88,7 @@ FULL = Preset(
     pol_samples=100,
     pol_vs_em_samples=100,
     cleaning_runs=10,
+    grid_blocks={"warping2d_thesis": 64, "minwarping_thesis": 64, "sift": 8},
     reductions=(),
 )
 
