@@ -16,6 +16,7 @@ import tempfile
 from pathlib import Path
 
 from bionav.errors import UserError
+from bionav.files import user_path
 
 EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
@@ -29,7 +30,10 @@ YAML_GROUPS = ("experiment", "db", "preprocess", "layout", "data", "mode")
 
 
 def _fail(message: str, code: int = EXIT_USER_ERROR) -> None:
-    print(f"bionav: error: {message}", file=sys.stderr)
+    try:
+        print(f"bionav: error: {message}", file=sys.stderr)
+    except OSError:  # the terminal is gone (SIGHUP): the exit status and metrics.json still say it
+        pass
     sys.exit(code)
 
 
@@ -37,8 +41,21 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, 
     """Catch unknown plugin names before Hydra starts; return the output dirs given (path, is_sweep)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
+    words = _override_words(argv)
+    parser = OverridesParser.create()
+    for word in words:
+        try:
+            parser.parse_overrides([word])
+        except Exception as exc:
+            detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            key = word.split("=", 1)[0]
+            raise UserError(
+                f"cannot read the override {word!r} ({detail}). Values with characters such as ~ * ? : [ ] "
+                f"or spaces must be quoted for Hydra, inside the shell's quotes, e.g. '{key}=\"...\"' "
+                f"(see https://hydra.cc/docs/advanced/override_grammar/basic)."
+            ) from None
     try:
-        overrides = OverridesParser.create().parse_overrides([a for a in argv if not a.startswith("-")])
+        overrides = parser.parse_overrides(words)
     except Exception:
         return []  # Hydra reports syntax errors itself
     dirs: list[tuple[Path, bool]] = []
@@ -61,8 +78,33 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, 
                         f"Run `python -m bionav.plugins` to see every installed plugin."
                     )
         if key in ("hydra.run.dir", "hydra.sweep.dir"):
-            dirs.append((Path(str(override.value())), key == "hydra.sweep.dir"))
+            value = override.value()
+            if not isinstance(value, str) or not value.strip():
+                raise UserError(
+                    f"{key}={value!r} names no directory (an empty one would be the current directory, whose "
+                    f"files a run would mix with its own); give a directory, e.g. {key}=outputs/my_run."
+                )
+            dirs.append((user_path(value), key == "hydra.sweep.dir"))
     return dirs
+
+
+#: options of Hydra's command line that take the next word as their value
+_FLAGS_WITH_VALUE = ("--cfg", "-c", "--package", "-p", "--config-path", "-cp", "--config-name", "-cn",
+                     "--config-dir", "-cd", "--experimental-rerun", "--shell-completion", "-sc")
+
+
+def _override_words(argv: list[str]) -> list[str]:
+    """The words of the command line that are overrides (not options, not an option's value)."""
+    out, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+            continue
+        if a.startswith("-"):
+            skip = a in _FLAGS_WITH_VALUE
+            continue
+        out.append(a)
+    return out
 
 
 def _concrete_overrides(argv: list[str]) -> list[str] | None:
@@ -200,6 +242,38 @@ def _check_writable(path: Path, *, sweep: bool = False) -> None:
             check_free(job)
 
 
+def _resuming(argv: list[str]) -> bool:
+    """True when the command line says ``bionav.resume=true``."""
+    words = [w.lstrip("+") for w in _override_words(argv)]
+    return any(w.split("=", 1)[0] == "bionav.resume" and w.split("=", 1)[1].strip().lower() in ("true", "1", "yes")
+               for w in words if "=" in w)
+
+
+def _check_not_finished(path: Path, *, sweep: bool, resume: bool) -> None:
+    """Refuse to write a run or sweep into a directory that holds a finished one (unless resuming)."""
+    from bionav.experiments.runner import read_metrics
+
+    if resume or "${" in str(path) or not path.is_dir():
+        return
+    if sweep:
+        finished = (path / "summary.csv").is_file() or any(
+            (read_metrics(job) or {}).get("status") == "completed" for job in path.glob("*") if job.is_dir())
+        if finished:
+            raise UserError(
+                f"the sweep directory {path} holds a sweep with finished jobs; a new sweep there would overwrite "
+                f"them. Choose another directory with hydra.sweep.dir=..., or finish that sweep with the same "
+                f"command plus bionav.resume=true (finished jobs are kept)."
+            )
+        return
+    metrics = read_metrics(path)
+    if isinstance(metrics, dict) and metrics.get("status") == "completed":
+        raise UserError(
+            f"the run directory {path} holds a finished run (metrics.json says completed); a new run there would "
+            f"overwrite it. Choose another directory with hydra.run.dir=..., or add bionav.resume=true to keep it "
+            f"and show its results."
+        )
+
+
 def _task(cfg) -> float | None:
     """One job; returns the run's objective (config ``objective``) for sweepers, worst on failure."""
     from hydra.core.hydra_config import HydraConfig
@@ -244,6 +318,7 @@ def _task(cfg) -> float | None:
         )
     else:
         _print_result(metrics)
+        print(f"run directory: {run_dir}")  # the last line: where everything the run wrote is
     return objective.value(metrics) if objective else None
 
 
@@ -304,6 +379,9 @@ def limit_blas_threads() -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
+    from bionav.errors import guard_closed_pipe
+
+    guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
     argv = list(sys.argv[1:] if argv is None else argv)
     limit_blas_threads()
     from bionav.completion import BASH_SCRIPT, rewrite_query_line, wants_bash_install
@@ -326,7 +404,9 @@ def main(argv: list[str] | None = None) -> None:
                                             "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
         # only after every value passed: a refused run leaves no directory behind
+        resume = _resuming(argv)
         for path, sweep in output_dirs:
+            _check_not_finished(path, sweep=sweep, resume=resume)
             _check_writable(path, sweep=sweep)
     except UserError as exc:
         _fail(str(exc))
@@ -341,9 +421,10 @@ def main(argv: list[str] | None = None) -> None:
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    try:
+    try:  # SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does
         signal.signal(signal.SIGTERM, _terminate)
-    except ValueError:  # not the main thread
+        signal.signal(signal.SIGHUP, _terminate)
+    except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
         pass
     try:
         hydra_main()
@@ -353,3 +434,5 @@ def main(argv: list[str] | None = None) -> None:
         _fail("interrupted before the run started; nothing was recorded.", 130)
     if multirun:
         _sweep_failures()
+        if _SWEEP.get("dir") is not None:
+            print(f"sweep directory: {_SWEEP['dir']}")
