@@ -242,6 +242,74 @@ def _check_writable(path: Path, *, sweep: bool = False) -> None:
             check_free(job)
 
 
+def _check_sweep_overrides(argv: list[str]) -> None:
+    """Search spaces and sweeper settings that a sweeper would reject with a traceback (or never finish)."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.core.override_parser.types import IntervalSweep, RangeSweep
+
+    try:
+        overrides = OverridesParser.create().parse_overrides(_override_words(argv))
+    except Exception:
+        return
+    for o in overrides:
+        key, value = o.key_or_group, o.value()
+        if isinstance(value, IntervalSweep) and not value.start < value.end:
+            raise UserError(
+                f"{o.input_line}: an interval's lower bound must be below its upper bound; write "
+                f"{key}=interval({value.end},{value.start})."
+            )
+        if isinstance(value, RangeSweep) and value.step and (value.stop - value.start) / value.step <= 0:
+            raise UserError(f"{o.input_line} holds no value (start {value.start}, stop {value.stop}, step "
+                            f"{value.step}); give start < stop for a positive step, e.g. {key}=range(1,10).")
+        if key == "hydra.sweeper.direction" and value not in ("minimize", "maximize"):
+            raise UserError(f"hydra.sweeper.direction={value} is not a direction: use minimize or maximize (the "
+                            f"run's objective.direction, e.g. minimize for aae, maximize for rr).")
+        if key == "hydra.sweeper.n_trials" and (not isinstance(value, int) or isinstance(value, bool) or value < 1):
+            raise UserError(f"hydra.sweeper.n_trials={value}: a study needs at least one trial; give "
+                            f"hydra.sweeper.n_trials=1 or more.")
+
+
+def _check_objective_metric(cfg, metrics: dict) -> None:
+    """A sweeper optimising a metric that the run does not write would rank every trial +-inf: refuse."""
+    from hydra.core.hydra_config import HydraConfig
+
+    node = cfg.get("objective")
+    target = str(_select(HydraConfig.get(), "sweeper._target_") or "")
+    if node is None or not target or target.endswith("BasicSweeper") or metrics.get("status") != "completed":
+        return
+    metric = str(node.get("metric"))
+    value: object = metrics
+    for part in metric.split("."):
+        value = value.get(part) if isinstance(value, dict) else None
+    if value is None and metrics.get(metric) is None:
+        keys = ", ".join(k for k, v in metrics.items() if isinstance(v, (int, float)) and not isinstance(v, bool))
+        raise UserError(f"objective.metric={metric} is not in this run's metrics.json, so the sweeper would rank "
+                        f"every trial as the worst; name one of its numbers ({keys}), e.g. objective.metric=aae.")
+
+
+def _select(node, key: str):
+    from omegaconf import OmegaConf
+
+    return OmegaConf.select(node, key, default=None)
+
+
+def _check_name_lengths(path: Path, key: str) -> None:
+    """Each folder name of an output directory fits the file system (255 bytes on most)."""
+    probe = path
+    while not os.path.isdir(probe) and probe != probe.parent:
+        probe = probe.parent
+    try:
+        limit = os.pathconf(probe, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    for part in path.parts:
+        if len(os.fsencode(part)) > limit:
+            raise UserError(
+                f"File name too long: the folder name {part[:40]}... in {key} has {len(os.fsencode(part))} bytes, "
+                f"more than the {limit} this file system allows; choose a shorter {key}=..."
+            )
+
+
 def _resuming(argv: list[str]) -> bool:
     """True when the command line says ``bionav.resume=true``."""
     words = [w.lstrip("+") for w in _override_words(argv)]
@@ -310,6 +378,10 @@ def _task(cfg) -> float | None:
             EXIT_INTERNAL_ERROR,
         )
     if multirun:
+        try:
+            _check_objective_metric(cfg, metrics)
+        except UserError as exc:
+            _fail(f"{exc} (job {hc.job.num}: {run_dir})")
         log.info(
             "job %s: %s",
             hc.job.num,
@@ -404,8 +476,11 @@ def main(argv: list[str] | None = None) -> None:
                                             "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
         # only after every value passed: a refused run leaves no directory behind
+        if any(a in ("-m", "--multirun") for a in argv):
+            _check_sweep_overrides(argv)
         resume = _resuming(argv)
         for path, sweep in output_dirs:
+            _check_name_lengths(path, "hydra.sweep.dir" if sweep else "hydra.run.dir")
             _check_not_finished(path, sweep=sweep, resume=resume)
             _check_writable(path, sweep=sweep)
     except UserError as exc:

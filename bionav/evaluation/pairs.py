@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FuturesTimeout
@@ -211,6 +212,8 @@ def home_vector_matrix(
     #: rows being computed: position in s_idx -> (angles, compass, computed mask, reported mask); the worker
     #: writes a pair's values before setting its computed flag, the caller's thread only reads flagged pairs
     live: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+    #: set when the caller stops early (Ctrl-C, SIGTERM, an error): rows in progress end after their current pair
+    stop = threading.Event()
 
     def row(k: int) -> tuple[np.ndarray, np.ndarray]:
         si = s_idx[k]
@@ -220,6 +223,8 @@ def home_vector_matrix(
         live[k] = (angles, compass, computed, np.zeros(len(currents), dtype=bool))
         s_pos = snapshots.positions[si]
         for ci in range(len(currents)):
+            if stop.is_set():
+                break
             if np.array_equal(currents.positions[ci], s_pos):
                 continue
             kwargs = {"neighbours": neighbours_of(ci)} if method.uses_test_steps else {}
@@ -257,16 +262,20 @@ def home_vector_matrix(
                         last = time.monotonic()
                 live.pop(k, None)
                 yield result
-        finally:
+        finally:  # normal end, or the caller stopped early: nothing more to compute
+            stop.set()
             for future in futures:
                 future.cancel()
 
     with ThreadPoolExecutor(max(1, workers)) as pool:
         rows = []
-        for si, r in zip(s_idx, progress(finished_rows(pool), desc="home vectors", total=len(s_idx))):
-            rows.append(r)
-            if on_row is not None:
-                on_row(int(si), r[0], r[1])
+        try:
+            for si, r in zip(s_idx, progress(finished_rows(pool), desc="home vectors", total=len(s_idx))):
+                rows.append(r)
+                if on_row is not None:
+                    on_row(int(si), r[0], r[1])
+        finally:  # also when on_row or the progress bar raised: the pool must not wait for whole rows
+            stop.set()
     t2 = time.perf_counter()
 
     angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))

@@ -185,7 +185,8 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
             except OSError:
                 pass
         _finish(run_dir, mcap, metrics, started, failing=True)
-        log.error("%s failed after %.1f s: %s", name, metrics["wall_time_s"], metrics["error"])
+        log.error("%s %s after %.1f s: %s", name, "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed",
+                  metrics["wall_time_s"], metrics["error"])
         if full is not None:
             raise full from None
         raise
