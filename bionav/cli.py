@@ -210,7 +210,7 @@ def _has_yaml(group: str, value: str) -> bool:
 
 def _check_writable(path: Path, *, sweep: bool = False) -> None:
     """The output directory can be created and written, and no live run holds it."""
-    from bionav.experiments.runlock import check_free
+    from bionav.runlock import check_free
 
     fix = "Choose another one with hydra.run.dir=... (or hydra.sweep.dir=... for -m)."
     probe = path

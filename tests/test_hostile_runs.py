@@ -157,7 +157,7 @@ def test_second_run_into_the_same_directory_is_refused(tmp_path, render_cache, t
 def test_lock_of_a_live_process_blocks_and_a_dead_one_does_not(tmp_path, tiny_folder):
     import socket
 
-    from bionav.experiments.runlock import LOCK_FILE, _process_start
+    from bionav.runlock import LOCK_FILE, _process_start
 
     run_dir = tmp_path / "run"
     run_dir.mkdir()

@@ -18,9 +18,9 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import __version__
 from bionav.errors import UserError
 from bionav.experiments.context import RunContext
-from bionav.experiments.runlock import RunLock
 from bionav.files import write_json_atomic
 from bionav.logs.writer import McapLog
+from bionav.runlock import RunLock
 
 log = logging.getLogger(__name__)
 
@@ -118,7 +118,7 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
     """Run ``cfg.experiment.name`` in ``run_dir`` and write metrics.json and run.mcap.
 
     The directory is locked for the run (a second run into it is refused;
-    see :mod:`bionav.experiments.runlock`). metrics.json first says
+    see :mod:`bionav.runlock`). metrics.json first says
     ``"status": "running"``, then, written atomically, ``"completed"`` on
     success, or ``"status": "failed"`` and ``"error"`` on any failure (the
     exception is re-raised); run.mcap is closed properly either way. With

@@ -99,7 +99,7 @@ def run(args) -> int:
                 pass
         except OSError as exc:
             raise UserError(f"cannot write the report directory {out}: {exc.strerror}. Choose another with --out.") from None
-        from bionav.experiments.runlock import RunLock
+        from bionav.runlock import RunLock
 
         # one writer per report directory (the runs below it hold their own locks); a stale lock is taken over
         with RunLock(out, what="report directory (--out)",
