@@ -144,3 +144,11 @@ def test_unreadable_file_mode_is_an_error(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "1_0.png").chmod(0)
     assert_fails_cleanly(run_folder(tmp_path, folder), "1_0.png", "cannot be read", "db.on_bad_image=skip")
+
+
+def test_db_help_into_a_closed_pipe_ends_quietly(tmp_path):
+    from helpers import run_into_closed_pipe
+
+    proc = run_into_closed_pipe("--help", module="bionav.db", cwd=tmp_path)
+    assert proc.returncode == 141, proc.stderr
+    assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr
