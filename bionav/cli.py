@@ -455,6 +455,8 @@ def main(argv: list[str] | None = None) -> None:
 
     guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
     argv = list(sys.argv[1:] if argv is None else argv)
+    # `python -m bionav homing=sift -m ...`: Hydra's parser takes overrides only after its flags
+    argv = [a for a in argv if a in ("-m", "--multirun")] + [a for a in argv if a not in ("-m", "--multirun")]
     limit_blas_threads()
     from bionav.completion import BASH_SCRIPT, rewrite_query_line, wants_bash_install
 

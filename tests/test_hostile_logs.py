@@ -103,9 +103,11 @@ def test_recover_into_dev_full(tmp_path, good_log, force):
 def test_recover_on_a_full_disk_keeps_the_input_and_removes_the_partial_output(tmp_path, good_log, monkeypatch):
     """ENOSPC while writing the output: one message naming it, the input intact, no half-written output."""
     import errno
+    import importlib
 
     from bionav.errors import UserError
-    from bionav.logs import recover as rec
+
+    rec = importlib.import_module("bionav.logs.recover")
 
     def full(*_a, **_k):
         raise OSError(errno.ENOSPC, "No space left on device")

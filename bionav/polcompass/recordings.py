@@ -249,7 +249,8 @@ def load_sessions(root, *, n_photodiodes: int = 4):
         if session.rotations:
             k = {r.counts.shape[1] for r in session.rotations}
             if len(k) > 1:
-                errors.append((folder, f"The session {folder} mixes files with different unit counts {sorted(k)}."))
+                errors.append((folder, f"The session {folder} mixes files with different unit counts {sorted(k)}; one session "
+                                       "holds one sensor layout: move the files of the other layout to their own folder."))
                 continue
             sessions.append(session)
     return sessions, errors
