@@ -152,3 +152,24 @@ def test_db_help_into_a_closed_pipe_ends_quietly(tmp_path):
     proc = run_into_closed_pipe("--help", module="bionav.db", cwd=tmp_path)
     assert proc.returncode == 141, proc.stderr
     assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr
+
+
+def test_db_export_into_a_folder_another_command_writes_is_refused(tmp_path):
+    import json
+    import socket
+
+    from helpers import write_tiny_folder
+
+    tiny = write_tiny_folder(tmp_path / "tiny")
+    out = tmp_path / "export"
+    out.mkdir()
+    me = os.getpid()  # a live process holding the folder: this test
+    ticks = open(f"/proc/{me}/stat").read().rsplit(")", 1)[-1].split()[19]
+    (out / ".bionav.lock").write_text(json.dumps({"pid": me, "host": socket.gethostname(), "start_ticks": ticks}))
+    proc = run_bionav("export", "folder", str(out), f"db.path={tiny}", cwd=tmp_path, module="bionav.db")
+    assert_fails_cleanly(proc, str(out), "in use by another bionav command", f"pid {me}", code=2, max_seconds=120)
+    assert not list(out.glob("*.png"))
+    (out / ".bionav.lock").unlink()
+    proc = run_bionav("export", "folder", str(out), f"db.path={tiny}", cwd=tmp_path, module="bionav.db")
+    assert proc.returncode == 0, proc.stderr
+    assert len(list(out.glob("*.png"))) == 9 and not (out / ".bionav.lock").exists()
