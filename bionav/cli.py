@@ -483,8 +483,8 @@ def main(argv: list[str] | None = None) -> None:
         resume = _resuming(argv)
         for path, sweep in output_dirs:
             _check_name_lengths(path, "hydra.sweep.dir" if sweep else "hydra.run.dir")
+            _check_writable(path, sweep=sweep)  # a live writer first: "in use" says more than "finished"
             _check_not_finished(path, sweep=sweep, resume=resume)
-            _check_writable(path, sweep=sweep)
     except UserError as exc:
         _fail(str(exc))
 

@@ -60,8 +60,17 @@ def _launcher_overrides(name: str | None, extra: list[str]) -> list[str]:
     return [f"hydra/launcher={name}", *extra]
 
 
+def _interrupt(signum, frame) -> None:  # noqa: ARG001
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
+    import signal
+
     args = build_parser().parse_args(argv)
+    for sig in ("SIGTERM", "SIGHUP"):  # `kill` and a closed terminal end the command as Ctrl-C does
+        if hasattr(signal, sig):
+            signal.signal(getattr(signal, sig), _interrupt)
     try:
         return run(args)
     except UserError as exc:
