@@ -3,4 +3,6 @@
 from bionav.cli import main
 
 if __name__ == "__main__":
-    main()
+    from bionav.errors import run_main
+
+    run_main(main, "bionav")

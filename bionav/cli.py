@@ -16,6 +16,7 @@ import tempfile
 from pathlib import Path
 
 from bionav.errors import UserError
+from bionav.files import user_path
 
 EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
@@ -29,7 +30,10 @@ YAML_GROUPS = ("experiment", "db", "preprocess", "layout", "data", "mode")
 
 
 def _fail(message: str, code: int = EXIT_USER_ERROR) -> None:
-    print(f"bionav: error: {message}", file=sys.stderr)
+    try:
+        print(f"bionav: error: {message}", file=sys.stderr)
+    except OSError:  # the terminal is gone (SIGHUP): the exit status and metrics.json still say it
+        pass
     sys.exit(code)
 
 
@@ -37,8 +41,21 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, 
     """Catch unknown plugin names before Hydra starts; return the output dirs given (path, is_sweep)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
+    words = _override_words(argv)
+    parser = OverridesParser.create()
+    for word in words:
+        try:
+            parser.parse_overrides([word])
+        except Exception as exc:
+            detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            key = word.split("=", 1)[0]
+            raise UserError(
+                f"cannot read the override {word!r} ({detail}). Values with characters such as ~ * ? : [ ] "
+                f"or spaces must be quoted for Hydra, inside the shell's quotes, e.g. '{key}=\"...\"' "
+                f"(see https://hydra.cc/docs/advanced/override_grammar/basic)."
+            ) from None
     try:
-        overrides = OverridesParser.create().parse_overrides([a for a in argv if not a.startswith("-")])
+        overrides = parser.parse_overrides(words)
     except Exception:
         return []  # Hydra reports syntax errors itself
     dirs: list[tuple[Path, bool]] = []
@@ -61,8 +78,33 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, 
                         f"Run `python -m bionav.plugins` to see every installed plugin."
                     )
         if key in ("hydra.run.dir", "hydra.sweep.dir"):
-            dirs.append((Path(str(override.value())), key == "hydra.sweep.dir"))
+            value = override.value()
+            if not isinstance(value, str) or not value.strip():
+                raise UserError(
+                    f"{key}={value!r} names no directory (an empty one would be the current directory, whose "
+                    f"files a run would mix with its own); give a directory, e.g. {key}=outputs/my_run."
+                )
+            dirs.append((user_path(value), key == "hydra.sweep.dir"))
     return dirs
+
+
+#: options of Hydra's command line that take the next word as their value
+_FLAGS_WITH_VALUE = ("--cfg", "-c", "--package", "-p", "--config-path", "-cp", "--config-name", "-cn",
+                     "--config-dir", "-cd", "--experimental-rerun", "--shell-completion", "-sc")
+
+
+def _override_words(argv: list[str]) -> list[str]:
+    """The words of the command line that are overrides (not options, not an option's value)."""
+    out, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+            continue
+        if a.startswith("-"):
+            skip = a in _FLAGS_WITH_VALUE
+            continue
+        out.append(a)
+    return out
 
 
 def _concrete_overrides(argv: list[str]) -> list[str] | None:
@@ -168,7 +210,7 @@ def _has_yaml(group: str, value: str) -> bool:
 
 def _check_writable(path: Path, *, sweep: bool = False) -> None:
     """The output directory can be created and written, and no live run holds it."""
-    from bionav.experiments.runlock import check_free
+    from bionav.runlock import check_free
 
     fix = "Choose another one with hydra.run.dir=... (or hydra.sweep.dir=... for -m)."
     probe = path
@@ -198,6 +240,106 @@ def _check_writable(path: Path, *, sweep: bool = False) -> None:
     if sweep:
         for job in sorted(p.parent for p in path.glob("*/.bionav.lock")):
             check_free(job)
+
+
+def _check_sweep_overrides(argv: list[str]) -> None:
+    """Search spaces and sweeper settings that a sweeper would reject with a traceback (or never finish)."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.core.override_parser.types import IntervalSweep, RangeSweep
+
+    try:
+        overrides = OverridesParser.create().parse_overrides(_override_words(argv))
+    except Exception:
+        return
+    for o in overrides:
+        key, value = o.key_or_group, o.value()
+        if isinstance(value, IntervalSweep) and not value.start < value.end:
+            raise UserError(
+                f"{o.input_line}: an interval's lower bound must be below its upper bound; write "
+                f"{key}=interval({value.end},{value.start})."
+            )
+        if isinstance(value, RangeSweep) and value.step and (value.stop - value.start) / value.step <= 0:
+            raise UserError(f"{o.input_line} holds no value (start {value.start}, stop {value.stop}, step "
+                            f"{value.step}); give start < stop for a positive step, e.g. {key}=range(1,10).")
+        if key == "hydra.sweeper.direction" and value not in ("minimize", "maximize"):
+            raise UserError(f"hydra.sweeper.direction={value} is not a direction: use minimize or maximize (the "
+                            f"run's objective.direction, e.g. minimize for aae, maximize for rr).")
+        if key == "hydra.sweeper.n_trials" and (not isinstance(value, int) or isinstance(value, bool) or value < 1):
+            raise UserError(f"hydra.sweeper.n_trials={value}: a study needs at least one trial; give "
+                            f"hydra.sweeper.n_trials=1 or more.")
+
+
+def _check_objective_metric(cfg, metrics: dict) -> None:
+    """A sweeper optimising a metric that the run does not write would rank every trial +-inf: refuse."""
+    from hydra.core.hydra_config import HydraConfig
+
+    node = cfg.get("objective")
+    target = str(_select(HydraConfig.get(), "sweeper._target_") or "")
+    if node is None or not target or target.endswith("BasicSweeper") or metrics.get("status") != "completed":
+        return
+    metric = str(node.get("metric"))
+    value: object = metrics
+    for part in metric.split("."):
+        value = value.get(part) if isinstance(value, dict) else None
+    if value is None and metrics.get(metric) is None:
+        keys = ", ".join(k for k, v in metrics.items() if isinstance(v, (int, float)) and not isinstance(v, bool))
+        raise UserError(f"objective.metric={metric} is not in this run's metrics.json, so the sweeper would rank "
+                        f"every trial as the worst; name one of its numbers ({keys}), e.g. objective.metric=aae.")
+
+
+def _select(node, key: str):
+    from omegaconf import OmegaConf
+
+    return OmegaConf.select(node, key, default=None)
+
+
+def _check_name_lengths(path: Path, key: str) -> None:
+    """Each folder name of an output directory fits the file system (255 bytes on most)."""
+    probe = path
+    while not os.path.isdir(probe) and probe != probe.parent:
+        probe = probe.parent
+    try:
+        limit = os.pathconf(probe, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    for part in path.parts:
+        if len(os.fsencode(part)) > limit:
+            raise UserError(
+                f"File name too long: the folder name {part[:40]}... in {key} has {len(os.fsencode(part))} bytes, "
+                f"more than the {limit} this file system allows; choose a shorter {key}=..."
+            )
+
+
+def _resuming(argv: list[str]) -> bool:
+    """True when the command line says ``bionav.resume=true``."""
+    words = [w.lstrip("+") for w in _override_words(argv)]
+    return any(w.split("=", 1)[0] == "bionav.resume" and w.split("=", 1)[1].strip().lower() in ("true", "1", "yes")
+               for w in words if "=" in w)
+
+
+def _check_not_finished(path: Path, *, sweep: bool, resume: bool) -> None:
+    """Refuse to write a run or sweep into a directory that holds a finished one (unless resuming)."""
+    from bionav.experiments.runner import read_metrics
+
+    if resume or "${" in str(path) or not path.is_dir():
+        return
+    if sweep:
+        finished = (path / "summary.csv").is_file() or any(
+            (read_metrics(job) or {}).get("status") == "completed" for job in path.glob("*") if job.is_dir())
+        if finished:
+            raise UserError(
+                f"the sweep directory {path} holds a sweep with finished jobs; a new sweep there would overwrite "
+                f"them. Choose another directory with hydra.sweep.dir=..., or finish that sweep with the same "
+                f"command plus bionav.resume=true (finished jobs are kept)."
+            )
+        return
+    metrics = read_metrics(path)
+    if isinstance(metrics, dict) and metrics.get("status") == "completed":
+        raise UserError(
+            f"the run directory {path} holds a finished run (metrics.json says completed); a new run there would "
+            f"overwrite it. Choose another directory with hydra.run.dir=..., or add bionav.resume=true to keep it "
+            f"and show its results."
+        )
 
 
 def _task(cfg) -> float | None:
@@ -236,6 +378,10 @@ def _task(cfg) -> float | None:
             EXIT_INTERNAL_ERROR,
         )
     if multirun:
+        try:
+            _check_objective_metric(cfg, metrics)
+        except UserError as exc:
+            _fail(f"{exc} (job {hc.job.num}: {run_dir})")
         log.info(
             "job %s: %s",
             hc.job.num,
@@ -244,6 +390,7 @@ def _task(cfg) -> float | None:
         )
     else:
         _print_result(metrics)
+        print(f"run directory: {run_dir}")  # the last line: where everything the run wrote is
     return objective.value(metrics) if objective else None
 
 
@@ -318,7 +465,12 @@ def limit_blas_threads() -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
+    from bionav.errors import guard_closed_pipe
+
+    guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
     argv = list(sys.argv[1:] if argv is None else argv)
+    # `python -m bionav homing=sift -m ...`: Hydra's parser takes overrides only after its flags
+    argv = [a for a in argv if a in ("-m", "--multirun")] + [a for a in argv if a not in ("-m", "--multirun")]
     limit_blas_threads()
     from bionav.completion import BASH_SCRIPT, rewrite_query_line, wants_bash_install
 
@@ -357,8 +509,13 @@ def main(argv: list[str] | None = None) -> None:
                                             "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
             _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
         # only after every value passed: a refused run leaves no directory behind
+        if any(a in ("-m", "--multirun") for a in argv):
+            _check_sweep_overrides(argv)
+        resume = _resuming(argv)
         for path, sweep in output_dirs:
-            _check_writable(path, sweep=sweep)
+            _check_name_lengths(path, "hydra.sweep.dir" if sweep else "hydra.run.dir")
+            _check_writable(path, sweep=sweep)  # a live writer first: "in use" says more than "finished"
+            _check_not_finished(path, sweep=sweep, resume=resume)
     except UserError as exc:
         _fail(str(exc))
 
@@ -372,9 +529,10 @@ def main(argv: list[str] | None = None) -> None:
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    try:
+    try:  # SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does
         signal.signal(signal.SIGTERM, _terminate)
-    except ValueError:  # not the main thread
+        signal.signal(signal.SIGHUP, _terminate)
+    except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
         pass
     try:
         if completion and any(a.startswith("query=") for a in argv):
@@ -387,3 +545,5 @@ def main(argv: list[str] | None = None) -> None:
         _fail("interrupted before the run started; nothing was recorded.", 130)
     if multirun:
         _sweep_failures()
+        if _SWEEP.get("dir") is not None:
+            print(f"sweep directory: {_SWEEP['dir']}")

@@ -174,6 +174,18 @@ def config_options(group: str) -> list[str]:
     return sorted(options)
 
 
+def hydra_group_options(group: str) -> list[str]:
+    """Options of a config group as Hydra sees them, Hydra's own plugins included (e.g. ``hydra/launcher``)."""
+    from hydra import initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
+    register_configs()
+    GlobalHydra.instance().clear()
+    own = dict(config_dirs())["bionav"]
+    with initialize_config_dir(config_dir=str(own), version_base="1.3"):
+        return sorted(GlobalHydra.instance().config_loader().get_group_options(group))
+
+
 def compose(overrides: Sequence[str] = (), *, config_name: str = "config",
             return_hydra_config: bool = False) -> DictConfig:
     """Compose bionav's configuration outside the command line (tests, tools).

@@ -1,5 +1,9 @@
 """Errors that the command line turns into one clear message (no traceback)."""
 
+from __future__ import annotations
+
+from typing import Callable, NoReturn
+
 
 class UserError(Exception):
     """A problem the user can fix: bad name, missing file, bad value, unreachable device.
@@ -15,3 +19,81 @@ class PluginError(UserError):
 
 class DeviceError(UserError):
     """A serial device is missing, busy, silent or speaks garbage."""
+
+
+#: exit status after output went into a closed pipe (128 + SIGPIPE, what a shell reports for `yes | head -1`)
+EXIT_CLOSED_PIPE = 141
+
+
+def closed_pipe_exit() -> NoReturn:
+    """End the process quietly because stdout's reader has gone (``... | head -1``).
+
+    Points stdout at ``/dev/null`` so the interpreter's final flush cannot
+    raise again, then exits with :data:`EXIT_CLOSED_PIPE` (``SystemExit``,
+    which Hydra's error reporting lets through).
+    """
+    import os
+    import sys
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.__stdout__.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+    sys.exit(EXIT_CLOSED_PIPE)
+
+
+class _ClosedPipeGuard:
+    """``sys.stdout`` whose writes end the process quietly when the reader has gone."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            closed_pipe_exit()
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            closed_pipe_exit()
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+def guard_closed_pipe() -> None:
+    """Make output into a closed pipe end the process quietly (the one home of this handling).
+
+    Called by :func:`run_main` and :func:`bionav.cli.main`: ``python -m bionav --help | head -1``,
+    ``python -m bionav.plugins | head -1`` and ``python -m bionav.logs info ... | head -1`` exit
+    with status :data:`EXIT_CLOSED_PIPE` and no ``BrokenPipeError`` traceback.
+    """
+    import sys
+
+    if not isinstance(sys.stdout, _ClosedPipeGuard) and sys.stdout is not None:
+        sys.stdout = _ClosedPipeGuard(sys.stdout)
+
+
+def run_main(main: Callable[[], "int | None"], prog: str) -> NoReturn:
+    """Run a command's ``main()`` and exit with its status: the one wrapper of every ``__main__``.
+
+    * output into a closed pipe ends quietly (:func:`guard_closed_pipe`);
+    * a :class:`UserError` that escapes ``main`` becomes ``<prog>: error: <message>``
+      on stderr and exit status 2.
+    """
+    import sys
+
+    guard_closed_pipe()
+    try:
+        code = main()
+        sys.stdout.flush()
+    except BrokenPipeError:
+        closed_pipe_exit()
+    except UserError as exc:
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        code = 2
+    sys.exit(code or 0)

@@ -11,6 +11,10 @@
   home of rendered stand-in databases and cached per-image work.
 * :func:`cache_key` is the SHA-256 of a JSON payload and of array bytes, so
   caches are content-addressed and safe to share between runs.
+* :func:`user_path`, :func:`not_a_regular_file` and :func:`read_json_file` are
+  the bounded reads of user-given data files: ``~`` expanded, never opening a
+  FIFO or a device (which would block or never end), a size limit checked
+  before reading, UTF-16 and oversized integers explained.
 """
 
 from __future__ import annotations
@@ -24,13 +28,152 @@ from typing import IO, Any, Callable
 
 import numpy as np
 
-__all__ = ["cache_key", "default_cache_dir", "write_atomic", "write_json_atomic"]
+__all__ = ["cache_key", "check_cache_dir", "default_cache_dir", "not_a_regular_file", "read_json_file", "user_path",
+           "write_atomic", "write_json_atomic"]
 
 
 def default_cache_dir() -> Path:
-    """``$BIONAV_CACHE`` if set, else ``~/.cache/bionav``."""
+    """``$BIONAV_CACHE`` (``~`` expanded) if set, else ``~/.cache/bionav``.
+
+    Raises
+    ------
+    UserError
+        When ``$BIONAV_CACHE`` cannot hold a cache (:func:`check_cache_dir`).
+    """
     env = os.environ.get("BIONAV_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "bionav"
+    if env is None:
+        return Path.home() / ".cache" / "bionav"
+    return check_cache_dir(env)
+
+
+def check_cache_dir(value: str | os.PathLike) -> Path:
+    """The cache folder ``value`` (``~`` expanded) once it is known to be usable; checked before any work.
+
+    Refused: an empty value (it would mean the current folder), a file (or a
+    file on the way), a place where no folder can be created or written
+    (``/proc``, ``/sys``, a read-only disk). The message names
+    ``BIONAV_CACHE`` when that environment variable is set, else ``cache_dir``.
+
+    Raises
+    ------
+    UserError
+        Naming the value, the problem and the fix.
+    """
+    from bionav.errors import UserError
+
+    name = "BIONAV_CACHE" if "BIONAV_CACHE" in os.environ else "cache_dir"
+    fix = ("Set BIONAV_CACHE to a writable folder (e.g. export BIONAV_CACHE=~/.cache/bionav), or unset it to use "
+           "~/.cache/bionav." if name == "BIONAV_CACHE" else "Give cache_dir=<a writable folder>.")
+    text = os.fspath(value)
+    if not text.strip():
+        raise UserError(f"{name} is set but empty, so bionav does not know where to keep its render and per-image "
+                        f"cache. {fix}")
+    path = user_path(text)
+    probe = path
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    problem = None
+    if probe.exists() and not probe.is_dir():
+        problem = "it is a file, not a folder" if probe == path else f"{probe} is a file, not a folder"
+    elif str(path.absolute()).startswith(("/proc/", "/sys/", "/dev/")) or path.absolute() in (
+            Path("/proc"), Path("/sys"), Path("/dev")):
+        problem = "it lies in a virtual file system (/proc, /sys or /dev) that cannot hold files"
+    elif not os.access(probe, os.W_OK | os.X_OK):
+        problem = f"{probe} is not writable"
+    if problem:
+        raise UserError(f"{name}={text} cannot hold the render and per-image cache: {problem}. {fix}")
+    return path
+
+
+def user_path(value: str | os.PathLike) -> Path:
+    """A path the user typed, with a leading ``~`` / ``~user`` expanded (Hydra and YAML do not)."""
+    return Path(os.path.expanduser(os.fspath(value)))
+
+
+def not_a_regular_file(path: str | Path) -> str | None:
+    """Why ``path`` cannot be read as a data file, or ``None`` if it is a regular file.
+
+    FIFOs, sockets and devices (``/dev/null``, ``/dev/zero``) are refused
+    before they are opened: reading one blocks or never ends. The answer is a
+    phrase such as ``"is a FIFO (named pipe)"``.
+    """
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "does not exist"
+    except OSError as exc:
+        return f"cannot be read ({exc.strerror or exc})"
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "is a folder, not a file"
+    if stat.S_ISFIFO(mode):
+        return "is a FIFO (named pipe), not a file"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "is a device, not a file"
+    if stat.S_ISSOCK(mode):
+        return "is a socket, not a file"
+    return "is not a regular file"
+
+
+#: integers with more digits than this are refused in JSON data files (beyond float64's range anyway)
+MAX_INT_DIGITS = 308
+
+
+def _bounded_int(text: str) -> int | float:
+    if len(text.lstrip("-")) > MAX_INT_DIGITS:
+        raise ValueError(f"an integer of {len(text.lstrip('-'))} digits (beyond the range of a 64-bit float)")
+    return int(text)
+
+
+def read_json_file(path: str | Path, *, what: str, fix: str, max_bytes: int = 256 * 2**20) -> Any:
+    """Parse a user's JSON data file, refusing anything that would block, exhaust memory or confuse.
+
+    Parameters
+    ----------
+    path : path-like
+        The file (``~`` expanded).
+    what : str
+        What the file is, for messages, e.g. ``"the recording"``.
+    fix : str
+        The sentence telling the user what to do about a bad file.
+    max_bytes : int
+        Larger files are refused before they are read (bytes).
+
+    Raises
+    ------
+    UserError
+        Naming the file and the problem: not a regular file (FIFO, device,
+        folder, missing), larger than ``max_bytes``, UTF-16/32 instead of
+        UTF-8, invalid JSON, integers of more than :data:`MAX_INT_DIGITS` digits.
+    """
+    from bionav.errors import UserError
+
+    path = user_path(path)
+    problem = not_a_regular_file(path)
+    if problem is None and path.stat().st_size > max_bytes:
+        problem = f"is {path.stat().st_size / 2**20:.0f} MiB, more than the {max_bytes / 2**20:.0f} MiB allowed"
+    if problem is None:
+        try:
+            data = path.read_bytes()
+        except OSError as exc:
+            problem = f"cannot be read ({exc.strerror or exc})"
+    if problem is not None:
+        raise UserError(f"{what} {path} {problem}. {fix}")
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff") or (len(data) > 1 and (data[0] == 0 or data[1] == 0)):
+        raise UserError(f"{what} {path} is UTF-16 (or UTF-32) text; JSON files must be UTF-8. Convert it, e.g. "
+                        f"`iconv -f UTF-16 -t UTF-8 {path} > fixed.json`, or re-export it as UTF-8. {fix}")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise UserError(f"{what} {path} is not UTF-8 text (byte {exc.start} cannot be decoded); JSON files must "
+                        f"be UTF-8. {fix}") from None
+    try:
+        return json.loads(text, parse_int=_bounded_int)
+    except ValueError as exc:
+        raise UserError(f"{what} {path} is not valid JSON ({exc}). {fix}") from None
 
 
 def cache_key(payload: Any, *arrays: np.ndarray) -> str:

@@ -3,7 +3,8 @@
 #
 #   scripts/slurm-localhost.sh start    install (Debian/Ubuntu, apt-get) if needed, then start munge,
 #                                       MariaDB + slurmdbd (accounting), slurmctld and slurmd
-#   scripts/slurm-localhost.sh stop     stop every daemon this script started
+#   scripts/slurm-localhost.sh stop     stop every daemon this script started (pid files in $SLURM_LOCAL_DIR,
+#                                       each checked by its command name; never the system's munge or MariaDB)
 #   scripts/slurm-localhost.sh status   print what runs; exit 0 when slurmctld answers, else 3
 #
 # Idempotent: `start` starts only what is not running, `stop` stops only what runs. Needs root (or
@@ -30,8 +31,18 @@ if [ "$(id -u)" -ne 0 ]; then
     die "needs root (apt-get and the SLURM daemons); run it as root or with sudo."
 fi
 
-alive() {  # alive PIDFILE: the process named in PIDFILE runs
-    [ -s "$1" ] && kill -0 "$(cat "$1")" 2>/dev/null
+alive() {  # alive PIDFILE: the process named in PIDFILE runs and is the daemon the file is named after
+    # (a stale pid file may name a pid reused by an unrelated process: its command name tells them apart)
+    [ -s "$1" ] || return 1
+    local pid name
+    pid=$(head -c 32 "$1" | tr -d '[:space:]')
+    [[ "$pid" =~ ^[1-9][0-9]*$ ]] || return 1
+    name=$(basename "$1" .pid)
+    [ "$(cat "/proc/$pid/comm" 2>/dev/null)" = "$name" ]
+}
+
+stop_daemon() {  # stop_daemon PIDFILE: SIGTERM to the daemon named in PIDFILE if it is that daemon
+    alive "$1" && kill "$(head -c 32 "$1" | tr -d '[:space:]')" 2>/dev/null || true
 }
 
 wait_for() {  # wait_for SECONDS DESCRIPTION COMMAND...
@@ -146,23 +157,28 @@ EOF
 }
 
 start_munge() {
-    alive /run/munge/munged.pid && return 0
+    # a munged already answering (the system's own) is used as it is, and never stopped by this script
+    munge -n 2>/dev/null | unmunge >/dev/null 2>&1 && return 0
+    alive "$DIR/munged.pid" && return 0
     [ -s /etc/munge/munge.key ] || {
         if command -v mungekey >/dev/null; then mungekey --create --keyfile=/etc/munge/munge.key; else
             dd if=/dev/urandom of=/etc/munge/munge.key bs=1024 count=1 status=none; fi
         chown munge:munge /etc/munge/munge.key && chmod 400 /etc/munge/munge.key
     }
-    install -d -o munge -g munge -m 0755 /run/munge
-    runuser -u munge -- /usr/sbin/munged
+    install -d -o munge -g munge -m 0755 /run/munge "$DIR/munge"
+    runuser -u munge -- /usr/sbin/munged --pid-file="$DIR/munge/munged.pid"
+    ln -sf "$DIR/munge/munged.pid" "$DIR/munged.pid"
     wait_for 10 munged bash -c 'munge -n | unmunge'
 }
 
 start_accounting() {
     [ "$ACCOUNTING" = 1 ] || return 0
-    if ! alive /run/mysqld/mysqld.pid; then
-        install -d -o mysql -g root -m 0755 /run/mysqld
-        setsid /usr/sbin/mariadbd --user=mysql --bind-address=127.0.0.1 --pid-file=/run/mysqld/mysqld.pid \
+    # a MariaDB already answering (the system's own) is used as it is, and never stopped by this script
+    if ! mariadb -e 'SELECT 1' >/dev/null 2>&1 && ! alive "$DIR/mariadbd.pid"; then
+        install -d -o mysql -g root -m 0755 /run/mysqld "$DIR/mysql"
+        setsid /usr/sbin/mariadbd --user=mysql --bind-address=127.0.0.1 --pid-file="$DIR/mysql/mariadbd.pid" \
             >>"$DIR/log/mariadb.log" 2>&1 </dev/null &
+        ln -sf "$DIR/mysql/mariadbd.pid" "$DIR/mariadbd.pid"
         wait_for 30 MariaDB mariadb -e 'SELECT 1'
     fi
     mariadb -e "CREATE DATABASE IF NOT EXISTS slurm_acct_db; CREATE OR REPLACE USER 'slurm'@'localhost' IDENTIFIED BY 'slurm'; GRANT ALL ON slurm_acct_db.* TO 'slurm'@'localhost'"
@@ -194,13 +210,13 @@ stop() {
     if alive "$DIR/slurmctld.pid" || alive "$DIR/slurmd.pid"; then
         scontrol shutdown >/dev/null 2>&1 || true
     fi
+    # only the daemons this script started (pid files in $DIR), each checked by its command name
     local pidfile
-    for pidfile in "$DIR/slurmctld.pid" "$DIR/slurmd.pid" "$DIR/slurmdbd.pid" /run/mysqld/mysqld.pid; do
-        if alive "$pidfile"; then kill "$(cat "$pidfile")" 2>/dev/null || true; fi
+    for pidfile in "$DIR/slurmctld.pid" "$DIR/slurmd.pid" "$DIR/slurmdbd.pid" "$DIR/mariadbd.pid" "$DIR/munged.pid"; do
+        stop_daemon "$pidfile"
     done
-    if alive /run/munge/munged.pid; then runuser -u munge -- /usr/sbin/munged --stop >/dev/null 2>&1 || true; fi
     local deadline=$((SECONDS + 30))
-    for pidfile in "$DIR/slurmctld.pid" "$DIR/slurmd.pid" "$DIR/slurmdbd.pid" /run/mysqld/mysqld.pid /run/munge/munged.pid; do
+    for pidfile in "$DIR/slurmctld.pid" "$DIR/slurmd.pid" "$DIR/slurmdbd.pid" "$DIR/mariadbd.pid" "$DIR/munged.pid"; do
         while alive "$pidfile" && [ "$SECONDS" -lt "$deadline" ]; do sleep 0.2; done
         alive "$pidfile" && say "warning: $(basename "$pidfile" .pid) still runs (pid $(cat "$pidfile"))"
     done
@@ -209,7 +225,7 @@ stop() {
 
 status() {
     local name pidfile
-    for name in munged:/run/munge/munged.pid mariadbd:/run/mysqld/mysqld.pid slurmdbd:$DIR/slurmdbd.pid \
+    for name in munged:$DIR/munged.pid mariadbd:$DIR/mariadbd.pid slurmdbd:$DIR/slurmdbd.pid \
         slurmctld:$DIR/slurmctld.pid slurmd:$DIR/slurmd.pid; do
         pidfile=${name#*:}
         if alive "$pidfile"; then echo "${name%%:*}: running (pid $(cat "$pidfile"))"; else echo "${name%%:*}: stopped"; fi

@@ -3,19 +3,74 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 
 def run_bionav(*args: str, cwd: Path, env: dict | None = None, module: str = "bionav", timeout: float = 600):
-    """Run ``python -m <module> args`` and return the CompletedProcess (text mode)."""
+    """Run ``python -m <module> args`` and return the CompletedProcess (text mode), with ``.seconds`` (wall time)."""
     full_env = dict(os.environ)
     full_env.setdefault("BIONAV_CACHE", str(Path(cwd) / "cache"))
     full_env.update(env or {})
-    return subprocess.run(
+    started = time.monotonic()
+    proc = subprocess.run(
         [sys.executable, "-m", module, *args], cwd=cwd, env=full_env, capture_output=True, text=True, timeout=timeout
     )
+    proc.seconds = time.monotonic() - started
+    return proc
+
+
+def assert_fails_cleanly(proc, *needles: str, code: int | None = None, max_seconds: float | None = None,
+                         absent: tuple[str, ...] = ()) -> str:
+    """The one "fails cleanly" check of the hostile suites (issue 28): returns the error paragraph.
+
+    A non-zero exit status (``code`` if given), no Python traceback on stdout or stderr, exactly one
+    paragraph (one line, ``<prog>: error: ...``) on stderr, not an internal error, that contains every
+    needle (the problem and the fix named) and none of ``absent`` (anywhere on stderr), and, with
+    ``max_seconds``, a bounded wall time (``proc.seconds`` from :func:`run_bionav`).
+    """
+    out, err = proc.stdout or "", proc.stderr or ""
+    assert proc.returncode != 0, f"exit status 0\n{out}\n{err}"
+    if code is not None:
+        assert proc.returncode == code, f"exit status {proc.returncode}, expected {code}\n{err}"
+    assert "Traceback" not in err and "Traceback" not in out, err or out
+    errors = [line for line in err.splitlines() if re.match(r"^[\w.]+: error: ", line)]
+    assert len(errors) == 1, f"expected one error paragraph on stderr:\n{err}"
+    message = errors[0]
+    assert "internal error" not in message, message
+    for needle in needles:
+        assert needle in message, f"{needle!r} not in the error paragraph:\n{message}"
+    for needle in absent:
+        assert needle not in err, err
+    if max_seconds is not None:
+        assert proc.seconds <= max_seconds, f"took {proc.seconds:.1f} s (bound {max_seconds} s)"
+    return message
+
+
+def install_plugin_dist(site: Path, dist: str, entry_points: dict, modules: dict) -> Path:
+    """A real ``.dist-info`` (with entry points) and modules in folder ``site``, found by importlib.metadata
+    once ``site`` is on PYTHONPATH: a third-party plugin installed without pip."""
+    import textwrap
+
+    info = site / f"{dist.replace('-', '_')}-1.0.dist-info"
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: 1.0\n")
+    lines = []
+    for group, eps in entry_points.items():
+        lines.append(f"[{group}]")
+        lines += [f"{name} = {target}" for name, target in eps.items()]
+    (info / "entry_points.txt").write_text("\n".join(lines) + "\n")
+    for name, source in modules.items():
+        (site / f"{name}.py").write_text(textwrap.dedent(source))
+    return site
+
+
+def pythonpath_with(site: Path) -> dict:
+    """Environment additions putting ``site`` first on PYTHONPATH."""
+    return {"PYTHONPATH": os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
 
 
 def write_tiny_folder(folder: Path, *, shape: tuple[int, int] = (16, 64), sigma: float = 2.0) -> Path:
@@ -33,3 +88,20 @@ def write_tiny_folder(folder: Path, *, shape: tuple[int, int] = (16, 64), sigma:
             img = cv2.GaussianBlur(rng.random(shape).astype(np.float32), (0, 0), sigma)
             cv2.imwrite(str(folder / f"{x}_{y}.png"), np.uint8(255 * img / img.max()))
     return folder
+
+
+def run_into_closed_pipe(*args: str, module: str, cwd: Path, timeout: float = 300):
+    """``python -m <module> args`` with stdout a pipe whose reader has gone (``... | head -1`` once head exited).
+
+    The read end is closed before the command starts, so its first write fails (EPIPE) whatever its timing.
+    Returns the CompletedProcess (``stdout`` empty, ``stderr`` text).
+    """
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        proc = subprocess.run([sys.executable, "-m", module, *args], cwd=cwd, stdout=write_end, stderr=subprocess.PIPE,
+                              text=True, timeout=timeout, env=dict(os.environ))
+    finally:
+        os.close(write_end)
+    proc.stdout = ""
+    return proc

@@ -11,7 +11,7 @@ import os
 
 import numpy as np
 import pytest
-from helpers import run_bionav
+from helpers import assert_fails_cleanly, run_bionav
 
 from bionav.db.imageio import write_image
 
@@ -35,17 +35,6 @@ def run_folder(tmp_path, folder, *extra):
                       cwd=tmp_path)
 
 
-def clean_error(proc, *needles):
-    assert proc.returncode != 0, proc.stdout + proc.stderr
-    assert "Traceback" not in proc.stderr, proc.stderr
-    errors = [line for line in proc.stderr.splitlines() if line.startswith("bionav: error:")]
-    assert len(errors) == 1, proc.stderr
-    assert "internal error" not in errors[0], errors[0]
-    for needle in needles:
-        assert needle in errors[0], errors[0]
-    return errors[0]
-
-
 def strict_metrics(run_dir):
     """metrics.json parsed strictly: NaN or Infinity are not JSON."""
     def no_constants(name):
@@ -58,14 +47,14 @@ def test_stray_far_file_is_named_instead_of_allocating_a_huge_grid(tmp_path):
     folder = make_folder(tmp_path / "db", grid(3, 3))
     write_image(folder / "99999_99999.png", np.zeros((SIZE[1], SIZE[0])))
     proc = run_folder(tmp_path, folder)
-    clean_error(proc, "99999_99999.png", "100000 x 100000", "db.grid_shape")
+    assert_fails_cleanly(proc, "99999_99999.png", "100000 x 100000", "db.grid_shape")
 
 
 def test_stray_file_outside_declared_grid_can_be_skipped(tmp_path):
     folder = make_folder(tmp_path / "db", grid(3, 3))
     write_image(folder / "99999_99999.png", np.zeros((SIZE[1], SIZE[0])))
     proc = run_folder(tmp_path, folder, "db.grid_shape=[3,3]")
-    clean_error(proc, "99999_99999.png", "outside the declared 3 x 3 grid", "db.on_bad_image=skip")
+    assert_fails_cleanly(proc, "99999_99999.png", "outside the declared 3 x 3 grid", "db.on_bad_image=skip")
     proc = run_folder(tmp_path, folder, "db.grid_shape=[3,3]", "db.on_bad_image=skip", "experiment.snapshots=[0]")
     assert proc.returncode == 0, proc.stderr
     assert "skipping" in proc.stdout + proc.stderr and "99999_99999.png" in proc.stdout + proc.stderr
@@ -74,7 +63,7 @@ def test_stray_file_outside_declared_grid_can_be_skipped(tmp_path):
 def test_one_image_database_is_a_user_error_not_nan(tmp_path):
     folder = make_folder(tmp_path / "db", [(0, 0)])
     proc = run_folder(tmp_path, folder)
-    clean_error(proc, "has 1 usable image(s)", "at least 2")
+    assert_fails_cleanly(proc, "has 1 usable image(s)", "at least 2")
     metrics = strict_metrics(tmp_path / "run")
     assert metrics["status"] == "failed" and "at least 2" in metrics["error"]
 
@@ -84,7 +73,7 @@ def test_directory_named_like_an_image_is_reported(tmp_path):
     (folder / "1_1.png").unlink()
     (folder / "1_1.png").mkdir()
     proc = run_folder(tmp_path, folder)
-    clean_error(proc, "1_1.png", "is a directory", "db.on_bad_image=skip")
+    assert_fails_cleanly(proc, "1_1.png", "is a directory", "db.on_bad_image=skip")
     proc = run_folder(tmp_path, folder, "db.on_bad_image=skip", "experiment.snapshots=[0]")
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout + proc.stderr
@@ -96,27 +85,27 @@ def test_symlink_loop_named_like_an_image_is_reported(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "1_0.png").unlink()
     os.symlink("1_0.png", folder / "1_0.png")  # points at itself
-    clean_error(run_folder(tmp_path, folder), "1_0.png", "symbolic-link loop")
+    assert_fails_cleanly(run_folder(tmp_path, folder), "1_0.png", "symbolic-link loop")
 
 
 def test_dangling_symlink_named_like_an_image_is_reported(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "0_1.png").unlink()
     os.symlink(tmp_path / "gone.png", folder / "0_1.png")
-    clean_error(run_folder(tmp_path, folder), "0_1.png", "does not exist")
+    assert_fails_cleanly(run_folder(tmp_path, folder), "0_1.png", "does not exist")
 
 
 def test_fifo_named_like_an_image_is_reported_not_read(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "0_0.png").unlink()
     os.mkfifo(folder / "0_0.png")  # reading it would block forever
-    clean_error(run_folder(tmp_path, folder), "0_0.png", "not a regular file")
+    assert_fails_cleanly(run_folder(tmp_path, folder), "0_0.png", "not a regular file")
 
 
 def test_unreadable_image_is_an_error_or_skipped_with_a_warning(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "1_1.png").write_bytes(b"\x89PNG\r\n\x1a\n garbage")
-    clean_error(run_folder(tmp_path, folder), "1_1.png", "not a readable image", "db.on_bad_image=skip")
+    assert_fails_cleanly(run_folder(tmp_path, folder), "1_1.png", "not a readable image", "db.on_bad_image=skip")
     proc = run_folder(tmp_path, folder, "db.on_bad_image=skip", "experiment.snapshots=[0]")
     assert proc.returncode == 0, proc.stderr
     assert "1_1.png" in proc.stdout + proc.stderr
@@ -137,7 +126,7 @@ def test_present_and_missing_cells_are_reported_at_load(tmp_path):
 def test_bad_db_values_on_a_folder(tmp_path, bad):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     key = bad.split("=")[0]
-    clean_error(run_folder(tmp_path, folder, bad), key, "allowed")
+    assert_fails_cleanly(run_folder(tmp_path, folder, bad), key, "allowed")
 
 
 def test_metrics_never_hold_nan():
@@ -154,4 +143,33 @@ def test_metrics_never_hold_nan():
 def test_unreadable_file_mode_is_an_error(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "1_0.png").chmod(0)
-    clean_error(run_folder(tmp_path, folder), "1_0.png", "cannot be read", "db.on_bad_image=skip")
+    assert_fails_cleanly(run_folder(tmp_path, folder), "1_0.png", "cannot be read", "db.on_bad_image=skip")
+
+
+def test_db_help_into_a_closed_pipe_ends_quietly(tmp_path):
+    from helpers import run_into_closed_pipe
+
+    proc = run_into_closed_pipe("--help", module="bionav.db", cwd=tmp_path)
+    assert proc.returncode == 141, proc.stderr
+    assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr
+
+
+def test_db_export_into_a_folder_another_command_writes_is_refused(tmp_path):
+    import json
+    import socket
+
+    from helpers import write_tiny_folder
+
+    tiny = write_tiny_folder(tmp_path / "tiny")
+    out = tmp_path / "export"
+    out.mkdir()
+    me = os.getpid()  # a live process holding the folder: this test
+    ticks = open(f"/proc/{me}/stat").read().rsplit(")", 1)[-1].split()[19]
+    (out / ".bionav.lock").write_text(json.dumps({"pid": me, "host": socket.gethostname(), "start_ticks": ticks}))
+    proc = run_bionav("export", "folder", str(out), f"db.path={tiny}", cwd=tmp_path, module="bionav.db")
+    assert_fails_cleanly(proc, str(out), "in use by another bionav command", f"pid {me}", code=2, max_seconds=120)
+    assert not list(out.glob("*.png"))
+    (out / ".bionav.lock").unlink()
+    proc = run_bionav("export", "folder", str(out), f"db.path={tiny}", cwd=tmp_path, module="bionav.db")
+    assert proc.returncode == 0, proc.stderr
+    assert len(list(out.glob("*.png"))) == 9 and not (out / ".bionav.lock").exists()

@@ -96,3 +96,11 @@ def test_unknown_homing_still_lists_all_names(tmp_path, site):
     proc = run_bionav("homing=nope", cwd=tmp_path, env=env_with(site))
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert "sift" in proc.stderr and "solo" in proc.stderr
+
+
+def test_plugin_list_into_a_closed_pipe_ends_quietly(tmp_path):
+    from helpers import run_into_closed_pipe
+
+    proc = run_into_closed_pipe(module="bionav.plugins", cwd=tmp_path)
+    assert proc.returncode == 141, proc.stderr
+    assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr

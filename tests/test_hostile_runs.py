@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import run_bionav, write_tiny_folder
+from helpers import assert_fails_cleanly, run_bionav, write_tiny_folder
 from mcap.reader import make_reader
 from mcap.records import Message
 from mcap.stream_reader import StreamReader
@@ -30,18 +30,6 @@ from bionav.logs.reader import read_attachment, read_messages
 SLOW_RUN = ("homing=sift", "workers=1", "bionav.cache_prepared=false", "homing.contrast_threshold=0",
             "homing.search_radius=0.5")
 ROW_TOPIC = "/grid_homing/snapshot_rows"
-
-
-def _clean_failure(proc, *needles, code=None):
-    """Non-zero exit, no traceback, one paragraph (one line) naming the problem, containing every needle."""
-    assert proc.returncode != 0, proc.stdout + proc.stderr
-    if code is not None:
-        assert proc.returncode == code, proc.stderr
-    assert "Traceback" not in proc.stderr, proc.stderr
-    errors = [line for line in proc.stderr.splitlines() if "error" in line.lower()]
-    assert errors, proc.stderr
-    for needle in needles:
-        assert needle in errors[-1], proc.stderr
 
 
 @pytest.fixture(scope="module")
@@ -153,7 +141,7 @@ def test_second_run_into_the_same_directory_is_refused(tmp_path, render_cache, t
         hydra_cfg = (run_dir / ".hydra" / "config.yaml").read_bytes()
         second = run_bionav("homing=mfdid", "db=folder", f"db.path={tiny_folder}", f"hydra.run.dir={run_dir}",
                             cwd=tmp_path)
-        _clean_failure(second, "in use by another bionav run", f"pid {first.pid}", "hydra.run.dir", code=2)
+        assert_fails_cleanly(second, "in use by another bionav command", f"pid {first.pid}", "hydra.run.dir", code=2)
         assert first.poll() is None  # the first run goes on
         assert _status(run_dir) == "running" and (run_dir / ".hydra" / "config.yaml").read_bytes() == hydra_cfg
     finally:
@@ -169,7 +157,7 @@ def test_second_run_into_the_same_directory_is_refused(tmp_path, render_cache, t
 def test_lock_of_a_live_process_blocks_and_a_dead_one_does_not(tmp_path, tiny_folder):
     import socket
 
-    from bionav.experiments.runlock import LOCK_FILE, _process_start
+    from bionav.runlock import LOCK_FILE, _process_start
 
     run_dir = tmp_path / "run"
     run_dir.mkdir()
@@ -179,14 +167,14 @@ def test_lock_of_a_live_process_blocks_and_a_dead_one_does_not(tmp_path, tiny_fo
                 "start_ticks": _process_start(sleeper.pid)}
         (run_dir / LOCK_FILE).write_text(json.dumps(lock))
         args = ("homing=mfdid", "db=folder", f"db.path={tiny_folder}", f"hydra.run.dir={run_dir}")
-        _clean_failure(run_bionav(*args, cwd=tmp_path), "in use by another bionav run", code=2)
+        assert_fails_cleanly(run_bionav(*args, cwd=tmp_path), "in use by another bionav command", code=2)
         # the same pid with another start time is a reused pid: stale
         (run_dir / LOCK_FILE).write_text(json.dumps({**lock, "start_ticks": "1"}))
         proc = run_bionav(*args, cwd=tmp_path)
         assert proc.returncode == 0, proc.stderr
         # another host's lock cannot be checked: refused, with the way out
         (run_dir / LOCK_FILE).write_text(json.dumps({**lock, "host": "elsewhere"}))
-        _clean_failure(run_bionav(*args, cwd=tmp_path), "elsewhere", "delete", code=2)
+        assert_fails_cleanly(run_bionav(*args, cwd=tmp_path), "elsewhere", "delete", code=2)
     finally:
         sleeper.kill()
         sleeper.wait()
@@ -207,7 +195,7 @@ def test_ctrl_c_during_a_sweep_writes_the_summary(tmp_path, render_cache):
     done = subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
     summary = (sweep / "summary.md").read_text() if (sweep / "summary.md").exists() else "(no summary.md)"
     assert proc.returncode == 130, (summary, err[-3000:])
-    _clean_failure(done, "interrupted", "summary", "bionav.resume=true", code=130)
+    assert_fails_cleanly(done, "interrupted", "summary", "bionav.resume=true", code=130)
     import csv
 
     with open(sweep / "summary.csv") as f:
@@ -222,7 +210,7 @@ def test_failed_jobs_fail_the_sweep_and_errors_stay_in_their_cell(tmp_path, tiny
     bad = tmp_path / "mis|sing"
     proc = run_bionav("-m", "homing=mfdid", "db=folder", f"db.path={tiny_folder},'{bad}'",
                       f"hydra.sweep.dir={sweep}", cwd=tmp_path)
-    _clean_failure(proc, "1 of 2 jobs failed", "bionav.fail_on_job_error=false", code=1)
+    assert_fails_cleanly(proc, "1 of 2 jobs failed", "bionav.fail_on_job_error=false", code=1)
     assert "1 of 2 jobs failed" in proc.stderr.strip().splitlines()[-1]  # the last line states the count
     md = (sweep / "summary.md").read_text()
     table = [line for line in md.splitlines() if line.startswith("| ")]
@@ -244,16 +232,16 @@ def test_markdown_cells_escape_pipes_and_newlines():
 
 @pytest.mark.parametrize("target", ["/proc/foo", "/proc/self/foo/bar"])
 def test_output_dir_in_proc_is_clean(tmp_path, target):
-    _clean_failure(run_bionav(f"hydra.run.dir={target}", cwd=tmp_path), "cannot write the output directory",
+    assert_fails_cleanly(run_bionav(f"hydra.run.dir={target}", cwd=tmp_path), "cannot write the output directory",
                    "hydra.run.dir", code=2)
 
 
 def test_sweep_with_cfg_is_clean(tmp_path):
-    _clean_failure(run_bionav("-m", "homing=sift,mfdid", "--cfg", "job", cwd=tmp_path), "drop -m", code=2)
+    assert_fails_cleanly(run_bionav("-m", "homing=sift,mfdid", "--cfg", "job", cwd=tmp_path), "drop -m", code=2)
 
 
 def _disk_full_checks(proc, run_dir: Path):
-    _clean_failure(proc, "no space left on", "hydra.run.dir", code=2)
+    assert_fails_cleanly(proc, "no space left on", "hydra.run.dir", code=2)
     assert "bug" not in proc.stderr
     assert not (run_dir / "error.log").exists() or (run_dir / "error.log").read_text().strip()
 
@@ -351,7 +339,7 @@ def test_corrupt_png_gives_one_clean_line_without_libpng_noise(tmp_path, tiny_fo
     (tiny_folder / "1_1.png").write_bytes(bytes(data))
     proc = run_bionav("homing=mfdid", "db=folder", f"db.path={tiny_folder}", f"hydra.run.dir={tmp_path / 'r'}",
                       cwd=tmp_path)
-    _clean_failure(proc, "1_1.png", "corrupt", code=2)
+    assert_fails_cleanly(proc, "1_1.png", "corrupt", code=2)
     assert "libpng" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
 
@@ -368,7 +356,7 @@ def test_interrupt_or_terminate_a_run_keeps_its_results(tmp_path, render_cache, 
     finally:
         proc.send_signal(sig)
         out, err = proc.communicate(timeout=60)
-    _clean_failure(subprocess.CompletedProcess(proc.args, proc.returncode, out, err), "interrupted", code=130)
+    assert_fails_cleanly(subprocess.CompletedProcess(proc.args, proc.returncode, out, err), "interrupted", code=130)
     metrics = json.loads((run_dir / "metrics.json").read_text())
     assert metrics["status"] == "failed" and "KeyboardInterrupt" in metrics["error"]
     with open(run_dir / "run.mcap", "rb") as f:

@@ -10,24 +10,9 @@ import dataclasses
 import typing
 
 import pytest
-from helpers import run_bionav
+from helpers import assert_fails_cleanly, run_bionav
 
 from bionav.validation import Range, bounded, check_config, range_of
-
-
-def clean_error(proc, *needles, absent=()):
-    """Non-zero exit, no traceback, exactly one ``bionav: error:`` paragraph containing ``needles``."""
-    assert proc.returncode != 0, proc.stdout + proc.stderr
-    assert "Traceback" not in proc.stderr, proc.stderr
-    errors = [line for line in proc.stderr.splitlines() if line.startswith("bionav: error:")]
-    assert len(errors) == 1, proc.stderr
-    message = errors[0]
-    for needle in needles:
-        assert needle in message, message
-    for needle in absent:
-        assert needle not in proc.stderr, proc.stderr
-    return message
-
 
 # (overrides, strings the message must contain)
 BAD_VALUES = [
@@ -68,7 +53,7 @@ BAD_VALUES = [
 @pytest.mark.parametrize("overrides,needles", BAD_VALUES, ids=[" ".join(o) for o, _ in BAD_VALUES])
 def test_bad_value_is_named_with_its_range(tmp_path, overrides, needles):
     proc = run_bionav(*overrides, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
-    clean_error(proc, "bad value", "allowed", *needles)
+    assert_fails_cleanly(proc, "bad value", "allowed", *needles)
     assert proc.returncode == 2
     run = tmp_path / "run"
     assert not run.exists() or not any(run.iterdir())  # refused before anything was run or written
@@ -91,23 +76,23 @@ MISSPELT = [
 @pytest.mark.parametrize("overrides,key,hint,listed", MISSPELT, ids=[" ".join(o) for o, *_ in MISSPELT])
 def test_misspelt_key_names_the_node_keys_and_the_closest(tmp_path, overrides, key, hint, listed):
     proc = run_bionav(*overrides, cwd=tmp_path)
-    clean_error(proc, f"unknown key {key}", hint, listed, absent=("+homing.", "To append to your config use"))
+    assert_fails_cleanly(proc, f"unknown key {key}", hint, listed, absent=("+homing.", "To append to your config use"))
 
 
 def test_snapshot_index_beyond_the_database_is_named(tmp_path):
     proc = run_bionav("homing=mfdid", "experiment.snapshots=[0,500]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
-    clean_error(proc, "experiment.snapshots=[0, 500]", "0..169")
+    assert_fails_cleanly(proc, "experiment.snapshots=[0, 500]", "0..169")
 
 
 def test_wrong_type_names_key_and_value(tmp_path):
     proc = run_bionav("homing.n_features=abc", cwd=tmp_path)
-    clean_error(proc, "homing.n_features=abc", "Integer")
+    assert_fails_cleanly(proc, "homing.n_features=abc", "Integer")
 
 
 def test_memory_bound_refuses_image_stack_before_allocating(tmp_path):
     # inside the per-side range, but 170 images of 16000 x 16000 pixels do not fit in memory
     proc = run_bionav("db.image_size=[16000,16000]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
-    clean_error(proc, "db.image_size=[16000,16000]", "memory", "choose a smaller db.image_size")
+    assert_fails_cleanly(proc, "db.image_size=[16000,16000]", "memory", "choose a smaller db.image_size")
 
 
 def test_data_node_is_typed():

@@ -47,9 +47,10 @@ def test_resumed_sweep_does_not_recompute_finished_jobs(tmp_path, tiny_folder):
     assert proc.returncode == 0, proc.stderr
     assert {p: p.stat().st_mtime_ns for p in sweep.glob("*/metrics.json")} == before
     assert {p: p.read_bytes() for p in sweep.glob("*/run.mcap")} == logs
-    # without resume the jobs run again
-    assert run_bionav(*args, cwd=tmp_path).returncode == 0
-    assert {p: p.stat().st_mtime_ns for p in sweep.glob("*/metrics.json")} != before
+    # without resume a finished sweep is not overwritten (issue 32): refused, naming the directory and the fix
+    proc = run_bionav(*args, cwd=tmp_path)
+    assert proc.returncode == 2 and str(sweep) in proc.stderr and "bionav.resume=true" in proc.stderr, proc.stderr
+    assert {p: p.stat().st_mtime_ns for p in sweep.glob("*/metrics.json")} == before
 
 
 def test_report_rebuilds_table_and_compares_methods(tmp_path, tiny_folder):

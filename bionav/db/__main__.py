@@ -1,7 +1,6 @@
 """``python -m bionav.db``: see :mod:`bionav.db.cli`."""
 
-import sys
-
 from bionav.db.cli import main
+from bionav.errors import run_main
 
-sys.exit(main())
+run_main(main, "bionav.db")

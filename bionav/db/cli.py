@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 from bionav.errors import UserError
+from bionav.files import user_path
 
 
 def _parser(names: list[str]) -> argparse.ArgumentParser:
@@ -74,9 +75,10 @@ def run(argv: list[str]) -> int:
     if args.command == "show":
         from bionav.db.sheets import write_show
 
-        out = args.out if args.out is not None else Path("outputs") / "db" / args.db
+        out = user_path(args.out) if args.out is not None else Path("outputs") / "db" / args.db
         try:
-            paths = write_show(db, out)
+            with _one_writer(out):
+                paths = write_show(db, out)
         except OSError as exc:
             raise UserError(f"cannot write to {out}: {exc}; choose a writable folder with --out DIR.") from None
         nx, ny = db.grid_shape
@@ -87,10 +89,23 @@ def run(argv: list[str]) -> int:
     else:
         from bionav.db.export import export_database
 
-        overrides = export_database(db, args.dir, bits=args.bits, overwrite=args.force)
+        with _one_writer(user_path(args.dir)):
+            overrides = export_database(db, user_path(args.dir), bits=args.bits, overwrite=args.force)
         print(f"wrote {len(db)} images of {db.name} to {args.dir}")
         print("read back with: python -m bionav " + " ".join(overrides))
     return 0
+
+
+def _one_writer(folder: Path):
+    """Hold ``folder``'s lock while writing (a second ``python -m bionav.db`` into it is refused)."""
+    from bionav.runlock import RunLock
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot create the output folder {folder}: {exc.strerror or exc}; choose a writable "
+                        "folder.") from None
+    return RunLock(folder, what="output folder", fix="Wait for that command to finish, or choose another folder.")
 
 
 def _camera(args, composed) -> int:
@@ -124,8 +139,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return run(sys.argv[1:] if argv is None else list(argv))
     except UserError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"bionav.db: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        print("bionav.db: error: interrupted; the files written so far are kept.", file=sys.stderr)
         return 130

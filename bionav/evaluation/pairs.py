@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import TimeoutError as FuturesTimeout
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Sequence
 
@@ -108,6 +110,8 @@ def home_vector_matrix(
     prepared: tuple[list[Any], list[Any]] | None = None,
     cache: Any = None,
     on_row: Callable[[int, np.ndarray, np.ndarray], None] | None = None,
+    on_partial: Callable[[int, np.ndarray, np.ndarray, np.ndarray], None] | None = None,
+    partial_period_s: float = 2.0,
     batch: bool = True,
 ) -> HomeVectorMatrix:
     """Home vectors from every current view to every (selected) snapshot.
@@ -137,6 +141,17 @@ def home_vector_matrix(
         ``snapshot`` is its index into ``snapshots``, ``angles`` and
         ``compass`` have shape (C,), radians in the grid frame (NaN: none).
         Experiments log rows here, so a crash loses no finished row.
+    on_partial : callable, optional
+        ``on_partial(snapshot, currents, angles, compass)`` is called (in the
+        caller's thread) about every ``partial_period_s`` seconds with the
+        pairs computed since its last call, inside rows not yet finished:
+        ``currents`` are indices into the current views (shape (K,)),
+        ``angles`` and ``compass`` shape (K,), radians in the grid frame. With
+        it, a crash loses at most about ``partial_period_s`` of computed home
+        vectors however long a row takes (per-pair path; a method's batch path
+        reports whole rows only).
+    partial_period_s : float
+        Period of ``on_partial``, seconds (> 0).
     batch : bool
         Use the method's batch path (:meth:`HomingMethod.all_pairs_angles`)
         when it has one and snapshots and current views are one database;
@@ -194,11 +209,22 @@ def home_vector_matrix(
                 out[key] = cur_prep[lut[x + dx, y + dy]]
         return out
 
-    def row(si: int) -> tuple[np.ndarray, np.ndarray]:
+    #: rows being computed: position in s_idx -> (angles, compass, computed mask, reported mask); the worker
+    #: writes a pair's values before setting its computed flag, the caller's thread only reads flagged pairs
+    live: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+    #: set when the caller stops early (Ctrl-C, SIGTERM, an error): rows in progress end after their current pair
+    stop = threading.Event()
+
+    def row(k: int) -> tuple[np.ndarray, np.ndarray]:
+        si = s_idx[k]
         angles = np.full(len(currents), np.nan)
         compass = np.full(len(currents), np.nan)
+        computed = np.zeros(len(currents), dtype=bool)
+        live[k] = (angles, compass, computed, np.zeros(len(currents), dtype=bool))
         s_pos = snapshots.positions[si]
         for ci in range(len(currents)):
+            if stop.is_set():
+                break
             if np.array_equal(currents.positions[ci], s_pos):
                 continue
             kwargs = {"neighbours": neighbours_of(ci)} if method.uses_test_steps else {}
@@ -206,14 +232,50 @@ def home_vector_matrix(
             angles[ci] = hv.angle + currents.headings[ci]
             if hv.compass is not None:
                 compass[ci] = hv.compass - (currents.headings[ci] - snapshots.headings[si])
+            computed[ci] = True
         return wrap_angle(angles), wrap_angle(compass)
+
+    def report_partial(first_open: int) -> None:
+        """Hand the pairs computed since the last report, of rows not reported whole, to ``on_partial``."""
+        for k in sorted(live.copy()):  # a worker may add a row meanwhile
+            if k < first_open:
+                continue
+            angles, compass, computed, reported = live[k]
+            new = np.flatnonzero(computed & ~reported)
+            if new.size:
+                on_partial(int(s_idx[k]), new, wrap_angle(angles[new]), wrap_angle(compass[new]))
+                reported[new] = True
+
+    def finished_rows(pool: ThreadPoolExecutor):
+        """Rows in order; while waiting for one, report partial rows every ``partial_period_s``."""
+        futures = [pool.submit(row, k) for k in range(len(s_idx))]
+        last = time.monotonic()
+        try:
+            for k, future in enumerate(futures):
+                while True:
+                    wait = max(0.0, last + partial_period_s - time.monotonic())
+                    try:
+                        result = future.result(timeout=wait if on_partial is not None else None)
+                        break
+                    except FuturesTimeout:
+                        report_partial(k)
+                        last = time.monotonic()
+                live.pop(k, None)
+                yield result
+        finally:  # normal end, or the caller stopped early: nothing more to compute
+            stop.set()
+            for future in futures:
+                future.cancel()
 
     with ThreadPoolExecutor(max(1, workers)) as pool:
         rows = []
-        for si, r in zip(s_idx, progress(pool.map(row, s_idx), desc="home vectors", total=len(s_idx))):
-            rows.append(r)
-            if on_row is not None:
-                on_row(int(si), r[0], r[1])
+        try:
+            for si, r in zip(s_idx, progress(finished_rows(pool), desc="home vectors", total=len(s_idx))):
+                rows.append(r)
+                if on_row is not None:
+                    on_row(int(si), r[0], r[1])
+        finally:  # also when on_row or the progress bar raised: the pool must not wait for whole rows
+            stop.set()
     t2 = time.perf_counter()
 
     angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))

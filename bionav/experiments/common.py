@@ -10,6 +10,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
+from bionav.files import user_path
 
 
 def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageDatabase:
@@ -23,7 +24,7 @@ def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageD
     db = load_database(
         node,
         data_dir=Path(str(cfg.data_dir)),
-        cache_dir=Path(str(cfg.cache_dir)),
+        cache_dir=user_path(str(cfg.cache_dir)),
         preprocess=preprocess,
     )
     if len(db) < 2:
@@ -98,7 +99,7 @@ def prepared_cache(cfg: DictConfig):
     name = str(cfg.homing.name)
     if cfg.get("signature") and cfg.signature.get("name"):
         name = f"{name}-{cfg.signature.name}"
-    return PreparedCache(Path(str(cfg.cache_dir)), name)
+    return PreparedCache(user_path(str(cfg.cache_dir)), name)
 
 
 def _get(node, key, default=None):

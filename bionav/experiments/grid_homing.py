@@ -45,6 +45,20 @@ HOME_VECTOR_ROW_SCHEMA = {
 }
 
 
+HOME_VECTOR_PARTIAL_SCHEMA = {
+    "type": "object",
+    "description": ("home vectors of a snapshot's row still being computed, logged about every 2 s (the whole row "
+                    "follows on /grid_homing/snapshot_rows when finished)"),
+    "properties": {
+        "snapshot": {"type": "array", "items": {"type": "integer"}, "description": "snapshot cell (x, y)"},
+        "currents": {"type": "array", "description": "current-view cells (x, y) of these pairs"},
+        "angles": {"type": "array", "description": "home directions, radians CCW in the grid frame (null: none)"},
+        "ae": {"type": "array", "description": "angular errors, radians (null: none)"},
+        "compass_error": {"type": "array", "description": "estimated minus true rotation, radians (null: none)"},
+    },
+}
+
+
 def _finite_or_none(values) -> list[float | None]:
     return [float(a) if np.isfinite(a) else None for a in np.asarray(values, dtype=float)]
 
@@ -101,9 +115,21 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             schema=HOME_VECTOR_ROW_SCHEMA,
         )
 
+    def log_partial(si: int, currents: np.ndarray, angles: np.ndarray, compass: np.ndarray) -> None:
+        """Pairs of a row still being computed, every ~2 s (a crash loses at most that much of a long row)."""
+        ae = angular_errors(angles[None], ideal_home_angles(db.positions[[si]], db.positions[currents]))[0]
+        ctx.log.write(
+            "/grid_homing/partial_rows",
+            {"snapshot": db.positions[si], "currents": db.positions[currents], "angles": _finite_or_none(angles),
+             "ae": _finite_or_none(ae), "compass_error": _finite_or_none(compass)},
+            schema_name="bionav.HomeVectorPartialRow",
+            schema=HOME_VECTOR_PARTIAL_SCHEMA,
+        )
+        ctx.log.flush()  # to the file now: the ~2 s of this period are all a crash can lose
+
     hv = home_vector_matrix(
         method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
-        cache=prepared_cache(cfg), on_row=log_row,
+        cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial,
     )
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))

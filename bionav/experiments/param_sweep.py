@@ -43,6 +43,7 @@ from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.evaluation.pairs import home_vector_matrix
 from bionav.experiments.configs import experiment_config
+from bionav.files import user_path
 from bionav.report.figures import pyplot, save_figure
 
 ROWS_FILE = "param_sweep.jsonl"
@@ -399,7 +400,7 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
     sizes.sort(key=lambda wh: -wh[0] * wh[1])  # largest first: the pool ends with short tasks
     preprocessings = [_preprocess_node(str(v)) for v in _grid_values(grid.preprocess, what="preprocess")]
     base = _GridTask(db_node=OmegaConf.to_container(cfg.db, resolve=True), data_dir=str(cfg.data_dir),
-                     cache_dir=str(cfg.cache_dir), size=sizes[0], preprocess=None, signatures=signatures,
+                     cache_dir=str(user_path(str(cfg.cache_dir))), size=sizes[0], preprocess=None, signatures=signatures,
                      homing_cfg=homing_cfg, rings=tuple(int(r) for r in exp.rings),
                      n_coeffs=tuple(int(k) for k in exp.n_coeffs), step_length=float(exp.step_length),
                      success_radius=float(exp.success_radius))

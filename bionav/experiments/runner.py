@@ -18,9 +18,9 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import __version__
 from bionav.errors import UserError
 from bionav.experiments.context import RunContext
-from bionav.experiments.runlock import RunLock
 from bionav.files import write_json_atomic
 from bionav.logs.writer import McapLog
+from bionav.runlock import RunLock
 
 log = logging.getLogger(__name__)
 
@@ -100,6 +100,10 @@ def validate_run_config(cfg: DictConfig) -> None:
 
     check_run_settings(cfg)
     check_group_nodes(cfg)
+    if cfg.get("cache_dir") is not None:  # before any rendering: a cache that cannot be written wastes it all
+        from bionav.files import check_cache_dir
+
+        check_cache_dir(str(cfg.cache_dir))
     for group, kind in PLUGIN_NODES.items():
         node = cfg.get(group)
         if node and node.get("name"):
@@ -114,7 +118,7 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
     """Run ``cfg.experiment.name`` in ``run_dir`` and write metrics.json and run.mcap.
 
     The directory is locked for the run (a second run into it is refused;
-    see :mod:`bionav.experiments.runlock`). metrics.json first says
+    see :mod:`bionav.runlock`). metrics.json first says
     ``"status": "running"``, then, written atomically, ``"completed"`` on
     success, or ``"status": "failed"`` and ``"error"`` on any failure (the
     exception is re-raised); run.mcap is closed properly either way. With
@@ -142,6 +146,7 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
         **metrics, "status": "running", "started": time.strftime("%Y-%m-%dT%H:%M:%S%z", time.localtime(started)),
         "pid": os.getpid(),
     })
+    log.info("%s started in %s (pid %d); results: %s, %s", name, run_dir, os.getpid(), METRICS_FILE, LOG_FILE)
     mcap = None
     try:
         mcap = McapLog(run_dir / LOG_FILE)
@@ -169,6 +174,7 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
             # Ctrl-C inside compiled code (numba) surfaces as SystemError caused by KeyboardInterrupt
             metrics.update(status="failed", error=f"KeyboardInterrupt: (inside {type(exc).__name__}: {exc})")
             _finish(run_dir, mcap, metrics, started, failing=True)
+            log.error("%s interrupted after %.1f s", name, metrics["wall_time_s"])
             raise KeyboardInterrupt from None
         full = disk_full_error(exc, run_dir)
         metrics["status"] = "failed"
@@ -179,10 +185,14 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
             except OSError:
                 pass
         _finish(run_dir, mcap, metrics, started, failing=True)
+        log.error("%s %s after %.1f s: %s", name, "interrupted" if isinstance(exc, KeyboardInterrupt) else "failed",
+                  metrics["wall_time_s"], metrics["error"])
         if full is not None:
             raise full from None
         raise
     _finish(run_dir, mcap, metrics, started, failing=False)
+    log.info("%s completed in %.1f s: %s", name, metrics["wall_time_s"], ", ".join(
+        f"{k}={v:.4g}" for k, v in metrics.items() if isinstance(v, float) and k != "wall_time_s") or "no scalar metrics")
     return metrics
 
 

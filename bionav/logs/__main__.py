@@ -10,19 +10,25 @@ from bionav.errors import UserError
 
 
 def _info(path: str) -> None:
+    try:
+        _print_info(path)
+    except (UserError, BrokenPipeError):
+        raise
+    except Exception as exc:  # a damaged file: a cut-off summary, a flipped byte in a record
+        raise UserError(
+            f"{path} is damaged and cannot be summarised ({type(exc).__name__}: {str(exc)[:200]}); rebuild a readable "
+            f"log from its intact records with `python -m bionav.logs recover {path} repaired.mcap`."
+        ) from None
+
+
+def _print_info(path: str) -> None:
     from mcap.reader import make_reader
 
     from bionav.logs.reader import _open
 
     with _open(path) as f:
-        try:
-            reader = make_reader(f)
-            summary = reader.get_summary()
-        except Exception as exc:
-            raise UserError(
-                f"{path} has no readable summary ({exc}); if the run crashed while writing, repair it with "
-                f"`python -m bionav.logs recover {path} repaired.mcap`."
-            ) from None
+        reader = make_reader(f)
+        summary = reader.get_summary()
         if summary is None or summary.statistics is None:
             raise UserError(f"{path} has no summary section; repair it with `python -m bionav.logs recover`.")
         stats = summary.statistics
@@ -44,6 +50,17 @@ def _info(path: str) -> None:
             print(f"metadata {meta.name}:")
             for key, value in sorted(meta.metadata.items()):
                 print(f"  {key} = {value}")
+
+
+def _print_results(results: dict) -> None:
+    """What the recovered log holds, as metrics of the run that was cut short."""
+    for topic, n in sorted(results.get("messages", {}).items()):
+        print(f"  {topic:40s} {n:8d} messages")
+    if "n_home_vectors" in results:
+        aae = results["aae_logged"]
+        print(f"home vectors logged: {results['n_home_vectors']} of {results['n_snapshots']} snapshots "
+              f"({results['n_complete_rows']} whole rows); AAE over them: "
+              + ("none" if aae is None else f"{aae:.4f} rad"))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -68,6 +85,7 @@ def main(argv: list[str] | None = None) -> int:
                 f"recovered {report.messages} messages on {report.channels} channels, "
                 f"{report.attachments} attachments, {report.metadata} metadata records ({state}) -> {args.output}"
             )
+            _print_results(report.results or {})
     except UserError as exc:
         print(f"bionav.logs: error: {exc}", file=sys.stderr)
         return 2
@@ -75,4 +93,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from bionav.errors import run_main
+
+    run_main(main, "bionav.logs")

@@ -12,8 +12,10 @@ from bionav.errors import UserError
 
 
 def _open(path: str | Path):
+    from bionav.files import user_path
     from bionav.logs.recover import check_mcap
 
+    path = user_path(path)
     check_mcap(path)
     return open(path, "rb")
 

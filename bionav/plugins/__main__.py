@@ -41,4 +41,6 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from bionav.errors import run_main
+
+    run_main(main, "bionav.plugins")

@@ -23,7 +23,6 @@ the time.
 from __future__ import annotations
 
 import datetime as _dt
-import json
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -97,6 +96,10 @@ class Session:
         return self.local_time.replace(tzinfo=tz).astimezone(_dt.timezone.utc)
 
 
+#: larger rotation files are refused before they are read (bytes; a real one is well below 1 MB)
+MAX_RECORDING_BYTES = 64 * 2**20
+
+
 def _fail(path, field_name, problem):
     raise RecordingError(
         f"The recording {path} is not a POL-OP rotation file: field {field_name!r} {problem}. Each file needs "
@@ -114,34 +117,39 @@ def load_rotation(path, *, n_photodiodes: int = 4) -> Rotation:
         Naming the file and the field: another layout, a missing unit, NaN or
         negative counts, a yaw series of another length.
     """
-    path = Path(path)
+    from bionav.files import read_json_file, user_path
+
+    path = user_path(path)
     try:
-        data = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"Cannot read the recording {path} ({exc}); check the path and permissions.") from None
-    except json.JSONDecodeError as exc:
-        raise RecordingError(f"The recording {path} is not valid JSON ({exc}); re-export or remove the file.") from None
+        data = read_json_file(path, what="The recording", fix="Re-export the file as UTF-8 JSON or remove it.",
+                              max_bytes=MAX_RECORDING_BYTES)
+    except UserError as exc:
+        raise RecordingError(str(exc)) from None
     if not isinstance(data, dict):
         _fail(path, "<top level>", f"is a JSON {type(data).__name__}, not an object")
-    units = sorted(int(k[len("pol_op_"):]) for k in data if re.fullmatch(r"pol_op_\d+", k))
+    # unit numbers as strings first: `pol_op_99999999999` must not build a range of 10^11 units
+    units = sorted(int(k[len("pol_op_"):]) for k in data if re.fullmatch(r"pol_op_\d{1,6}", k))
+    odd = sorted(k for k in data if k.startswith("pol_op_") and not re.fullmatch(r"pol_op_\d{1,6}", k))
+    if odd:
+        _fail(path, odd[0], "is not a unit key pol_op_<n> with n below 1000000")
     if not units:
         _fail(path, "pol_op_0", f"is missing (keys present: {', '.join(sorted(data)[:8])})")
-    missing = sorted(set(range(max(units) + 1)) - set(units))
-    if missing:
-        _fail(path, f"pol_op_{missing[0]}", "is missing (unit numbers must run from 0 without gaps)")
+    missing = next((i for i, u in enumerate(units) if u != i), None)
+    if missing is not None:
+        _fail(path, f"pol_op_{missing}", "is missing (unit numbers must run from 0 without gaps)")
     for key in ("azimuths", "yaw"):
         if key not in data:
             _fail(path, key, "is missing")
     k = len(units)
     try:
         azimuths = np.asarray(data["azimuths"], float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         _fail(path, "azimuths", "is not a list of numbers")
     if azimuths.shape != (k,) or not np.all(np.isfinite(azimuths)):
         _fail(path, "azimuths", f"must hold {k} finite numbers (one per unit), got shape {azimuths.shape}")
     try:
         yaw = np.asarray(data["yaw"], float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         _fail(path, "yaw", "is not a list of numbers")
     if yaw.ndim != 1 or not np.all(np.isfinite(yaw)):
         _fail(path, "yaw", "must be a flat list of finite numbers")
@@ -150,7 +158,7 @@ def load_rotation(path, *, n_photodiodes: int = 4) -> Rotation:
         key = f"pol_op_{u}"
         try:
             c = np.asarray(data[key], float)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             _fail(path, key, "is not a list of count lists")
         if c.ndim != 2 or c.shape[1] != n_photodiodes:
             _fail(path, key, f"must be N x {n_photodiodes} counts, got shape {c.shape}")
@@ -188,9 +196,17 @@ def _condition(parts) -> str:
 
 def find_sessions(root) -> list[tuple[Path, list[Path]]]:
     """Session folders below ``root`` (or ``root`` itself): ``(folder, rotation files sorted by number)``."""
-    root = Path(root)
-    if root.is_file():
+    from bionav.files import not_a_regular_file, user_path
+
+    root = user_path(root)
+    problem = not_a_regular_file(root)
+    if problem is None:
         return [(root.parent, [root])]
+    if problem != "does not exist" and not root.is_dir():
+        raise UserError(
+            f"recordings.path={root} {problem}. Point it at a folder of POL-OP recordings (e.g. "
+            "../shared/data/celestial-compass, or one session folder holding 1.json, 2.json, ...)."
+        )
     if not root.is_dir():
         raise UserError(
             f"recordings.path={root} does not exist. Point it at a folder of POL-OP recordings (e.g. "
@@ -218,7 +234,9 @@ def load_sessions(root, *, n_photodiodes: int = 4):
     errors : list of (Path, str)
         Each bad file with its message.
     """
-    root = Path(root)
+    from bionav.files import user_path
+
+    root = user_path(root)
     sessions, errors = [], []
     for folder, files in find_sessions(root):
         rel = folder.relative_to(root) if folder != root and root.is_dir() else Path(folder.name)
@@ -231,7 +249,8 @@ def load_sessions(root, *, n_photodiodes: int = 4):
         if session.rotations:
             k = {r.counts.shape[1] for r in session.rotations}
             if len(k) > 1:
-                errors.append((folder, f"The session {folder} mixes files with different unit counts {sorted(k)}."))
+                errors.append((folder, f"The session {folder} mixes files with different unit counts {sorted(k)}; one session "
+                                       "holds one sensor layout: move the files of the other layout to their own folder."))
                 continue
             sessions.append(session)
     return sessions, errors

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -17,26 +16,33 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("dir", help="a sweep directory (multirun/...) or any directory holding runs")
     args = parser.parse_args(argv)
-    root = Path(args.dir)
+    from bionav.files import user_path
+
+    root = user_path(args.dir)
     if not root.is_dir():
         print(f"bionav.report: error: {root} is not a directory; pass a sweep or run directory.", file=sys.stderr)
         return 2
     from bionav.report.sections import extra_sections
     from bionav.report.summary import write_summary
+    from bionav.runlock import RunLock
 
-    csv_path, md_path, rows = write_summary(root)
-    if not rows:
-        print(f"bionav.report: error: no runs (metrics.json) found below {root}.", file=sys.stderr)
-        return 2
-    text = md_path.read_text()
-    sections = extra_sections(root, rows)
-    if sections:
-        text = text + "\n" + "\n\n".join(sections) + "\n"
-        md_path.write_text(text)
+    # one writer of summary.csv / summary.md per directory; a stale lock is taken over
+    with RunLock(root, what="directory", fix="Wait for the other `python -m bionav.report` to finish."):
+        csv_path, md_path, rows = write_summary(root)
+        if not rows:
+            print(f"bionav.report: error: no runs (metrics.json) found below {root}.", file=sys.stderr)
+            return 2
+        text = md_path.read_text()
+        sections = extra_sections(root, rows)
+        if sections:
+            text = text + "\n" + "\n\n".join(sections) + "\n"
+            md_path.write_text(text)
     print(text)
     print(f"written: {csv_path}, {md_path}", file=sys.stderr)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from bionav.errors import run_main
+
+    run_main(main, "bionav.report")

@@ -16,11 +16,35 @@ def _overrides(job_dir: Path) -> dict[str, str]:
         return {}
     import yaml
 
+    try:
+        items = yaml.safe_load(path.read_text()) or []
+    except (OSError, ValueError, yaml.YAMLError):
+        return {}
+    if not isinstance(items, list):  # not written by Hydra
+        return {}
     out = {}
-    for item in yaml.safe_load(path.read_text()) or []:
+    for item in items:
         key, _, value = str(item).partition("=")
         out[key.lstrip("+~")] = value
     return out
+
+
+def _read_metrics(path: Path) -> dict[str, Any]:
+    """A run's metrics.json as a dict; a ``failed`` row's values when missing, not a file, unreadable or not an object."""
+    from bionav.files import not_a_regular_file
+
+    problem = not_a_regular_file(path)  # a FIFO named metrics.json must not block the report
+    if problem == "does not exist":
+        return {"status": "failed", "error": "no metrics.json (the job died before finishing)"}
+    if problem is not None:
+        return {"status": "failed", "error": f"metrics.json {problem}"}
+    try:
+        metrics = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        return {"status": "failed", "error": f"metrics.json cannot be read ({type(exc).__name__})"}
+    if not isinstance(metrics, dict):
+        return {"status": "failed", "error": f"metrics.json holds a JSON {type(metrics).__name__}, not an object"}
+    return metrics
 
 
 def find_runs(root: Path) -> list[Path]:
@@ -55,10 +79,7 @@ def collect_rows(root: Path) -> tuple[list[dict[str, Any]], list[str]]:
             if k not in override_keys:
                 override_keys.append(k)
         row.update(overrides)
-        try:
-            metrics = json.loads((run_dir / "metrics.json").read_text())
-        except (OSError, ValueError):
-            metrics = {"status": "failed", "error": "no metrics.json (the job died before finishing)"}
+        metrics = _read_metrics(run_dir / "metrics.json")
         row.update(flatten(metrics))
         rows.append(row)
     return rows, override_keys

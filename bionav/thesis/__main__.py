@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -48,14 +49,30 @@ def _launcher_overrides(name: str | None, extra: list[str]) -> list[str]:
         if extra:
             raise UserError("--launcher-arg needs --launcher NAME (e.g. --launcher joblib).")
         return []
+    from bionav.config import hydra_group_options
+
+    available = hydra_group_options("hydra/launcher")
+    if name not in available:
+        raise UserError(f"unknown --launcher {name!r}; installed Hydra launchers: {', '.join(available)} "
+                        "(joblib comes with `pip install \"bionav[parallel]\"`, submitit_* with "
+                        "`pip install \"bionav[slurm]\"`).")
     for e in extra:
         if "=" not in e:
             raise UserError(f"--launcher-arg {e!r} must be KEY=VALUE, e.g. hydra.launcher.n_jobs=2.")
     return [f"hydra/launcher={name}", *extra]
 
 
+def _interrupt(signum, frame) -> None:  # noqa: ARG001
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
+    import signal
+
     args = build_parser().parse_args(argv)
+    for sig in ("SIGTERM", "SIGHUP"):  # `kill` and a closed terminal end the command as Ctrl-C does
+        if hasattr(signal, sig):
+            signal.signal(getattr(signal, sig), _interrupt)
     try:
         return run(args)
     except UserError as exc:
@@ -73,37 +90,51 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def run(args) -> int:
-    from bionav.thesis.items import Context, select_items
-    from bionav.thesis.outcome import Outcome
+    from bionav.files import user_path
+    from bionav.thesis.items import select_items
     from bionav.thesis.presets import PRESETS, PUBLIC_PRESETS
-    from bionav.thesis.reference import load_reference
-    from bionav.thesis.report import Section, markdown_to_html, report_markdown, verdict_counts, write_csv
-    from bionav.thesis.runs import Runner, tool_env, usable_cpus
 
     started = time.time()
     load_start = _loadavg()
     if args.preset not in PRESETS:
         raise UserError(f"unknown --preset {args.preset!r}; choose one of {', '.join(PUBLIC_PRESETS)}.")
     preset = PRESETS[args.preset]
+    if args.jobs is not None and not 1 <= args.jobs <= 4096:
+        from bionav.thesis.runs import usable_cpus
+
+        raise UserError(f"--jobs {args.jobs} is out of range; give 1 (one run after the other) up to the number "
+                        f"of runs to execute at once, e.g. --jobs {usable_cpus()}.")
     items = select_items(args.only)
-    out = Path(args.out).resolve()
+    out = user_path(args.out).resolve()
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out} is a file; give a directory.")
     if not args.dry_run:
         try:
             out.mkdir(parents=True, exist_ok=True)
-            probe = out / ".write_test"
-            probe.write_text("")
-            probe.unlink()
+            with tempfile.TemporaryFile(dir=out):
+                pass
         except OSError as exc:
             raise UserError(f"cannot write the report directory {out}: {exc.strerror}. Choose another with --out.") from None
+        from bionav.runlock import RunLock
+
+        # one writer per report directory (the runs below it hold their own locks); a stale lock is taken over
+        with RunLock(out, what="report directory (--out)",
+                     fix="Wait for that command to finish, or give this one another --out."):
+            return _run_in(args, out, items, preset, started, load_start)
+    return _run_in(args, out, items, preset, started, load_start)
+
+
+def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> int:
+    from bionav.thesis.items import Context
+    from bionav.thesis.outcome import Outcome
+    from bionav.thesis.reference import load_reference
+    from bionav.thesis.report import Section, markdown_to_html, report_markdown, verdict_counts, write_csv
+    from bionav.thesis.runs import Runner, tool_env, usable_cpus
+
     ref_all = load_reference()
     specs = {it.id: it.runs(preset) for it in items}
     launcher = _launcher_overrides(args.launcher, args.launcher_arg)
     jobs = usable_cpus() if args.jobs is None else args.jobs
-    if not 1 <= jobs <= 4096:
-        raise UserError(f"--jobs {args.jobs} is out of range; give 1 (one run after the other) up to the number "
-                        f"of runs to execute at once, e.g. --jobs {usable_cpus()}.")
     runner = Runner(out=out, launcher=launcher, dry_run=args.dry_run, echo=lambda s: print(s, flush=True),
                     env=tool_env(), jobs=jobs)
     all_specs = [s for ss in specs.values() for s in ss]
@@ -171,4 +202,6 @@ def argv_for_display(args) -> list[str]:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from bionav.errors import run_main
+
+    run_main(main, "bionav.thesis")

@@ -96,10 +96,16 @@ def select_items(only: str | None) -> list[Item]:
     from bionav.errors import UserError
 
     items = list(REGISTRY.values())
-    if not only:
+    if only is None:
         return items
+    words = [w.strip() for w in only.split(",") if w.strip()]
+    if not words:
+        raise UserError(
+            f"--only {only!r} names no item; give comma-separated items such as --only 5.3,B.1 "
+            f"(items: {', '.join(it.id for it in items)}), or leave --only out to run every item."
+        )
     chosen: list[Item] = []
-    for word in [w.strip() for w in only.split(",") if w.strip()]:
+    for word in words:
         hits = [it for it in items if word == it.id or word in it.aliases]
         if not hits:
             raise UserError(

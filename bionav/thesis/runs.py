@@ -152,10 +152,16 @@ class RunResult:
 
 
 def read_json(path: Path) -> dict | None:
+    """The JSON object in ``path``; ``None`` if missing, not a regular file, unreadable or not an object."""
+    from bionav.files import not_a_regular_file
+
+    if not_a_regular_file(path) is not None:
+        return None
     try:
-        return json.loads(Path(path).read_text())
+        data = json.loads(Path(path).read_text())
     except (OSError, ValueError):
         return None
+    return data if isinstance(data, dict) else None
 
 
 def index_runs(root: Path) -> dict[str, Path]:
@@ -177,7 +183,9 @@ def index_runs(root: Path) -> dict[str, Path]:
             continue
         try:
             overrides = yaml.safe_load(ov_file.read_text()) or []
-        except (OSError, yaml.YAMLError):
+        except (OSError, ValueError, yaml.YAMLError):
+            continue
+        if not isinstance(overrides, list):  # not written by Hydra: not a run of ours
             continue
         found.setdefault(canonical_key([str(o) for o in overrides]), run_dir)
     for marker in root.rglob(SWEEP_DONE):

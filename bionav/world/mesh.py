@@ -185,6 +185,13 @@ def _load_trimesh(path: Path) -> TriangleMesh:
                         "faces. Reconstruct a surface (e.g. Poisson reconstruction) and save it as .obj or .ply.")
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64)
+    bad = np.flatnonzero(np.any((faces < 0) | (faces >= len(vertices)), axis=tuple(range(1, faces.ndim))))
+    if bad.size:
+        first = faces[bad[0]]
+        vertex = int(first.min() if first.min() < 0 else first.max())
+        raise UserError(f"{path}: face {int(bad[0])} names vertex {vertex}, "
+                        f"but the file has vertices 0..{len(vertices) - 1} ({bad.size} such faces); the file is "
+                        "damaged: re-export it from the program that made it.")
     tri = vertices[faces]
     colors = None
     visual = getattr(loaded, "visual", None)
@@ -222,11 +229,16 @@ def load_mesh(path) -> TriangleMesh:
         Missing file, unknown suffix, a file that is not a mesh, no triangles,
         NaN corners -- each with what was expected.
     """
+    from bionav.files import not_a_regular_file
+
     p = Path(path).expanduser()
     if not p.exists():
         raise UserError(f"mesh file {p} does not exist; give db.path=FILE with a {', '.join(MESH_SUFFIXES)} mesh.")
     if p.is_dir():
         raise UserError(f"mesh path {p} is a folder; give db.path=FILE pointing at a {', '.join(MESH_SUFFIXES)} file.")
+    problem = not_a_regular_file(p)  # a FIFO or a device would block the reader or never end
+    if problem is not None:
+        raise UserError(f"mesh file {p} {problem}; give db.path=FILE pointing at a {', '.join(MESH_SUFFIXES)} file.")
     suffix = p.suffix.lower()
     if suffix == ".mat":
         return _load_mat(p)

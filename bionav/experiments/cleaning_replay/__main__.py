@@ -31,4 +31,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from bionav.errors import run_main
+
+    run_main(main, "bionav.experiments.cleaning_replay")

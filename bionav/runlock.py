@@ -65,13 +65,16 @@ def lock_owner(run_dir: str | Path) -> dict | None:
     return info
 
 
-def _refusal(run_dir: Path, info: dict) -> UserError:
+#: what a refused run is told to do (the thesis command passes its own, naming --out)
+RUN_FIX = "Choose another directory with hydra.run.dir=..., or wait for that run to finish."
+
+
+def _refusal(run_dir: Path, info: dict, *, what: str = "run directory", fix: str = RUN_FIX) -> UserError:
     where = info.get("host", "?")
     return UserError(
-        f"the run directory {run_dir} is in use by another bionav run (pid {info.get('pid')} on {where}, "
-        f"started {info.get('started', '?')}); two runs in one directory would overwrite each other's "
-        f"metrics.json and run.mcap. Choose another directory with hydra.run.dir=..., or wait for that run to "
-        f"finish. If that run is dead (on another host), delete {run_dir / LOCK_FILE}."
+        f"the {what} {run_dir} is in use by another bionav command (pid {info.get('pid')} on {where}, "
+        f"started {info.get('started', '?')}); two writers in one directory would overwrite each other's "
+        f"files. {fix} If that command is dead (on another host), delete {run_dir / LOCK_FILE}."
     )
 
 
@@ -88,12 +91,14 @@ class RunLock:
     Raises
     ------
     UserError
-        When another live run holds the directory.
+        When another live run holds the directory (``what`` names the
+        directory's role and ``fix`` the way out in that message).
     """
 
-    def __init__(self, run_dir: str | Path) -> None:
+    def __init__(self, run_dir: str | Path, *, what: str = "run directory", fix: str = RUN_FIX) -> None:
         self.path = Path(run_dir) / LOCK_FILE
         self._held = False
+        self._words = {"what": what, "fix": fix}
 
     def acquire(self) -> "RunLock":
         me = {
@@ -113,12 +118,12 @@ class RunLock:
                 except FileExistsError:
                     owner = lock_owner(self.path.parent)
                     if owner is not None:
-                        raise _refusal(self.path.parent, owner) from None
+                        raise _refusal(self.path.parent, owner, **self._words) from None
                     try:  # stale: the owner crashed
                         self.path.unlink()
                     except FileNotFoundError:
                         pass
-            raise _refusal(self.path.parent, _read(self.path) or {})
+            raise _refusal(self.path.parent, _read(self.path) or {}, **self._words)
         finally:
             tmp.unlink(missing_ok=True)
 
