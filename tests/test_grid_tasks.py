@@ -1,7 +1,7 @@
 """Issue 29 item 1: a grid-homing run split into tasks by snapshots gives the unsplit run's results.
 
 The tasks (``experiment.block=[i,n]``) run through ``python -m bionav`` on the thesis runner's
-pool, ``python -m bionav.experiments.grid_homing_merge`` joins them; AAE*, MAE*, RR*, the
+pool, ``python -m bionav.experiments.merge`` joins them; AAE*, MAE*, RR*, the
 compass AAE, the pair count and per_snapshot.csv must equal the unsplit run's exactly.
 """
 
@@ -64,8 +64,28 @@ def test_merge_refuses_an_incomplete_split(folder_db, tmp_path):
                           cwd=tmp_path)
         assert proc.returncode == 0, proc.stderr[-2000:]
     merge = run_bionav(str(tmp_path / "m"), str(tmp_path / "b0"), str(tmp_path / "b2"), cwd=tmp_path,
-                       module="bionav.experiments.grid_homing_merge")
+                       module="bionav.experiments.merge")
     assert merge.returncode == 2 and "Traceback" not in merge.stderr
     assert "missing or mixed blocks [(1, 3)]" in merge.stderr
     bad = run_bionav(*overrides, "experiment.block=[3,3]", f"hydra.run.dir={tmp_path / 'bad'}", cwd=tmp_path)
     assert bad.returncode != 0 and "Traceback" not in bad.stderr and "0 <= i < n" in bad.stderr
+
+
+def test_split_cross_db_run_merges_to_the_unsplit_results(tmp_path):
+    overrides = ("experiment=cross_db", "homing=mfdid", "experiment.family=[sim_original,sim_doorlit]",
+                 "db.image_size=[120,18]", "experiment.snapshot_stride=4")
+    cache = {"BIONAV_CACHE": str(tmp_path / "cache")}
+    whole = run_bionav(*overrides, f"hydra.run.dir={tmp_path / 'whole'}", "workers=1", cwd=tmp_path, env=cache)
+    assert whole.returncode == 0, whole.stderr[-2000:]
+    expected = json.loads((tmp_path / "whole" / "metrics.json").read_text())
+
+    spec = RunSpec(overrides, group="cross", blocks=3)
+    result = Runner(out=tmp_path / "report", jobs=2, echo=lambda s: None,
+                    env={**tool_env(), **cache}).run_all([spec])[spec.key]
+    assert result.ok, result.error
+    merged = json.loads((result.dir / "metrics.json").read_text())
+    for key in ("aae", "mae", "rr", "n_databases", "n_snapshots", "homing"):
+        assert merged[key] == expected[key], key
+    assert merged["tasks"] == 3
+    assert (result.dir / "cross_db.csv").read_text() == (tmp_path / "whole" / "cross_db.csv").read_text()
+    assert (result.dir / "plots" / "cross_db.png").is_file()

@@ -35,7 +35,7 @@ class GridHomingConfig:
     n_quiver_plots : quiver plots of home-vector fields for this many snapshots.
     snapshots : only these snapshot indices (None = all); handy for quick looks.
     block : ``[i, n]``: only every n-th of those snapshots, starting at the i-th (0 <= i < n): one
-        task of a run split into n; ``python -m bionav.experiments.grid_homing_merge`` joins the
+        task of a run split into n; ``python -m bionav.experiments.merge`` joins the
         tasks into the unsplit run's files, with identical measures.
     """
 
@@ -53,6 +53,8 @@ class CrossDbConfig:
 
     family : databases sharing one grid (``db.image_size``, ``db.seed``, ``db.noise`` apply to all).
     snapshot_stride : evaluate every k-th grid cell along x and y as snapshot (1 = all, as the thesis).
+    block : ``[i, n]``: only every n-th of those snapshots, from the i-th, for every database pair:
+        task i of a run split into n (``python -m bionav.experiments.merge`` joins them).
     """
 
     name: str = "cross_db"
@@ -62,6 +64,7 @@ class CrossDbConfig:
     snapshot_stride: int = bounded(2, ge=1, le=1000)
     step_length: float = bounded(0.5, **_STEP)
     success_radius: float = bounded(1.0, **_RADIUS)
+    block: Optional[list[int]] = bounded(None, length=(2, 2), item=Range(ge=0, le=10**6))
 
 
 @dataclass

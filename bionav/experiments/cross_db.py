@@ -2,13 +2,16 @@
 
 Writes ``cross_db.csv`` (for each measure, rows = snapshot database, columns =
 current-view database), heatmaps like thesis fig. 5.6, and metrics.json with
-AAE*, MAE*, RR* averaged over all off-diagonal database pairs.
+AAE*, MAE*, RR* averaged over all off-diagonal database pairs. With
+``experiment.block=[i,n]`` a run is task i of n (every n-th snapshot, all database pairs);
+:func:`merge` joins the tasks (``python -m bionav.experiments.merge``).
 """
 
 from __future__ import annotations
 
 import csv
-from typing import Any
+from pathlib import Path
+from typing import Any, Sequence
 
 import numpy as np
 import yaml
@@ -20,6 +23,10 @@ from bionav.evaluation.measures import angular_errors, ideal_home_angles, qualit
 from bionav.evaluation.pairs import home_vector_matrix, prepare_images
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
 from bionav.experiments.configs import experiment_config
+from bionav.experiments.runner import LOG_FILE
+from bionav.experiments.tasks import block_of, check_blocks, finish_merge, merge_target, read_task
+from bionav.logs.reader import read_attachment, read_messages
+from bionav.logs.writer import McapLog
 from bionav.report.figures import pyplot, save_figure
 
 #: settings of cfg.db that apply to every member of the family
@@ -91,6 +98,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     stride = max(1, int(exp.snapshot_stride))
     pos = first.positions
     snap_idx = np.flatnonzero((pos[:, 0] % stride == 0) & (pos[:, 1] % stride == 0))
+    if exp.block is not None:
+        snap_idx = np.asarray(block_of(exp.block, snap_idx), dtype=int)
 
     n = len(dbs)
     matrices = {k: np.full((n, n), np.nan) for k in MEASURES}
@@ -111,24 +120,106 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             ctx.log.write(
                 "/cross_db/cell",
                 {"snapshot_db": names[i], "current_db": names[j], "aae": q.aae, "mae": q.mae, "rr": q.rr,
-                 "aae_s": q.aae_s, "rr_s": q.rr_s, "snapshots": dbs[i].positions[snap_idx]},
+                 "aae_s": q.aae_s, "mae_s": q.mae_s, "rr_s": q.rr_s, "snapshots": dbs[i].positions[snap_idx],
+                 "snapshot_index": snap_idx, "ms_per_home_vector": hv.ms_per_home_vector},
                 schema_name="bionav.CrossDbCell",
             )
 
-    with open(ctx.dir / "cross_db.csv", "w", newline="") as f:
+    metrics = _write_results(ctx.dir, matrices, names, homing=str(cfg.homing.name), n_snapshots=len(snap_idx),
+                             ms=float(np.mean(per_pair_ms)))
+    if exp.block is not None:
+        metrics["block"] = [int(v) for v in exp.block]
+    return metrics
+
+
+def _write_results(run_dir: Path, matrices: dict[str, np.ndarray], names: list[str], *, homing: str,
+                   n_snapshots: int, ms: float) -> dict[str, Any]:
+    """cross_db.csv, plots/cross_db.png and the metrics of the measure matrices (rows: snapshot database)."""
+    n = len(names)
+    (run_dir / "plots").mkdir(parents=True, exist_ok=True)
+    with open(run_dir / "cross_db.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["measure", "snapshot_db", *names])
         for key in MEASURES:
             for i in range(n):
                 w.writerow([key, names[i], *[f"{v:.6f}" for v in matrices[key][i]]])
-    _plot(ctx.plots / "cross_db.png", matrices, names, f"cross-database test, homing={cfg.homing.name}")
+    _plot(run_dir / "plots" / "cross_db.png", matrices, names, f"cross-database test, homing={homing}")
     off = ~np.eye(n, dtype=bool)
     return {
-        "homing": str(cfg.homing.name),
+        "homing": homing,
         "aae": float(np.mean(matrices["aae"][off])),
         "mae": float(np.mean(matrices["mae"][off])),
         "rr": float(np.mean(matrices["rr"][off])),
         "n_databases": n,
-        "n_snapshots": int(len(snap_idx)),
-        "ms_per_home_vector": float(np.mean(per_pair_ms)),
+        "n_snapshots": int(n_snapshots),
+        "ms_per_home_vector": ms,
     }
+
+
+# --------------------------------------------------------------------------- tasks of a split run
+_CELL_TOPIC = "/cross_db/cell"
+_TASK_SHARED = ("experiment", "homing", "n_databases")
+
+
+def merge(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
+    """Merge the tasks (``experiment.block=[i,n]``) of one split cross-database run into ``out``.
+
+    Each task logged, per database pair, the per-snapshot AAE_s, MAE_s and RR_s of its block of
+    snapshots with their database indices; per pair these are put back in snapshot order and
+    reduced as :func:`bionav.evaluation.measures.quality_measures` does (mean, median, mean),
+    so the matrices and metrics equal the unsplit run's. ``ms_per_home_vector`` is the mean of
+    the tasks' per-pair times.
+
+    Raises
+    ------
+    UserError
+        A task missing, not completed, of another run, or a snapshot in two tasks.
+    """
+    metas: list[dict] = []
+    cells: dict[tuple[str, str], dict[int, tuple[float, float, float]]] = {}
+    names: list[str] = []
+    ms: list[float] = []
+    for d in map(Path, task_dirs):
+        metas.append(read_task(d, metas, shared=_TASK_SHARED))
+        for _topic, _t, msg in read_messages(d / LOG_FILE, topics=[_CELL_TOPIC]):
+            key = (str(msg["snapshot_db"]), str(msg["current_db"]))
+            for name in key:
+                if name not in names:
+                    names.append(name)
+            rows = cells.setdefault(key, {})
+            for idx, a, m, r in zip(msg["snapshot_index"], msg["aae_s"], msg["mae_s"], msg["rr_s"]):
+                if int(idx) in rows:
+                    raise UserError(f"snapshot {idx} of {key[0]} -> {key[1]} is in two tasks; give each block once.")
+                rows[int(idx)] = (float(a), float(m), float(r))
+            ms.append(float(msg["ms_per_home_vector"]))
+    check_blocks(metas)
+    n = len(names)
+    if len(cells) != n * n:
+        raise UserError(f"the tasks hold {len(cells)} of the {n * n} database pairs; give the directories of "
+                        f"complete cross_db tasks.")
+    out = merge_target(out)
+    matrices = {k: np.full((n, n), np.nan) for k in MEASURES}
+    n_snapshots = 0
+    with McapLog(out / LOG_FILE) as log:
+        config = read_attachment(Path(task_dirs[0]) / LOG_FILE, "config.yaml")
+        if config is not None:
+            log.attach("config.yaml", config, media_type="application/yaml")
+        log.metadata("merge", {"tasks": ",".join(str(Path(d).resolve()) for d in task_dirs)})
+        for (si, sname) in enumerate(names):
+            for (cj, cname) in enumerate(names):
+                rows = cells[(sname, cname)]
+                order = sorted(rows)
+                aae_s, mae_s, rr_s = (np.array([rows[k][c] for k in order]) for c in range(3))
+                q = (float(np.mean(aae_s)), float(np.median(mae_s)), float(np.mean(rr_s)))
+                matrices["aae"][si, cj], matrices["mae"][si, cj], matrices["rr"][si, cj] = q
+                n_snapshots = len(order)
+                log.write(_CELL_TOPIC, {"snapshot_db": sname, "current_db": cname, "aae": q[0], "mae": q[1],
+                                        "rr": q[2], "aae_s": aae_s, "mae_s": mae_s, "rr_s": rr_s,
+                                        "snapshot_index": order}, schema_name="bionav.CrossDbCell")
+    metrics = {"experiment": "cross_db"}
+    metrics.update(_write_results(out, matrices, names, homing=str(metas[0]["homing"]), n_snapshots=n_snapshots,
+                                  ms=float(np.mean(ms))))
+    metrics.update(status="completed", tasks=len(metas),
+                   wall_time_s=round(sum(float(m.get("wall_time_s", 0.0)) for m in metas), 3))
+    finish_merge(task_dirs, out, metrics)
+    return metrics

@@ -578,7 +578,7 @@ class _Fig55:
 def _cross_spec(preset: Preset, homing: str) -> RunSpec:
     ov = ["experiment=cross_db", f"homing={homing}", f"experiment.family=[{','.join(preset.cross_db_family)}]",
           f"experiment.snapshot_stride={preset.cross_db_stride}", *size_arg(preset.cross_db_size)]
-    return RunSpec(tuple(ov), group="cross_db")
+    return RunSpec(tuple(ov), group="cross_db", blocks=int(preset.cross_db_blocks.get(homing, 1)))
 
 
 def _cross_matrix(res: RunResult, measure: str) -> tuple[list[str], np.ndarray]:

@@ -60,6 +60,9 @@ class Preset:
     #: snapshots with the thesis' warping parameters needs about 16 CPU hours (docs/thesis.md), so it
     #: goes as 64 tasks of about 15 minutes each that a launcher spreads over cores and nodes
     grid_blocks: dict = field(default_factory=dict)
+    #: tasks per cross-database run (fig. 5.6) by homing method: the thesis' 2D-warping over all 8 x 8
+    #: database pairs needs about 100 CPU hours, so 256 tasks of about 25 minutes
+    cross_db_blocks: dict = field(default_factory=dict)
     reductions: tuple[str, ...] = ()
 
 
@@ -89,6 +92,7 @@ FULL = Preset(
     pol_vs_em_samples=100,
     cleaning_runs=10,
     grid_blocks={"warping2d_thesis": 64, "minwarping_thesis": 64, "sift": 8},
+    cross_db_blocks={"warping2d_thesis": 256, "sift": 16},
     reductions=(),
 )
 

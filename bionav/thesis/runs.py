@@ -55,12 +55,13 @@ class RunSpec:
     blocks: int = 1
 
     def tasks(self) -> list["RunSpec"]:
-        """The independent tasks of this run: ``blocks`` grid-homing runs by snapshots, or the run itself.
+        """The independent tasks of this run: ``blocks`` runs by snapshots, or the run itself.
 
-        A grid-homing run with ``blocks = n > 1`` splits into ``experiment.block=[i,n]`` runs
-        (:mod:`bionav.experiments.grid_homing`) that :meth:`Runner.run_all` executes like any
-        run (each reused on its own when completed) and then merges into this run's directory
-        (``python -m bionav.experiments.grid_homing_merge``), with identical measures.
+        A grid-homing or cross-database run with ``blocks = n > 1`` splits into
+        ``experiment.block=[i,n]`` runs (:mod:`bionav.experiments.tasks`) that
+        :meth:`Runner.run_all` executes like any run (each reused on its own when completed)
+        and then merges into this run's directory (``python -m bionav.experiments.merge``),
+        with identical measures.
         """
         if self.blocks <= 1 or self.multirun:
             return [self]
@@ -381,7 +382,7 @@ class Runner:
                              seconds, cpu_seconds=cpu)
         _move_aside(run_dir)
         run_dir.parent.mkdir(parents=True, exist_ok=True)
-        cmd = [sys.executable, "-m", "bionav.experiments.grid_homing_merge", str(run_dir), *(str(p.dir) for p in parts)]
+        cmd = [sys.executable, "-m", "bionav.experiments.merge", str(run_dir), *(str(p.dir) for p in parts)]
         proc = subprocess.run(cmd, capture_output=True, text=True, env=self.env)
         metrics = read_json(run_dir / "metrics.json")
         if proc.returncode != 0 or not metrics or metrics.get("status") != "completed":
