@@ -38,7 +38,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--launcher-arg", action="append", default=[], metavar="KEY=VALUE",
                    help="extra launcher override, e.g. hydra.launcher.partition=cpu (repeatable)")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
-                   help="runs at once without a launcher (default: the number of CPUs; 1: one after the other)")
+                   help="runs at once (default: the usable CPUs; 1: one after the other); with --launcher, "
+                        "multiruns in flight (default 1; submitit_slurm: all job arrays at once)")
     p.add_argument("--dry-run", action="store_true", help="print the bionav commands and write nothing")
     p.add_argument("--report-only", action="store_true", help="run nothing; report from the runs already in DIR")
     return p
@@ -134,7 +135,12 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
     ref_all = load_reference()
     specs = {it.id: it.runs(preset) for it in items}
     launcher = _launcher_overrides(args.launcher, args.launcher_arg)
-    jobs = usable_cpus() if args.jobs is None else args.jobs
+    if args.jobs is not None:
+        jobs = args.jobs
+    elif launcher:  # multiruns in flight: every SLURM job array queued at once; one local launcher at a time
+        jobs = 4096 if "slurm" in (args.launcher or "") else 1
+    else:
+        jobs = usable_cpus()
     runner = Runner(out=out, launcher=launcher, dry_run=args.dry_run, echo=lambda s: print(s, flush=True),
                     env=tool_env(), jobs=jobs)
     all_specs = [s for ss in specs.values() for s in ss]

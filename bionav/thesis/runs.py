@@ -341,9 +341,10 @@ class Runner:
     dry_run : bool
         Only print the commands.
     jobs : int
-        Runs executed at once without a launcher (1: one after the other). Runs of one
+        Without a launcher: runs executed at once (1: one after the other). Runs of one
         database wait until its first run has rendered it (the render cache), and each run
         gets ``workers = max(1, cores // jobs)``, so the cores are shared, not oversubscribed.
+        With a launcher: multiruns in flight at once (each one a job array on SLURM).
     """
 
     out: Path
@@ -486,12 +487,8 @@ class Runner:
             if spec.multirun:
                 run_dir = self.out / "runs" / spec.group / spec.slug
                 commands.append((spec.command(run_dir, launcher=self.launcher), [spec], run_dir))
-        for i, (cmd, covered, sweep_dir) in enumerate(commands, 1):
-            shown = "python " + " ".join(_quote(c) for c in cmd[1:])
-            if self.dry_run:
-                self.echo(shown)
-                continue
-            self.echo(f"[{i}/{len(commands)}] {shown}")
+        def launch(i: int, cmd: list[str], covered: list[RunSpec], sweep_dir: Path) -> None:
+            self.echo(f"[{i}/{len(commands)}] python " + " ".join(_quote(c) for c in cmd[1:]))
             sweep_dir.parent.mkdir(parents=True, exist_ok=True)
             with open(sweep_dir.parent / f"{sweep_dir.name}.log", "w") as fh:
                 subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, env=self.env)
@@ -499,6 +496,16 @@ class Runner:
                 metrics = _sweep_metrics(sweep_dir)
                 if metrics["status"] == "completed":
                     (sweep_dir / SWEEP_DONE).write_text(json.dumps({"key": covered[0].key}))
+
+        if self.dry_run:
+            for cmd, _covered, _dir in commands:
+                self.echo("python " + " ".join(_quote(c) for c in cmd[1:]))
+        else:  # up to `jobs` multiruns in flight (SLURM: every job array queued at once)
+            from concurrent.futures import ThreadPoolExecutor
+
+            with ThreadPoolExecutor(max_workers=max(1, min(self.jobs, len(commands) or 1))) as pool:
+                for future in [pool.submit(launch, i, *c) for i, c in enumerate(commands, 1)]:
+                    future.result()
         index = index_runs(self.out)
         for spec in todo:
             d = index.get(spec.key)
