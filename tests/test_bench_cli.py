@@ -32,7 +32,7 @@ def test_bench_table_and_background_load(capsys):
 
 @pytest.mark.parametrize("argv, message", [
     (["--threads", "0"], "--threads must lie in 1.."),
-    (["--compass-fraction", "0"], "--compass-fraction must lie in (0, 1]"),
+    (["--compass-fraction", "0"], "--compass-fraction 0.0 must lie in (0, 1]"),
     (["--method", "nope"], "invalid choice"),
 ])
 def test_bench_rejects_bad_arguments(capsys, argv, message):
