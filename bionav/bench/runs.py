@@ -145,6 +145,7 @@ def run_benchmark(args) -> list[dict]:
                 "workers": args.workers, "wall_s": round(wall, 2), "cpu_s": round(cpu, 2),
                 "render_wall_s": round(sum(float(m.get("render_wall_s", 0.0)) for m in metrics), 2),
                 "runs_wall_s": [round(float(m.get("wall_time_s", 0.0)), 2) for m in metrics],
+                "workers_used": [int(m.get("workers", 0)) for m in metrics],
             }
         elif args.method == "cleaning":
             command = ["experiment=cleaning", f"layout={args.layout}", f"runs={args.runs}",
