@@ -51,8 +51,13 @@ def usable_cpus() -> int:
 def _init_pool_worker(numba_threads: int, initializer, initargs: tuple) -> None:
     """First thing in a pool worker: its numba thread pool sized to its share of the CPUs, then ``initializer``."""
     import os
+    import sys
 
     os.environ["NUMBA_NUM_THREADS"] = str(numba_threads)  # read when numba is first imported in this worker
+    if "numba" in sys.modules:  # imported while unpickling the initializer: no parallel region has run yet
+        from numba.core import config
+
+        config.reload_config()
     if initializer is not None:
         initializer(*initargs)
 
