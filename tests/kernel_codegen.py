@@ -112,9 +112,9 @@ def _examples():
     # SIFT matching: descriptors float32, keys int64
     xa, da, na = z(16), z(16, 128, dtype=f32), z(16, dtype=i64)
     ex["sift_scan_core"] = (sift_kernels._scan_core,
-                            (z(16, dtype=np.int32), na, i64(0), na.copy(), True, 0, 16, i64(0)))
+                            (z(16, dtype=np.int32), na, i64(0), na.copy(), na.copy(), True, 0, 16, i64(0)))
     ex["sift_scan_edge"] = (sift_kernels._scan_edge,
-                            (z(16, dtype=np.int32), na, i64(0), na.copy(), True, 0, 16, i64(0), 0.0, 0.0, xa, xa,
+                            (z(16, dtype=np.int32), na, i64(0), na.copy(), na.copy(), True, 0, 16, i64(0), 0.0, 0.0, xa, xa,
                              1.0, 1.0))
     ex["sift_match_sorted"] = (sift_kernels.match_sorted,
                                (xa, xa, da, na, na, xa, xa, da, na, na, 1.0, 1.0, na.copy(), na.copy(), True))
