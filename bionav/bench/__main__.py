@@ -420,7 +420,8 @@ def _reference_round(command: list[str], folder: Path, batch: int) -> dict[str, 
         raise UserError(f"--reference {shown!r} ran for over an hour in one round; give it fewer home vectors "
                         "(--batch)") from None
     if proc.returncode != 0:
-        tail = " ".join(proc.stderr.strip().splitlines()[-3:]) or "no message"
+        lines = [line.strip() for line in proc.stderr.splitlines() if line.strip()]
+        tail = lines[-1] if lines else "no message"  # its last line (the error, not a traceback)
         raise UserError(f"--reference {shown!r} failed with status {proc.returncode} ({tail}); run it by hand as "
                         f"`{shown} DIR N` to see why")
     out: dict[str, float] = {}

@@ -28,6 +28,11 @@ class BenchParser(argparse.ArgumentParser):
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
+    def _print_message(self, message, file=None) -> None:
+        # argparse swallows a closed pipe here (--help | head -0 would exit 0 having printed nothing)
+        if message:
+            (file or sys.stderr).write(message)
+
 
 def bounded_int(parser: argparse.ArgumentParser, name: str, value: int, lo: int, hi: int, why: str = "") -> None:
     """Exit through ``parser.error`` unless ``lo <= value <= hi`` (one message naming ``name`` and the range)."""

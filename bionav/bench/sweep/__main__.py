@@ -42,10 +42,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--n-jobs", type=int, default=2, help="joblib workers (default: 2; 1..256)")
     args = parser.parse_args(argv)
     bounded_int(parser, "--n-jobs", args.n_jobs, 1, 256)
-    for option, group, value in (("--homing", "homing", args.homing), ("--db", "db", args.db)):
-        names = config_names(group)
-        if value not in names:
-            parser.error(f"{option} {value!r} is not a {group} config; choose one of {', '.join(names)}")
+    from bionav.registry import entry_points_of
+
+    homings = sorted(set(entry_points_of("homing")) | set(config_names("homing")))
+    if args.homing not in homings:
+        parser.error(f"--homing {args.homing!r} is not a homing method; choose one of {', '.join(homings)}")
+    dbs = config_names("db")
+    if args.db not in dbs:
+        parser.error(f"--db {args.db!r} is not a database config; choose one of {', '.join(dbs)}")
     key, sep, values = args.sweep.partition("=")
     if not sep or not key.strip() or not values.strip():
         parser.error(f"--sweep {args.sweep!r} is not KEY=V1,V2,...; e.g. --sweep homing.lowpass_sigma=0.02,0.04")
