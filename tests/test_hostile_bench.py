@@ -64,6 +64,7 @@ BENCH_CASES = [
     (["--grid", "no_such_db", "--grid-snapshots", "1"], "--grid"),
     (["--method", "sift", "--variants", "nope"], "--variants"),
     (["--method", "sift", "--sift-size", "1", "1"], "--sift-size"),
+    (["--method", "sift", "--sift-size", "4096", "1024"], "--sift-size"),
     (["--method", "sift", "--images", "1000000000"], "--images"),
     (["--method", "sift", "--db", "no_such_db", "--images", "2"], "--db"),
     (["--cpu-name", "no-such-cpu"], "--cpu-name"),

@@ -211,6 +211,8 @@ def _print_aligned(header, cells) -> None:
 #: bounds checked before any work (memory and time of one run)
 MAX_SIZE = (2048, 512)        #: --size W H (min-warping's window table grows with W x steps)
 MAX_RENDER = (4096, 1024)     #: --render-size W H (ray-cast with 2 x 2 rays per pixel)
+MAX_SIFT = (4096, 1024)       #: --sift-size W H
+MAX_SIFT_PIXELS = 1 << 20     #: W x H of --sift-size (170 images of 1 Mpx in float32: about 0.7 GB)
 MAX_STEPS = 1024
 MAX_REPEAT = 1000
 MAX_BATCH = 10_000
@@ -312,8 +314,10 @@ def _check_args(parser, args) -> None:
     bounded_int(parser, "--grid-snapshots", args.grid_snapshots, 1, 100_000)
     bounded_int(parser, "--grid-rounds", args.grid_rounds, 1, MAX_REPEAT)
     sw, sh = args.sift_size
-    if not (8 <= sw <= 8192 and 8 <= sh <= 8192):
-        parser.error(f"--sift-size W H must lie in 8..8192, got {sw} {sh}; e.g. --sift-size 1122 162")
+    if not (8 <= sw <= MAX_SIFT[0] and 8 <= sh <= MAX_SIFT[1] and sw * sh <= MAX_SIFT_PIXELS):
+        parser.error(f"--sift-size {sw} {sh} is out of range: W must lie in 8..{MAX_SIFT[0]}, H in 8..{MAX_SIFT[1]} "
+                     f"and W x H at most {MAX_SIFT_PIXELS} pixels (the whole grid is held in memory); "
+                     "e.g. --sift-size 1122 162")
     if args.images is not None and not (2 <= args.images <= 100_000):
         parser.error(f"--images must be >= 2 (and at most 100000), got {args.images}; e.g. --images 20")
     if args.cpu_features is not None and args.cpu_name is None:
