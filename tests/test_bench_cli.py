@@ -31,7 +31,7 @@ def test_bench_table_and_background_load(capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--threads", "0"], "--threads must lie in 1.."),
+    (["--threads", "0"], "--threads 0 is out of range: it must lie in 1..64"),
     (["--compass-fraction", "0"], "--compass-fraction 0.0 must lie in (0, 1]"),
     (["--method", "nope"], "invalid choice"),
 ])
