@@ -31,8 +31,8 @@ def test_bench_table_and_background_load(capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--threads", "0"], "--threads must lie in 1.."),
-    (["--compass-fraction", "0"], "--compass-fraction must lie in (0, 1]"),
+    (["--threads", "0"], "--threads 0 is out of range: it must lie in 1..64"),
+    (["--compass-fraction", "0"], "--compass-fraction 0.0 must lie in (0, 1]"),
     (["--method", "nope"], "invalid choice"),
 ])
 def test_bench_rejects_bad_arguments(capsys, argv, message):
@@ -81,7 +81,7 @@ def test_bench_sift_times_a_small_grid_per_variant(capsys):
 @pytest.mark.parametrize("argv, message", [
     (["--method", "sift", "--variants", "plain,nope"], "--variants must be a comma-separated list of plain, histeq"),
     (["--method", "sift", "--images", "1"], "--images must be >= 2"),
-    (["--method", "sift", "--sift-size", "4", "41"], "--sift-size W H must lie in 8..8192"),
+    (["--method", "sift", "--sift-size", "4", "41"], "--sift-size 4 41 is out of range: W must lie in 8..4096"),
 ])
 def test_bench_sift_rejects_bad_arguments(capsys, argv, message):
     with pytest.raises(SystemExit) as exc:
@@ -110,3 +110,30 @@ def test_bench_grid_mode_names_an_unknown_database(capsys):
         main(["--grid", "no_such_db"])
     assert exc.value.code == 2
     assert "--grid no_such_db" in capsys.readouterr().err
+
+
+def test_bench_sweep_with_more_workers_than_cpus(tmp_path):
+    """Issue 29: `--method sweep --workers N` with N > CPUs completes; the pool has min(tasks, CPUs) processes."""
+    import os
+    import subprocess
+    import sys
+
+    from helpers import write_tiny_folder
+
+    from bionav.experiments.common import usable_cpus
+
+    folder = write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
+    cpus = usable_cpus()
+    argv = ["--json", "--method", "sweep", "--sweep-grid", "full", "--dbs", "folder", "--workers", str(cpus + 2),
+            "--override", f"db.path={folder}", "--override", "experiment.grids.full.signature='mean'",
+            "--override", "experiment.grids.full.image_size='[32,8],[64,16]'",
+            "--override", "experiment.grids.full.preprocess='none,he'",
+            "--override", "experiment.rings=[5]"]
+    env = dict(os.environ, BIONAV_CACHE=str(tmp_path / "cache"))
+    proc = subprocess.run([sys.executable, "-m", "bionav.bench", *argv], capture_output=True, text=True, env=env,
+                          timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    (row,) = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
+    assert row["workers"] == cpus + 2
+    assert row["workers_used"] == [min(4, cpus)]  # 2 sizes x 2 preprocessings = 4 tasks
+    assert row["configurations"] == 2 * 2 * 1  # [mean] at one ring count, per size and preprocessing

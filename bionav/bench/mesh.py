@@ -14,7 +14,6 @@ Rows (CPU and wall time, warm-up excluded):
 
 from __future__ import annotations
 
-import argparse
 import json
 import time
 
@@ -28,13 +27,17 @@ def _timed(fn):
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m bionav.bench.mesh",
+    from bionav.bench._cli import BenchParser, bounded_int
+
+    parser = BenchParser(prog="python -m bionav.bench.mesh",
                                      description="Time the mesh renderer (CPU and wall ms; warm-up excluded).")
     parser.add_argument("--json", action="store_true", help="one JSON object per line")
     parser.add_argument("--threads", type=int, default=2, help="threads of the grid row (default: 2)")
-    parser.add_argument("--repeat", type=int, default=10, help="timed panoramas per pose (default: 10)")
-    parser.add_argument("--grid", type=int, default=20, help="grid side of the database row (default: 20)")
+    parser.add_argument("--repeat", type=int, default=10, help="timed panoramas per pose (default: 10; 1..1000)")
+    parser.add_argument("--grid", type=int, default=20, help="grid side of the database row (default: 20; 1..50)")
     args = parser.parse_args(argv)
+    bounded_int(parser, "--repeat", args.repeat, 1, 1000)
+    bounded_int(parser, "--grid", args.grid, 1, 50)
 
     import numba
 
@@ -43,8 +46,8 @@ def main(argv=None) -> int:
     from bionav.world.mesh import mesh_from_arrays
     from bionav.world.mesh_render import MeshWorld, render_mesh_panorama
 
-    if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
-        parser.error(f"--threads must lie in 1..{numba.config.NUMBA_NUM_THREADS}")
+    bounded_int(parser, "--threads", args.threads, 1, numba.config.NUMBA_NUM_THREADS,
+                " (numba's threads on this machine)")
     world = mesh_world(seville_world_path())
     g = PanoramaGeometry.square_pixels(561, 81)
     poses = [(3.0, 5.0, 0.01), (4.5, 6.5, 0.01), (5.1, 1.5, 0.01), (7.5, 2.0, 0.01)]
@@ -73,7 +76,11 @@ def main(argv=None) -> int:
     centres = rng.uniform([0, 0, 0], [10, 10, 0.8], size=(50_000, 3))
     soup = MeshWorld(mesh_from_arrays(centres[:, None, :] + rng.normal(0, 0.05, size=(50_000, 3, 3))))
     panorama_row("panorama_50k", soup, "random soup, median over 4 poses")
+    from bionav.bench.cpu import numba_target
+
+    target = numba_target()
     for r in rows:
+        r.update(target)
         if args.json:
             print(json.dumps(r))
         else:
@@ -83,4 +90,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from bionav.bench._cli import run
+
+    run(main, "python -m bionav.bench.mesh")

@@ -27,7 +27,39 @@ import tempfile
 import time
 from pathlib import Path
 
+from bionav.errors import UserError
+
 RUN_METHODS = ("sweep", "cleaning")
+#: at most this many worker processes (each a Python process with its own numba and images)
+MAX_WORKERS = 256
+MAX_RUNS = 1000
+
+
+def config_names(group: str) -> list[str]:
+    """Names of the packaged configs of one group (``bionav/conf/<group>/*.yaml``)."""
+    folder = Path(__file__).resolve().parent.parent / "conf" / group
+    return sorted(p.stem for p in folder.glob("*.yaml"))
+
+
+def check_arguments(parser, args) -> None:
+    """The whole-run options against their bounds and the packaged names, before any work."""
+    from bionav.bench._cli import bounded_int
+
+    bounded_int(parser, "--workers", args.workers, 1, MAX_WORKERS)
+    bounded_int(parser, "--runs", args.runs, 1, MAX_RUNS)
+    dbs = [d.strip() for d in args.dbs.split(",") if d.strip()]
+    if not dbs:
+        parser.error(f"--dbs {args.dbs!r} names no database; e.g. --dbs sim_original,sim_hall1,sim_uni")
+    known = config_names("db")
+    bad = [d for d in dbs if d not in known]
+    if bad:
+        parser.error(f"--dbs: no database config named {', '.join(bad)}; choose from {', '.join(known)}")
+    layouts = config_names("layout")
+    if args.layout not in layouts:
+        parser.error(f"--layout {args.layout!r} is not a layout; choose one of {', '.join(layouts)}")
+    for item in args.override:
+        if "=" not in item or item.startswith("="):
+            parser.error(f"--override {item!r} is not KEY=VALUE; e.g. --override layout.n_lanes=3")
 
 
 def add_arguments(parser) -> None:
@@ -55,23 +87,42 @@ def _children_cpu() -> float:
 
 
 def _run(args: list[str], *, cwd: Path, env: dict) -> tuple[float, float]:
-    """Run ``python -m bionav args``; return (wall s, CPU s of it and its waited-for children)."""
+    """Run ``python -m bionav args``; return (wall s, CPU s of it and its waited-for children).
+
+    On failure the error of every failed job (its metrics.json, in ``cwd``)
+    goes into the message: the temporary directory is removed afterwards.
+    """
     c0, t0 = _children_cpu(), time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "bionav", *args], cwd=cwd, env=env, capture_output=True, text=True)
     wall, cpu = time.perf_counter() - t0, _children_cpu() - c0
     if proc.returncode != 0:
-        raise SystemExit(f"python -m bionav {' '.join(args)} failed:\n{proc.stderr[-3000:]}")
+        lines = [line for line in proc.stderr.splitlines() if line.strip() and not line.startswith("[")]
+        why = lines[-1].strip() if lines else f"exit status {proc.returncode}"
+        errors = sorted({str(m.get("error")) for m in _metrics(cwd) if m.get("status") == "failed"})
+        if errors:
+            why = f"{why} Job errors: {'; '.join(e[:300] for e in errors[:3])}"
+        raise UserError(f"the benchmarked run `python -m bionav {' '.join(a for a in args if 'dir=' not in a)}` "
+                        f"failed (status {proc.returncode}): {why}. Run that command by hand to see its log; "
+                        "fix the option it names (--override, --dbs, --layout)")
     return wall, cpu
 
 
 def _metrics(root: Path) -> list[dict]:
-    return [json.loads(p.read_text()) for p in sorted(root.rglob("metrics.json"))]
+    out = []
+    for p in sorted(root.rglob("metrics.json")):
+        try:
+            data = json.loads(p.read_text())
+        except (OSError, ValueError):
+            continue
+        if isinstance(data, dict):
+            out.append(data)
+    return out
 
 
 def run_benchmark(args) -> list[dict]:
     """Rows (one dict) of the whole-run benchmark ``args.method``."""
-    if args.workers < 1:
-        raise SystemExit("--workers must be >= 1")
+    from bionav.bench.cpu import numba_target
+
     machine = f"{platform.machine()} {os.cpu_count()} cpus"
     with tempfile.TemporaryDirectory(prefix="bionav-bench-") as tmp:
         tmp = Path(tmp)
@@ -80,7 +131,7 @@ def run_benchmark(args) -> list[dict]:
             env["BIONAV_CACHE"] = str(tmp / "cache")
         load_before = os.getloadavg()[0]
         if args.method == "sweep":
-            dbs = [d for d in args.dbs.split(",") if d]
+            dbs = [d.strip() for d in args.dbs.split(",") if d.strip()]
             command = ["-m", "experiment=param_sweep_grid", f"experiment.grid={args.sweep_grid}", f"db={','.join(dbs)}",
                        f"workers={args.workers}", f"hydra.sweep.dir={tmp / 'sweep'}"]
             if args.cold:
@@ -94,10 +145,9 @@ def run_benchmark(args) -> list[dict]:
                 "workers": args.workers, "wall_s": round(wall, 2), "cpu_s": round(cpu, 2),
                 "render_wall_s": round(sum(float(m.get("render_wall_s", 0.0)) for m in metrics), 2),
                 "runs_wall_s": [round(float(m.get("wall_time_s", 0.0)), 2) for m in metrics],
+                "workers_used": [int(m.get("workers", 0)) for m in metrics],
             }
         elif args.method == "cleaning":
-            if args.runs < 1:
-                raise SystemExit("--runs must be >= 1")
             command = ["experiment=cleaning", f"layout={args.layout}", f"runs={args.runs}",
                        f"workers={args.workers}", f"hydra.run.dir={tmp / 'cleaning'}", *args.override]
             wall, cpu = _run(command, cwd=tmp, env=env)
@@ -111,5 +161,6 @@ def run_benchmark(args) -> list[dict]:
         else:  # pragma: no cover - argparse restricts the choices
             raise SystemExit(f"unknown method {args.method!r}")
         row.update({"loadavg_1min": [round(load_before, 2), round(os.getloadavg()[0], 2)], "machine": machine,
+                    **numba_target(),
                     "command": "python -m bionav " + " ".join(c for c in command if "dir=" not in c)})
     return [row]

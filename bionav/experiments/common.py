@@ -39,6 +39,30 @@ def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageD
     return db
 
 
+def usable_cpus() -> int:
+    """CPUs this process may run on (its affinity mask; ``os.cpu_count()`` where there is none)."""
+    import os
+
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # pragma: no cover - platforms without affinity
+        return max(1, os.cpu_count() or 1)
+
+
+def _init_pool_worker(numba_threads: int, initializer, initargs: tuple) -> None:
+    """First thing in a pool worker: its numba thread pool sized to its share of the CPUs, then ``initializer``."""
+    import os
+    import sys
+
+    os.environ["NUMBA_NUM_THREADS"] = str(numba_threads)  # read when numba is first imported in this worker
+    if "numba" in sys.modules:  # imported while unpickling the initializer: no parallel region has run yet
+        from numba.core import config
+
+        config.reload_config()
+    if initializer is not None:
+        initializer(*initargs)
+
+
 @contextlib.contextmanager
 def worker_pool(workers: int, *, initializer=None, initargs: tuple = ()):
     """A pool of ``workers`` spawned processes that is torn down at once when the run stops.
@@ -47,13 +71,23 @@ def worker_pool(workers: int, *, initializer=None, initargs: tuple = ()):
     an exception (a failed task, Ctrl-C) the workers are terminated, so an
     interrupted run does not wait for the tasks still queued.
 
+    The pool has at most :func:`usable_cpus` processes (more processes than
+    CPUs only add memory and start-up time to CPU-bound tasks), and each
+    worker's numba thread pool gets its share of the CPUs
+    (``NUMBA_NUM_THREADS = max(1, CPUs // processes)``): without it every
+    worker starts one numba thread per CPU (the renderer's parallel loops),
+    ``workers x CPUs`` threads in all (256 with 16 workers on 16 cores).
+
     Yields
     ------
     multiprocessing.pool.Pool
     """
     from multiprocessing import get_context
 
-    pool = get_context("spawn").Pool(int(workers), initializer=initializer, initargs=initargs)
+    cpus = usable_cpus()
+    n = max(1, min(int(workers), cpus))
+    pool = get_context("spawn").Pool(n, initializer=_init_pool_worker,
+                                     initargs=(max(1, cpus // n), initializer, tuple(initargs)))
     try:
         yield pool
     except BaseException:

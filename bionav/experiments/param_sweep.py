@@ -378,7 +378,7 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
     Stand-ins not yet in the cache are rendered first, one size per task.
     """
     from bionav.config import plugin_config
-    from bionav.experiments.common import worker_pool
+    from bionav.experiments.common import usable_cpus, worker_pool
     from bionav.plugins.signatures import signature_class
     from bionav.report.ranking import write_parameter_report
 
@@ -406,7 +406,8 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
                      success_radius=float(exp.success_radius))
     renders = [dataclasses.replace(base, size=size) for size in sizes]
     tasks = [dataclasses.replace(base, size=size, preprocess=pre) for size in sizes for pre in preprocessings]
-    workers = max(1, min(int(cfg.get("workers") or 1), len(tasks)))
+    # never more processes than tasks or CPUs (worker_pool caps at the CPUs as well; recorded as used)
+    workers = max(1, min(int(cfg.get("workers") or 1), len(tasks), usable_cpus()))
     name = str(base.db_node.get("name", "db"))
     rows: list[dict[str, Any]] = []
     t0 = time.perf_counter()

@@ -191,6 +191,11 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
     for j in range(n_b):
         base_b[j] = nbs[j] * _SHIFT + rb[j]
     buf = np.empty((GROUP, n_b), np.int32)
+    # key_b's running minima over the rows of a group: row by row into the
+    # other of two buffers (an in-place minimum of int64 compiles to masked
+    # stores on AVX2), copied in and out once per segment
+    kb_cur = np.empty(n_b, np.int64)
+    kb_nxt = np.empty(n_b, np.int64)
     for g0 in range(0, n_a, GROUP):
         g1 = min(g0 + GROUP, n_a)
         if inside_image:
@@ -218,6 +223,8 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
                 t8 = _dot8(da, g0, db, j)
                 for t in range(GROUP):
                     buf[t, j] = t8[t]
+            if symmetric:
+                kb_cur[start:stop] = key_b[start:stop]
             for t in range(g1 - g0):
                 i = g0 + t
                 xi = xa[i]
@@ -239,29 +246,40 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
                 base_a = na[i] * _SHIFT + ra[i]
                 row = buf[t]
                 # pieces [c0, c1) core, [c1, c2) edge, [c2, c3) core, [c3, c4) edge, [c4, c5) core
-                best = _scan_core(row, base_b, base_a, key_b, symmetric, c0, c1, best)
-                best = _scan_edge(row, base_b, base_a, key_b, symmetric, c1, c2, best, xi, yi, xb, yb, width, r2)
-                best = _scan_core(row, base_b, base_a, key_b, symmetric, c2, c3, best)
-                best = _scan_edge(row, base_b, base_a, key_b, symmetric, c3, c4, best, xi, yi, xb, yb, width, r2)
-                best = _scan_core(row, base_b, base_a, key_b, symmetric, c4, c5, best)
+                # the pieces partition [start, stop): every entry of kb_nxt there is written once
+                best = _scan_core(row, base_b, base_a, kb_cur, kb_nxt, symmetric, c0, c1, best)
+                best = _scan_edge(row, base_b, base_a, kb_cur, kb_nxt, symmetric, c1, c2, best, xi, yi, xb, yb,
+                                  width, r2)
+                best = _scan_core(row, base_b, base_a, kb_cur, kb_nxt, symmetric, c2, c3, best)
+                best = _scan_edge(row, base_b, base_a, kb_cur, kb_nxt, symmetric, c3, c4, best, xi, yi, xb, yb,
+                                  width, r2)
+                best = _scan_core(row, base_b, base_a, kb_cur, kb_nxt, symmetric, c4, c5, best)
                 if c5 == start:  # no core: the whole range with the test
-                    best = _scan_edge(row, base_b, base_a, key_b, symmetric, start, stop, best, xi, yi, xb, yb,
-                                      width, r2)
+                    best = _scan_edge(row, base_b, base_a, kb_cur, kb_nxt, symmetric, start, stop, best, xi, yi,
+                                      xb, yb, width, r2)
                 key_a[i] = best
+                kb_cur, kb_nxt = kb_nxt, kb_cur
+            if symmetric:
+                key_b[start:stop] = kb_cur[start:stop]
 
 
 @nb.njit(nogil=True, cache=True)
-def _scan_core(row, base_b, base_a, key_b, symmetric, start, stop, best):
-    """Keys of candidates ``start .. stop - 1``, all inside the radius; returns the row's best key."""
+def _scan_core(row, base_b, base_a, kb_in, kb_out, symmetric, start, stop, best):
+    """Keys of candidates ``start .. stop - 1``, all inside the radius; returns the row's best key.
+
+    With ``symmetric``, ``kb_out[j] = min(kb_in[j], key of this row)`` for
+    ``j`` in ``start .. stop - 1`` (two buffers: no in-place stores).
+    """
     # slices and loops from 0: indices the compiler knows are non-negative vectorise without gathers
     dots = row[start:stop]
     bb = base_b[start:stop]
     if symmetric:
-        kb = key_b[start:stop]
+        ki = kb_in[start:stop]
+        ko = kb_out[start:stop]
         for j in range(dots.shape[0]):
             d = np.int64(dots[j]) * _TWO_SHIFT
             best = min(best, bb[j] - d)
-            kb[j] = min(kb[j], base_a - d)
+            ko[j] = min(ki[j], base_a - d)
     else:
         for j in range(dots.shape[0]):
             best = min(best, bb[j] - np.int64(dots[j]) * _TWO_SHIFT)
@@ -269,13 +287,15 @@ def _scan_core(row, base_b, base_a, key_b, symmetric, start, stop, best):
 
 
 @nb.njit(nogil=True, cache=True)
-def _scan_edge(row, base_b, base_a, key_b, symmetric, start, stop, best, xi, yi, xb, yb, width, r2):
-    """Keys of candidates ``start .. stop - 1`` with the exact neighbourhood test (eq. 5.3)."""
+def _scan_edge(row, base_b, base_a, kb_in, kb_out, symmetric, start, stop, best, xi, yi, xb, yb, width, r2):
+    """Keys of candidates ``start .. stop - 1`` with the exact neighbourhood test (eq. 5.3); ``kb_out`` as in
+    :func:`_scan_core`."""
     dots = row[start:stop]
     bb = base_b[start:stop]
     xs = xb[start:stop]
     ys = yb[start:stop]
-    kb = key_b[start:stop] if symmetric else key_b[:0]
+    ki = kb_in[start:stop] if symmetric else kb_in[:0]
+    ko = kb_out[start:stop] if symmetric else kb_out[:0]
     for j in range(dots.shape[0]):
         dx = abs(xi - xs[j])
         dx = min(dx, width - dx)
@@ -284,7 +304,7 @@ def _scan_edge(row, base_b, base_a, key_b, symmetric, start, stop, best, xi, yi,
         d = np.int64(dots[j]) * _TWO_SHIFT
         best = min(best, bb[j] - d if inside else _NONE)
         if symmetric:
-            kb[j] = min(kb[j], base_a - d if inside else _NONE)
+            ko[j] = min(ki[j], base_a - d if inside else _NONE)
     return best
 
 

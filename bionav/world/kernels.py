@@ -304,9 +304,11 @@ def _candidates(ox, oy, oz, az, margin, prim_kind, prim_idx, boxes, frusta, ells
             continue
         width = az_hi[p] - az_lo[p]
         for j in range(W):
-            if (az[j] - az_lo[p]) % two_pi <= width:
-                cands[j, counts[j]] = p
-                counts[j] += 1
+            # written unconditionally, counted where the column lies in the
+            # primitive's azimuth range (no conditional store; counts[j] <= q < n,
+            # and entries from counts[j] on are never read)
+            cands[j, counts[j]] = p
+            counts[j] += (az[j] - az_lo[p]) % two_pi <= width
     return cands, counts, el_lo, el_hi, rho_min
 
 

@@ -13,14 +13,14 @@ warm-up. Printed: one JSON object per decoder with ``decoder``, ``n_samples``,
 
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 import time
 
 import numpy as np
 
 DECODERS = ("sky_fit", "two_unit", "sol", "four_zeros", "eigenvector", "mean_vector")
+#: readings per session at most (rotations x samples; about 0.3 kB of memory each)
+MAX_READINGS = 200_000
 
 
 def _session(rotations: int, samples: int, seed: int):
@@ -43,17 +43,22 @@ def _session(rotations: int, samples: int, seed: int):
 
 def main(argv=None) -> int:
     from bionav import registry
+    from bionav.bench._cli import BenchParser, bounded_int
 
-    parser = argparse.ArgumentParser(prog="python -m bionav.bench.decoders",
+    parser = BenchParser(prog="python -m bionav.bench.decoders",
                                      description="Time POL-OP decoders per session (CPU and wall ms, warm-up excluded).")
     parser.add_argument("--decoder", choices=DECODERS + ("all",), default="all", help="decoder to time (default: all)")
     parser.add_argument("--rotations", type=int, default=12, help="rotations per session (default: 12)")
     parser.add_argument("--samples", type=int, default=412, help="samples per rotation (default: 412)")
     parser.add_argument("--repeat", type=int, default=5, help="timed calls (default: 5)")
     args = parser.parse_args(argv)
-    if args.rotations < 1 or args.samples < 8 or args.repeat < 1:
-        print("--rotations, --repeat must be >= 1 and --samples >= 8.", file=sys.stderr)
-        return 2
+    bounded_int(parser, "--rotations", args.rotations, 1, 1000)
+    bounded_int(parser, "--samples", args.samples, 8, MAX_READINGS)
+    bounded_int(parser, "--repeat", args.repeat, 1, 1000)
+    if args.rotations * args.samples > MAX_READINGS:
+        parser.error(f"--rotations {args.rotations} x --samples {args.samples} = {args.rotations * args.samples} "
+                     f"readings is more than {MAX_READINGS} per session; lower --samples or --rotations "
+                     f"(e.g. --samples {max(8, MAX_READINGS // args.rotations)})")
     array, ev, valid, ev_ms = _session(args.rotations, args.samples, 0)
     names = DECODERS if args.decoder == "all" else (args.decoder,)
     for name in names:
@@ -74,4 +79,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from bionav.bench._cli import run
+
+    run(main, "python -m bionav.bench.decoders")

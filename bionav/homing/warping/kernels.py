@@ -111,7 +111,15 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     """
     _, n_planes, width, step, n = levels.shape
     n_p = p_cols.shape[0]
-    best = np.empty(n_p * n, dtype=levels.dtype)
+    # two buffers of running minima, used in turn: each window's minima are
+    # written into the other buffer (``nxt = min(cur, x)``), never in place.
+    # An in-place minimum (``if x < best: best = x``, and even
+    # ``best = min(best, x)`` for 32-bit lanes) vectorises only with masked
+    # stores, which AVX2 lacks for bytes (the loop then stays scalar) and runs
+    # slowly for floats; a separate output compiles to plain packed
+    # ``vpminub`` / ``vminps`` and stores on AVX2 and AVX-512 alike.
+    cur = np.empty(n_p * n, dtype=levels.dtype)
+    nxt = np.empty(n_p * n, dtype=levels.dtype)
     row_stride = step * n
     flat = levels.reshape(-1)
     plane_size = width * row_stride
@@ -119,12 +127,12 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
     # snapshot columns in phase order (u = rr, rr + step, ...): one phase reads
     # a third of the table (step 3), which keeps the reads in cache; per window
     # all rotations at once (the window's plane and level stay fixed); the
-    # first window of a column is copied, the others compared and selected
-    # (packed byte compares). The minima are kept over whole rows (column
-    # i // step of the snapshot, any alpha) and added to the match values of
-    # alpha step (i // step - u // step) mod n afterwards, so that the table
-    # holds every distance once. The inner loops index flat arrays with
-    # unsigned offsets (no array views per window and rotation).
+    # first window of a column is copied, the others combined by packed
+    # minima. The minima are kept over whole rows (column i // step of the
+    # snapshot, any alpha) and added to the match values of alpha step
+    # (i // step - u // step) mod n afterwards, so that the table holds every
+    # distance once. The inner loops index flat arrays with unsigned offsets
+    # (no array views per window and rotation).
     for rr in range(step):
         for u in range(rr, width, step):
             e0 = start[u]
@@ -140,18 +148,17 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
                     if first:
                         for a in range(n):
                             ua = np.uint64(a)
-                            best[bb + ua] = flat[base + ua]
+                            nxt[bb + ua] = flat[base + ua]
                     else:
                         for a in range(n):
                             ua = np.uint64(a)
-                            x = flat[base + ua]
-                            if x < best[bb + ua]:
-                                best[bb + ua] = x
+                            nxt[bb + ua] = min(cur[bb + ua], flat[base + ua])
+                cur, nxt = nxt, cur
             if e1 == e0:
-                best[:] = big
+                cur[:] = big
             for ip in range(n_p):
                 acc = out[ip]
-                b = best[ip * n:(ip + 1) * n]
+                b = cur[ip * n:(ip + 1) * n]
                 # slices: plain contiguous loops (indices ``a + off`` would
                 # keep them from vectorising)
                 b1 = b[off:]
@@ -186,7 +193,10 @@ def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
     _, n_planes, width, step, _ = levels.shape
     n_t = a_cols.shape[0]
     total = np.zeros(n_t)
-    best = np.empty(n_t)
+    # running minima in two buffers used in turn (no in-place or conditional
+    # stores, see :func:`minwarp_scores`)
+    cur = np.empty(n_t)
+    nxt = np.empty(n_t)
     rr_t = np.empty(n_t, np.int64)
     m_t = np.empty(n_t, np.int64)
     p_t = np.empty(n_t, np.int64)
@@ -199,16 +209,15 @@ def minwarp_scores_at(levels, a_cols, p_cols, start, w_plane, w_level, w_v):
             i = (u + a_cols[t]) % width
             m_t[t] = i // step
             rr_t[t] = i - m_t[t] * step
-            best[t] = np.inf
+            cur[t] = np.inf
         for e in range(start[u], start[u + 1]):
             plane = levels[w_level[e], w_plane[e]]
             v0 = w_v[e] - u
             for t in range(n_t):
-                x = np.float64(plane[_wrap(v0 - p_t[t], width), rr_t[t], m_t[t]])
-                if x < best[t]:
-                    best[t] = x
+                nxt[t] = min(cur[t], np.float64(plane[_wrap(v0 - p_t[t], width), rr_t[t], m_t[t]]))
+            cur, nxt = nxt, cur
         for t in range(n_t):
-            total[t] += best[t]
+            total[t] += cur[t]
     return total
 
 
@@ -245,7 +254,10 @@ def minwarp_scores_runs(levels, a_first, n_a, p_cols, start, w_plane, w_level, w
     flat = levels.reshape(-1)
     n_p = p_cols.shape[0]
     total = np.zeros((n_p, n_a))
-    best = np.empty((n_p, n_a))
+    # running minima in two buffers used in turn (no in-place or conditional
+    # stores, see :func:`minwarp_scores`)
+    cur = np.empty((n_p, n_a))
+    nxt = np.empty((n_p, n_a))
     offs = np.empty((n_p, n_a), np.uint64)
     p_t = np.empty(n_p, np.int64)
     for t in range(n_p):
@@ -259,7 +271,7 @@ def minwarp_scores_runs(levels, a_first, n_a, p_cols, start, w_plane, w_level, w
             r = i - m * step
             for a in range(n_a):
                 offs[t, a] = np.uint64(r * m2 + m)
-                best[t, a] = np.inf
+                cur[t, a] = np.inf
                 i += 1
                 r += 1
                 if r == step:
@@ -274,15 +286,15 @@ def minwarp_scores_runs(levels, a_first, n_a, p_cols, start, w_plane, w_level, w
             v0 = w_v[e] - u
             for t in range(n_p):
                 rb = np.uint64((base + _wrap(v0 - p_t[t], width)) * row)
-                bt = best[t]
+                bt = cur[t]
+                nt = nxt[t]
                 ot = offs[t]
                 for a in range(n_a):
-                    x = np.float64(flat[rb + ot[a]])
-                    if x < bt[a]:
-                        bt[a] = x
+                    nt[a] = min(bt[a], np.float64(flat[rb + ot[a]]))
+            cur, nxt = nxt, cur
         for t in range(n_p):
             for a in range(n_a):
-                total[t, a] += best[t, a]
+                total[t, a] += cur[t, a]
     return total
 
 
@@ -368,23 +380,26 @@ def compass_measure(dist, p_cols):
     n_planes, width, step, m2 = dist.shape
     n = width // step
     out = np.zeros(p_cols.shape[0])
-    best = np.empty(n, dtype=dist.dtype)
+    cur = np.empty(n, dtype=dist.dtype)
+    nxt = np.empty(n, dtype=dist.dtype)
     # per rotation one diagonal d: the minimum over the planes is taken on
-    # whole rows (packed byte minima), then summed
+    # whole rows (packed minima into the other of two buffers: an in-place
+    # minimum of floats compiles to masked stores on AVX2), then summed
     for ip in range(p_cols.shape[0]):
         d = (-p_cols[ip]) % width
         total = 0.0
         for rr in range(step):
             row = dist[0, d, rr]
             for m in range(n):
-                best[m] = row[m]
+                cur[m] = row[m]
             for k in range(1, n_planes):
                 row = dist[k, d, rr]
                 for m in range(n):
-                    best[m] = min(best[m], row[m])
+                    nxt[m] = min(cur[m], row[m])
+                cur, nxt = nxt, cur
             s = 0.0
             for m in range(n):
-                s += np.float64(best[m])
+                s += np.float64(cur[m])
             total += s
         out[ip] = total
     return out
