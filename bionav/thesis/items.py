@@ -229,8 +229,8 @@ def write_table(ctx: Context, out: Outcome, name: str, title: str, rows: Sequenc
 
 
 def compare_bars(path: Path, labels: Sequence[str], series: Mapping[str, Sequence[Any]], *, title: str,
-                 ylabel: str = "") -> None:
-    """Grouped bars (thesis vs bionav values) per label."""
+                 ylabel: str) -> None:
+    """Grouped bars (thesis vs bionav values) per label; ``ylabel`` names the quantity and its unit."""
     from bionav.report.figures import pyplot, save_figure
 
     plt = pyplot()
@@ -242,7 +242,7 @@ def compare_bars(path: Path, labels: Sequence[str], series: Mapping[str, Sequenc
     ax.set_xticks(range(len(labels)), labels, rotation=30, ha="right", fontsize=8)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=9)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))  # beside the bars, covering none
     save_figure(fig, path, dpi=100)
 
 
@@ -370,7 +370,8 @@ class _Table53:
         out.checks.append(rho_check("AAE* across databases", ref["aae"], v["aae"]))
         write_table(ctx, out, "table5_3.md", ref["title"], out.rows)
         compare_bars(ctx.figure("table5_3.png"), [f"{m} {d}" for m in ("AAE*", "RR*") for d in THESIS_DBS],
-                     {"thesis": [*ref["aae"], *ref["rr"]], "bionav": [*v["aae"], *v["rr"]]}, title=ref["title"])
+                     {"thesis": [*ref["aae"], *ref["rr"]], "bionav": [*v["aae"], *v["rr"]]}, title=ref["title"],
+                     ylabel="AAE* (rad) | RR* (fraction of agents home)")
         out.figures.append("table5_3.png")
         return out
 
@@ -511,7 +512,7 @@ class _Fig55:
 
     @staticmethod
     def evaluate(ctx: Context, specs: list[RunSpec]) -> Outcome:
-        from bionav.report.figures import pyplot, save_figure
+        from bionav.report.figures import grid_cell_axes, pyplot, save_figure
 
         out = Outcome()
         sizes = ctx.preset.fig55_sizes
@@ -541,9 +542,8 @@ class _Fig55:
                     ax = axes[2 * e + r, i]
                     im = ax.imshow(grid, origin="lower", cmap="viridis", vmin=0, vmax=1 if col == 3 else None)
                     ax.set_title(f"{lab}, {s[0]}x{s[1]}, {eq}", fontsize=8)
-                    ax.set_xlabel("x (grid)", fontsize=7)
-                    ax.set_ylabel("y (grid)", fontsize=7)
-                    fig.colorbar(im, ax=ax, shrink=0.7)
+                    grid_cell_axes(ax, fontsize=7)
+                    fig.colorbar(im, ax=ax, shrink=0.7, label="AAE_s (rad)" if col == 2 else "RR_s")
         fig.suptitle("SIFT homing on sim_original: per-snapshot AAE_s and RR_s (thesis fig. 5.5)", fontsize=9)
         save_figure(fig, ctx.figure("fig5_5.png"), dpi=90)
         out.figures.append("fig5_5.png")
@@ -954,7 +954,8 @@ def _lda_item(table: str, data: str):
             compare_bars(ctx.figure(f"{table}.png"), list(FEATURES),
                          {"thesis J": [ref["J"][f] for f in FEATURES], "bionav J": [got["J"].get(f) for f in FEATURES],
                           "thesis J_sigma": [ref["J_sigma"][f] for f in FEATURES],
-                          "bionav J_sigma": [got["J_sigma"].get(f) for f in FEATURES]}, title=ref["title"])
+                          "bionav J_sigma": [got["J_sigma"].get(f) for f in FEATURES]}, title=ref["title"],
+                         ylabel="J, J_sigma (Fisher criterion, dimensionless)")
             out.figures.append(f"{table}.png")
             out.notes.append(f"Simulated samples (data={data}); the thesis' measured samples are not available.")
             return out
