@@ -227,7 +227,7 @@ def test_cli_bad_input_is_one_clear_message(tmp_path):
     proc = run_bionav("--only", "nope", "--out", str(tmp_path / "x"), cwd=tmp_path, module="bionav.thesis")
     assert proc.returncode == 2 and "unknown item 'nope'" in proc.stderr and "Traceback" not in proc.stderr
     proc = run_bionav("--preset", "huge", "--out", str(tmp_path / "x"), cwd=tmp_path, module="bionav.thesis")
-    assert proc.returncode == 2 and "unknown --preset 'huge'" in proc.stderr
+    assert proc.returncode == 2 and "unknown --preset 'huge'" in proc.stderr and "tiny" in proc.stderr
     (tmp_path / "file").write_text("")
     proc = run_bionav("--out", str(tmp_path / "file"), "--only", "3.1", cwd=tmp_path, module="bionav.thesis")
     assert proc.returncode == 2 and "is a file" in proc.stderr
