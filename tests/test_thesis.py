@@ -125,6 +125,10 @@ def test_report_keeps_the_asterisks_of_aae_mae_rr(tmp_path):
         assert text in page, text
     assert "<i>" not in page.replace("<i>Source:</i>", "").replace("<i>Verdict:</i>", "").replace("<i>Rule:</i>", "")
     assert "<b>holds</b>" in page  # real emphasis still renders
+    from bionav.thesis.items import markdown
+
+    table = markdown(["quantity", "thesis"], [["SIFT AAE* original", 0.2663], ["J: UV-IR vs All", "***"]])
+    assert "| SIFT AAE\\* original | 0.2663 |" in table and "| J: UV-IR vs All | \\*\\*\\* |" in table
 
 
 def test_select_items_by_id_and_thesis_number():

@@ -210,8 +210,14 @@ def read_csv(path: Path) -> list[dict[str, str]]:
 
 
 def markdown(header: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
+    """A Markdown table; text cells keep their asterisks (``AAE*``, ``***``) and pipes escaped."""
+    from bionav.thesis.report import md_text
+
+    def cell(v: Any) -> str:
+        return md_text(fmt(v) if not isinstance(v, str) else v).replace("|", "\\|")
+
     lines = ["| " + " | ".join(map(str, header)) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(fmt(v) if not isinstance(v, str) else v for v in r) + " |" for r in rows]
+    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
     return "\n".join(lines) + "\n"
 
 
