@@ -6,6 +6,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from test_cleaning_experiment import controllers  # noqa: F401  (fixture)
 
 from bionav.report.figures import pyplot
 
@@ -119,3 +120,21 @@ def test_thesis_bar_charts_have_a_y_label_and_a_legend_beside_the_bars(tmp_path,
     (fig,) = figures()
     assert fig.axes[0].get_ylabel() == "AAE* (rad) | RR* (fraction of agents home)"
     assert _legend_clear_of_axes(fig, fig.axes[0])
+
+
+@pytest.mark.usefixtures("controllers")
+def test_cleaning_legends_stand_beside_or_below_the_maps(tmp_path, figures):
+    from test_cleaning_experiment import config
+
+    from bionav.experiments.runner import run_experiment
+
+    run_experiment(config("odometry"), tmp_path, show_progress=False)
+    by_title = {f.axes[0].get_title(): f for f in figures() if f.axes}
+    traj = next(f for t, f in by_title.items() if t.startswith("Trajectories"))
+    layout = next(f for t, f in by_title.items() if t.startswith("Layout in the world"))
+    for fig in (traj, layout):
+        ax = fig.axes[0]
+        assert ax.get_xlabel().endswith("(m)") and ax.get_ylabel().endswith("(m)")
+        assert _legend_clear_of_axes(fig, ax)
+    labels = [t.get_text() for t in traj.axes[0].get_legend().get_texts()]
+    assert labels[:3] == ["obstacle outlines", "target area", "ideal meander"] and len(labels) == 3 + 2  # 2 runs
