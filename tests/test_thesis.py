@@ -107,6 +107,13 @@ def test_an_item_without_completed_runs_is_not_produced():
     assert gone.verdict == "not produced" and gone.score == (0, 0)
     assert (gone.rows, gone.checks, gone.figures, gone.missing, gone.notes) == ([], [], [], ["run x: not run"], ["a note"])
     assert Outcome().without_runs(3).missing == ["none of the item's 3 runs completed"]
+    # an ordering claim over five databases with two runs missing is not evaluated (it used to fail on 3 values)
+    from bionav.thesis.items import rho_check
+
+    partial = rho_check("RR*", [0.9, 0.8, 0.7, 0.6, 0.5], [0.5, None, 0.9, None, 0.6])
+    assert partial.passed is None and "2 of 5 values missing" in partial.detail
+    assert rho_check("RR*", [0.9, 0.8, 0.7], [0.5, 0.7, 0.9]).passed is False
+    assert rho_check("RR*", [0.9, 0.8, 0.7], [0.95, 0.85, 0.6]).passed is True
 
 
 def test_report_keeps_the_asterisks_of_aae_mae_rr(tmp_path):
