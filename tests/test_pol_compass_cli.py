@@ -4,6 +4,8 @@ import json
 
 from helpers import run_bionav
 
+from bionav.logs.reader import read_metadata
+
 
 def _metrics(run_dir):
     data = json.loads((run_dir / "metrics.json").read_text())
@@ -21,6 +23,9 @@ def test_rotation_then_replay_from_the_command_line(tmp_path):
     recorded = _metrics(rec)
     assert recorded["status"] == "completed" and recorded["heading_rmse_deg"] <= 1.0
     log = rec / "run.mcap"
+    plugins = read_metadata(log)["plugins"]  # the compass homes on nothing: no default homing=sift recorded
+    assert "homing" not in plugins and "signature" not in plugins
+    assert plugins["sensor"].startswith("polcompass_sim ") and plugins["pantilt"].startswith("sim ")
     rep = tmp_path / "rep"
     proc = run_bionav(
         "experiment=pol_compass",

@@ -99,6 +99,45 @@ def test_verdict_rule():
     assert spearman([1, 1], [1, 2]) is None
 
 
+def test_an_item_without_completed_runs_is_not_produced():
+    out = Outcome(rows=[Row("SIFT AAE* original", 0.27, None, 0.1)], checks=[Check("ordering", False)],
+                  figures=["table5_3.png"], missing=["run x: not run"], notes=["a note"])
+    assert out.verdict == "does not hold"  # what the report said before issue 32
+    gone = out.without_runs(5)
+    assert gone.verdict == "not produced" and gone.score == (0, 0)
+    assert (gone.rows, gone.checks, gone.figures, gone.missing, gone.notes) == ([], [], [], ["run x: not run"], ["a note"])
+    assert Outcome().without_runs(3).missing == ["none of the item's 3 runs completed"]
+    # an ordering claim over five databases with two runs missing is not evaluated (it used to fail on 3 values)
+    from bionav.thesis.items import rho_check
+
+    partial = rho_check("RR*", [0.9, 0.8, 0.7, 0.6, 0.5], [0.5, None, 0.9, None, 0.6])
+    assert partial.passed is None and "2 of 5 values missing" in partial.detail
+    assert rho_check("RR*", [0.9, 0.8, 0.7], [0.5, 0.7, 0.9]).passed is False
+    assert rho_check("RR*", [0.9, 0.8, 0.7], [0.95, 0.85, 0.6]).passed is True
+
+
+def test_report_keeps_the_asterisks_of_aae_mae_rr(tmp_path):
+    from bionav.thesis.report import Section, markdown_to_html, md_text, section_markdown
+
+    assert md_text("AAE*, MAE* and RR*") == "AAE\\*, MAE\\* and RR\\*"
+    assert md_text("`a*b*` and c*") == "`a*b*` and c\\*"  # code spans stay verbatim
+    o = Outcome(rows=[Row("SIFT AAE* original", 0.2663, 0.3, 0.1), Row("SIFT RR* uni", 0.9, 0.95, 0.1)],
+                checks=[Check("ordering of RR* across databases equal", True, "rho = 1.00")])
+    sec = Section("table5_3", "Table 5.3", "Table 5.3: results of SIFT homing", "table 5.3, p. 60",
+                  "|AAE*, MAE*| <= 0.1 rad; RR* within 0.1", o, [], ["AAE* and RR* grow with the image size"])
+    md = section_markdown(sec, tmp_path)
+    page = markdown_to_html(md, tmp_path)
+    for text in ("SIFT AAE* original", "SIFT RR* uni", "ordering of RR* across databases", "|AAE*, MAE*| &lt;= 0.1 rad",
+                 "AAE* and RR* grow"):
+        assert text in page, text
+    assert "<i>" not in page.replace("<i>Source:</i>", "").replace("<i>Verdict:</i>", "").replace("<i>Rule:</i>", "")
+    assert "<b>holds</b>" in page  # real emphasis still renders
+    from bionav.thesis.items import markdown
+
+    table = markdown(["quantity", "thesis"], [["SIFT AAE* original", 0.2663], ["J: UV-IR vs All", "***"]])
+    assert "| SIFT AAE\\* original | 0.2663 |" in table and "| J: UV-IR vs All | \\*\\*\\* |" in table
+
+
 def test_select_items_by_id_and_thesis_number():
     assert [it.id for it in select_items("5.3,B.1")] == ["table5_3", "tableB_1"]
     assert {it.id for it in select_items("5.4")} == {"table5_4", "fig5_4"}
@@ -186,6 +225,12 @@ def test_cli_reports_why_an_item_is_missing(tmp_path):
     assert "**Not produced / incomplete:**" in report and "not run (--report-only)" in report
     row = next(r for r in _rows(out / "items.csv") if r["item"] == "table5_3" and r["level"] == "item")
     assert row["verdict"] == "not produced"
+    # no run of the item: no value rows or checks (nothing reads "does not hold"), no empty figure embedded or left
+    assert [r for r in _rows(out / "items.csv") if r["item"] == "table5_3" and r["level"] != "item"] == []
+    assert "does not hold" not in report.split("## ")[-1]
+    assert not (out / "table5_3.png").exists() and "<img" not in (out / "report.html").read_text()
+    # the header names the command that wrote the report
+    assert f"Command: `python -m bionav.thesis --preset tiny --only 5.3 --out {out} --report-only`" in report
     assert "bionav" not in {r["bionav"] for r in _rows(out / "items.csv") if r["quantity"] == "SIFT AAE* original"}
 
 
@@ -193,7 +238,7 @@ def test_cli_bad_input_is_one_clear_message(tmp_path):
     proc = run_bionav("--only", "nope", "--out", str(tmp_path / "x"), cwd=tmp_path, module="bionav.thesis")
     assert proc.returncode == 2 and "unknown item 'nope'" in proc.stderr and "Traceback" not in proc.stderr
     proc = run_bionav("--preset", "huge", "--out", str(tmp_path / "x"), cwd=tmp_path, module="bionav.thesis")
-    assert proc.returncode == 2 and "unknown --preset 'huge'" in proc.stderr
+    assert proc.returncode == 2 and "unknown --preset 'huge'" in proc.stderr and "tiny" in proc.stderr
     (tmp_path / "file").write_text("")
     proc = run_bionav("--out", str(tmp_path / "file"), "--only", "3.1", cwd=tmp_path, module="bionav.thesis")
     assert proc.returncode == 2 and "is a file" in proc.stderr

@@ -22,8 +22,8 @@ def plot_trajectories(path: Path, results, world, plan, *, title: str = "") -> N
     if len(segs):
         a = to_plan_frame(np.c_[segs[:, 0:2], np.zeros(len(segs))], world.start)
         b = to_plan_frame(np.c_[segs[:, 2:4], np.zeros(len(segs))], world.start)
-        for p, q in zip(a, b):
-            ax.plot([p[0], q[0]], [p[1], q[1]], color="0.35", lw=1.0)
+        for k, (p, q) in enumerate(zip(a, b)):
+            ax.plot([p[0], q[0]], [p[1], q[1]], color="0.35", lw=1.0, label="obstacle outlines" if k == 0 else None)
     ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ls="--", lw=1.0, ec="k", label="target area"))
     ideal = ideal_meander(plan)
     ax.plot(ideal[:, 0], ideal[:, 1], color="0.7", lw=3, alpha=0.6, label="ideal meander")
@@ -38,7 +38,8 @@ def plot_trajectories(path: Path, results, world, plan, *, title: str = "") -> N
     ax.set_xlabel("x along the first lane (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(f"Trajectories of {len(results)} runs" + (f": {title}" if title else ""))
-    ax.legend(fontsize=6, loc="upper right", ncol=2)
+    # below the axes: the runs fill the target area, a legend inside would hide some (wheel errors left/right)
+    ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=3, frameon=False)
     save_figure(fig, path, dpi=120)
 
 
@@ -114,5 +115,5 @@ def plot_layout(path: Path, results, world, plan) -> None:
     ax.set_xlabel("world x (m)")
     ax.set_ylabel("world y (m)")
     ax.set_title("Layout in the world" + (" (guide wall for the first lane)" if world.guide_wall else ""))
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # beside the map
     save_figure(fig, path, dpi=110)

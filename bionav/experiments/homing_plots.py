@@ -7,7 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
-from bionav.report.figures import pyplot, save_figure
+from bionav.report.figures import grid_cell_axes, pyplot, save_figure
 
 
 def plot_home_vector_field(
@@ -40,8 +40,7 @@ def plot_home_vector_field(
     ax.set_xlim(-1, nx)
     ax.set_ylim(-1, ny)
     ax.set_aspect("equal")
-    ax.set_xlabel("x (grid units)")
-    ax.set_ylabel("y (grid units)")
+    grid_cell_axes(ax)
     ax.set_title(title, fontsize=9)
     save_figure(fig, path, dpi=110)
 
@@ -55,7 +54,11 @@ def plot_per_snapshot_maps(
     rr_s: np.ndarray,
     title: str,
 ) -> None:
-    """Heatmaps of AAE_s and RR_s over the grid, like thesis fig. 5.9 (missing cells blank)."""
+    """Heatmaps of AAE_s (rad) and RR_s (fraction) over the grid, like thesis fig. 5.9 (missing cells blank).
+
+    Each cell shows the value of the snapshot taken there; axes are grid cells
+    (x right, y up) with whole-cell ticks.
+    """
     plt = pyplot()
     nx, ny = grid_shape
     maps = []
@@ -66,9 +69,8 @@ def plot_per_snapshot_maps(
     fig, axes = plt.subplots(1, 2, figsize=(2 * (0.35 * nx + 1.6), 0.35 * ny + 1.4))
     for ax, m, label, cmap, vmax in zip(axes, maps, ("AAE$_s$ (rad)", "RR$_s$"), ("magma_r", "viridis"), (np.pi / 2, 1.0)):
         im = ax.imshow(m, origin="lower", cmap=cmap, vmin=0, vmax=vmax)
-        ax.set_title(label)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        fig.colorbar(im, ax=ax, shrink=0.8)
+        ax.set_title(f"{label} per snapshot position")
+        grid_cell_axes(ax)
+        fig.colorbar(im, ax=ax, shrink=0.8, label=label)
     fig.suptitle(title, fontsize=9)
     save_figure(fig, path, dpi=110)

@@ -452,6 +452,7 @@ def _plot_levels(path, rows: list[dict[str, Any]], *, title: str) -> None:
     ax.plot(x, [r["rr"] for r in rows], "o-", label="RR*")
     ax.plot(x, [r["aae"] for r in rows], "s--", label="AAE* (rad)")
     ax.set_xlabel("number of Fourier coefficients K" if key == "n_coeffs" else "number of rings R")
+    ax.set_ylabel("RR* (fraction) | AAE* (rad)")
     ax.set_ylim(0, max(1.0, max(r["aae"] for r in rows) * 1.05))
     ax.legend()
     ax.grid(alpha=0.3)

@@ -18,30 +18,37 @@ def _figure(*args, **kwargs):
 
 def plot_unit_voltages(path: Path, angle_deg, mean_volts, *, xlabel: str) -> None:
     """Mean output voltage of each POL-OP unit against an angle (fig. 4.2)."""
-    plt, fig, ax = _figure(figsize=(7, 4))
+    plt, fig, ax = _figure(figsize=(8, 4))
     order = np.argsort(angle_deg)
     for k in range(mean_volts.shape[1]):
         ax.plot(np.asarray(angle_deg)[order], mean_volts[order, k], ".-", color=UNIT_COLORS[k % 3], label=f"POL-OP unit {k + 1}")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("output voltage (V)")
-    ax.legend()
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # beside the axes, covering no curve
     ax.grid(alpha=0.3)
     save_figure(fig, path, dpi=120)
 
 
-def plot_rotation(path: Path, pans, heading, errors, *, axial: bool) -> None:
-    """Compass heading (offset removed) and its error against the pan angle."""
-    plt, fig, (ax1, ax2) = _figure(2, 1, figsize=(7, 6), sharex=True)
+def plot_rotation(path: Path, pans, heading, errors, *, axial: bool, xlabel: str = "pan (deg, CCW)") -> None:
+    """Compass heading (offset removed) and its error against the pan angle.
+
+    Headings are plotted in the pan angle's range: an axial compass (which
+    cannot tell ``phi`` from ``phi + 180`` deg) is shown as whichever of the two
+    lies nearest the pan angle, a full compass as ``phi + k 360`` nearest it.
+    Angles in degrees, counter-clockwise.
+    """
+    plt, fig, (ax1, ax2) = _figure(2, 1, figsize=(8, 6), sharex=True)
     pan_deg = np.degrees(pans)
     period = 180.0 if axial else 360.0
     wrapped = (np.degrees(heading) - pan_deg + period / 2) % period - period / 2 + pan_deg
-    ax1.plot(pan_deg, wrapped, ".", ms=3, label="polarized-light compass")
-    ax1.plot(pan_deg, pan_deg, "r-", lw=1, label="pan angle")
-    ax1.set_ylabel("heading (deg)" + (", mod 180" if axial else ""))
-    ax1.legend()
+    ax1.plot(pan_deg, wrapped, ".", ms=3, label="polarized-light compass" + (
+        "\n(axial: of phi and phi + 180\nthe one nearest the pan)" if axial else ""))
+    ax1.plot(pan_deg, pan_deg, "r-", lw=1, label=xlabel.split(" (")[0])
+    ax1.set_ylabel("heading (deg, CCW)")
+    ax1.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8)
     ax2.plot(pan_deg, np.degrees(errors), ".", ms=3)
-    ax2.set_xlabel("pan (deg)")
-    ax2.set_ylabel("heading error (deg)")
+    ax2.set_xlabel(xlabel)
+    ax2.set_ylabel("heading error (deg)" + (", axial" if axial else ""))
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
     save_figure(fig, path, dpi=120)

@@ -79,5 +79,5 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
     }
     if plots is not None:
         plots_mod.plot_rotation(plots / "heading_vs_pan.png", np.unwrap(yaw[ok]), heading[ok] - errors.offset, errors.errors,
-                                axial=False)
+                                axial=False, xlabel="robot yaw (deg, CCW, unwrapped)")
     return metrics

@@ -40,18 +40,32 @@ def error_vs_time_of_day(path, session_rows, decoders) -> None:
     save_figure(fig, path, dpi=DPI)
 
 
+#: lower end of the log axis of session_errors.png (deg); smaller errors are drawn at it
+ERROR_FLOOR_DEG = 0.1
+
+
 def session_distributions(path, per_session, decoder) -> None:
-    """Box plot of absolute errors per session (chosen decoder)."""
+    """Box plot of absolute heading errors per session (chosen decoder), degrees on a log axis.
+
+    Boxes span the quartiles with the median as a line; whiskers reach the
+    5th and 95th percentiles (outliers are not drawn). The log axis starts at
+    :data:`ERROR_FLOOR_DEG`: a decoded heading can hit the recorded yaw to a
+    thousandth of a degree by chance, which says nothing, so errors below the
+    floor are drawn at it (the plot's caption says so).
+    """
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(per_session) + 2), 4))
-    data = [np.abs(np.degrees(err)) for _s, _d, err in per_session]
+    fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(per_session) + 2), 4.4))
+    data = [np.maximum(np.abs(np.degrees(err)), ERROR_FLOOR_DEG) for _s, _d, err in per_session]
     labels = [f"{s.day[5:]} {s.time_of_day}{' C' if d.period == 'canopy' else ''}" for s, d, _e in per_session]
-    ax.boxplot(data, showfliers=False)
+    ax.boxplot(data, whis=(5, 95), showfliers=False)
     ax.set_xticks(range(1, len(labels) + 1))
     ax.set_xticklabels(labels, rotation=90, fontsize=7)
     ax.set_yscale("log")
-    ax.set_ylabel("|error| (deg)")
-    ax.set_title(f"per-session error distributions, decoder={decoder} (C: canopy)")
+    ax.set_ylim(bottom=ERROR_FLOOR_DEG)
+    ax.set_xlabel("session (month-day, time of day; C: under canopy)")
+    ax.set_ylabel(f"|heading error| (deg, log; < {ERROR_FLOOR_DEG:g} at {ERROR_FLOOR_DEG:g})")
+    ax.set_title(f"per-session error distributions, decoder={decoder}\n"
+                 "box: quartiles and median; whiskers: 5th-95th percentile", fontsize=9)
     save_figure(fig, path, dpi=DPI)
 
 

@@ -21,23 +21,33 @@ def draw_world(ax, world, *, color="0.15") -> None:
     ax.set_ylabel("y (m)")
 
 
+#: colour of the recorded routes in world_routes.png (no method's colour: methods take matplotlib's cycle)
+ROUTE_COLOR = "0.55"
+
+
 def plot_world_routes(path, world, setups, paths) -> None:
-    """World from above with each route (snapshots) and the agents' paths per method."""
+    """World from above (x, y in metres) with each recorded route, its snapshots and the agents' paths per method.
+
+    Every line drawn has a legend entry; the legend sits below the axes so it
+    covers neither the world nor a path.
+    """
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    fig, ax = plt.subplots(figsize=(6.5, 7.3))
     draw_world(ax, world)
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     methods = sorted({m for (_r, m) in paths})
-    for s in setups:
-        ax.plot(s.dense_xy[:, 0], s.dense_xy[:, 1], color="k", lw=2.5, alpha=0.35)
-        ax.plot(s.xy[:, 0], s.xy[:, 1], ".", color="k", ms=2)
+    for k, s in enumerate(setups):
+        ax.plot(s.dense_xy[:, 0], s.dense_xy[:, 1], color=ROUTE_COLOR, lw=2.5,
+                label="recorded route" if k == 0 else None)
+        ax.plot(s.xy[:, 0], s.xy[:, 1], ".", color="k", ms=2, label="route snapshots" if k == 0 else None)
     for (_r, m), p in paths.items():
         if p is not None:
             c = colors[methods.index(m) % len(colors)]
-            ax.plot(p[:, 0], p[:, 1], color=c, lw=1, label=m if _r == setups[0].name else None)
-    if any(p is not None for p in paths.values()):
-        ax.legend(loc="upper left", fontsize=8)
-    ax.set_title("routes (grey) and agent paths")
+            ax.plot(p[:, 0], p[:, 1], color=c, lw=1, label=f"agent path: {m}" if _r == setups[0].name else None)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8, frameon=False)
+    ax.set_title(f"{len(setups)} route{'s' if len(setups) != 1 else ''} (grey) with snapshots (black)"
+                 + (" and agent paths" if any(p is not None for p in paths.values()) else "")
+                 + "; world from above (dark)", fontsize=9)
     save_figure(fig, path, dpi=110)
 
 

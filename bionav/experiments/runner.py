@@ -42,14 +42,50 @@ def is_completed(run_dir: Path) -> bool:
     return bool(metrics) and metrics.get("status") == "completed"
 
 
+#: the plugin groups each experiment reads (run.mcap's "plugins" metadata records only these)
+EXPERIMENT_PLUGIN_GROUPS: dict[str, tuple[str, ...]] = {
+    "grid_homing": ("homing", "signature"),
+    "cross_db": ("homing", "signature"),
+    "param_sweep": ("homing", "signature"),
+    "skyline_homing": ("homing",),
+    "route_homing": ("homing",),  # only with "homing" in experiment.methods
+    "cleaning": ("controller", "homing"),
+    "pol_compass": ("sensor", "pantilt", "decoder"),
+    "pol_recordings": ("decoder",),
+    "contrast_scan": ("sensor", "pantilt"),
+    "contrast_lda": (),
+}
+
+
+def used_plugin_groups(cfg: DictConfig) -> tuple[str, ...]:
+    """The config groups whose plugins ``cfg.experiment`` uses (every group for an unknown experiment).
+
+    The defaults select ``homing=sift`` for every run; an experiment that
+    homes on nothing (the compass, the spectral contrasts) does not use it,
+    so its run.mcap must not name it.
+    """
+    name = str(OmegaConf.select(cfg, "experiment.name", default="") or "")
+    groups = EXPERIMENT_PLUGIN_GROUPS.get(name, tuple(PLUGIN_NODES) + ("decoder",))
+    if name == "route_homing" and "homing" not in list(OmegaConf.select(cfg, "experiment.methods", default=[]) or []):
+        groups = ()
+    return groups
+
+
 def plugin_versions(cfg: DictConfig) -> dict[str, str]:
-    """Selected plugin names with the distribution and version providing them."""
+    """The plugins the run's experiment uses: name, distribution and version per config group.
+
+    Only the groups of :func:`used_plugin_groups` are recorded (a compass run
+    names its sensor and decoder, not the default ``homing=sift``).
+    """
     from bionav import registry
 
     out = {"bionav": __version__}
     kinds = {"homing": "homing", "signature": "signature", "sensor": "sensor", "pantilt": "sensor", "controller": "controller"}
     kinds["decoder"] = "decoder"
+    used = used_plugin_groups(cfg)
     for group, kind in kinds.items():
+        if group not in used:
+            continue
         node = cfg.get(group)
         if not node or not node.get("name"):
             continue

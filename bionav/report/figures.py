@@ -32,3 +32,25 @@ def save_figure(fig, path, *, dpi: int) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
+
+
+def grid_cell_axes(ax, *, fontsize: float | None = None) -> None:
+    """Label ``ax`` as a map of grid positions: whole-cell ticks, axes "x (grid cells)" and "y (grid cells)".
+
+    Grid positions are integers (cell indices, x to the right, y up, as the
+    databases' grid frame), so a tick between two cells (0.5, 1.5) names no
+    position; only integer ticks are drawn.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Axes showing a grid map (``imshow(..., origin="lower")`` or positions in grid units).
+    fontsize : float, optional
+        Font size of the axis labels (matplotlib's default when None).
+    """
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_xlabel("x (grid cells)", fontsize=fontsize)
+    ax.set_ylabel("y (grid cells)", fontsize=fontsize)

@@ -166,6 +166,11 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
             outcome = it.evaluate(ctx, specs[it.id])
         except Exception as exc:  # a report section must never take the whole report down
             outcome = Outcome(missing=[f"evaluating this item failed: {type(exc).__name__}: {exc}"])
+        item_runs = [results[s.key] for s in specs[it.id]]
+        if item_runs and not any(r.ok for r in item_runs):
+            for name in (*outcome.figures, *outcome.tables):  # empty figures and all-n/a tables are not left behind
+                (out / name).unlink(missing_ok=True)
+            outcome = outcome.without_runs(len({r.spec.key for r in item_runs}))
         claims = list(ref.get("claims", []))
         if it.id.startswith("tableB"):
             claims += list(ref_all.get("appendix_b_claims", []))
@@ -201,6 +206,8 @@ def argv_for_display(args) -> list[str]:
     words.append(f"--out {args.out}")
     if args.jobs is not None:
         words.append(f"--jobs {args.jobs}")
+    if args.report_only:
+        words.append("--report-only")
     if args.launcher:
         words.append(f"--launcher {args.launcher}")
     words += [f"--launcher-arg {a}" for a in args.launcher_arg]

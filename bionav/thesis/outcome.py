@@ -12,7 +12,8 @@ HOLDS, PARTLY, FAILS, MISSING = "holds", "partly", "does not hold", "not produce
 VERDICT_RULE = (
     "An item's verdict comes from its checks: every value row with a tolerance (|bionav - thesis| <= tolerance) "
     "and every stated claim check is one check. *holds*: all checks pass; *partly*: at least half pass; "
-    "*does not hold*: fewer than half pass; *not produced*: no check could be evaluated (the section says why)."
+    "*does not hold*: fewer than half pass; *not produced*: none of the item's runs completed or no check could be "
+    "evaluated (the section says why)."
 )
 
 
@@ -74,14 +75,27 @@ class Outcome:
     tables: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
+    #: False when the item needs runs and none of them completed (verdict "not produced" whatever the rows say)
+    produced: bool = True
 
     def outcomes(self) -> list[bool]:
+        if not self.produced:
+            return []
         got = [r.passed for r in self.rows] + [c.passed for c in self.checks]
         return [g for g in got if g is not None]
 
     @property
     def verdict(self) -> str:
         return verdict_of(self.outcomes())
+
+    def without_runs(self, n_runs: int) -> Outcome:
+        """This outcome for an item none of whose ``n_runs`` runs completed: verdict "not produced".
+
+        Value rows, checks, figures and tables are dropped (they would compare
+        nothing or show empty axes); the reasons in ``missing`` and the notes stay.
+        """
+        missing = self.missing or [f"none of the item's {n_runs} runs completed"]
+        return Outcome(notes=list(self.notes), missing=list(missing), produced=False)
 
     @property
     def score(self) -> tuple[int, int]:

@@ -78,20 +78,35 @@ def _run_lines(section: Section, out: Path) -> list[str]:
     return lines
 
 
+_CODE_SPAN = re.compile(r"(`[^`]*`)")
+
+
+def md_text(text: object) -> str:
+    """Plain text for Markdown: ``*`` escaped outside code spans, so ``AAE*`` keeps its asterisk.
+
+    Names such as ``AAE*``, ``MAE*`` and ``RR*`` (thesis 3.2) would otherwise
+    open and close emphasis (``AAE*, MAE*`` renders as "AAE, MAE" in italics).
+    """
+    parts = _CODE_SPAN.split(str(text))
+    return "".join(p if p.startswith("`") and p.endswith("`") and len(p) > 1 else p.replace("*", "\\*") for p in parts)
+
+
 def _cell(text: str) -> str:
-    """Text for a Markdown table cell (pipes escaped, one line)."""
-    return str(text).replace("|", "\\|").replace("\n", " ")
+    """Text for a Markdown table cell (asterisks and pipes escaped, one line)."""
+    return md_text(text).replace("|", "\\|").replace("\n", " ")
 
 
 def section_markdown(s: Section, out: Path) -> str:
     o = s.outcome
     passed, total = o.score
-    md = [f"## {_heading(s)}", "", f"*Source:* {s.source}.  ", f"*Verdict:* **{o.verdict}** "
-          f"({passed} of {total} checks pass).  ", f"*Rule:* {s.rule}.", ""]
+    verdict = (f"*Verdict:* **{o.verdict}** ({passed} of {total} checks pass).  " if o.produced else
+               f"*Verdict:* **{o.verdict}** (none of this item's runs completed; nothing was compared).  ")
+    md = [f"## {md_text(_heading(s))}", "", f"*Source:* {md_text(s.source)}.  ", verdict,
+          f"*Rule:* {md_text(s.rule)}.", ""]
     if s.claims:
-        md += ["The thesis claims:", *[f"- {c}" for c in s.claims], ""]
+        md += ["The thesis claims:", *[f"- {md_text(c)}" for c in s.claims], ""]
     if o.missing:
-        md += ["**Not produced / incomplete:**", *[f"- {m}" for m in o.missing], ""]
+        md += ["**Not produced / incomplete:**", *[f"- {md_text(m)}" for m in o.missing], ""]
     if o.rows:
         notes = any(r.note for r in o.rows)  # e.g. the per-draw values of table 5.3 on the stand-ins
         md += ["| quantity | thesis | bionav | difference | tolerance | verdict |" + (" note |" if notes else ""),
@@ -106,11 +121,11 @@ def section_markdown(s: Section, out: Path) -> str:
                for c in o.checks]
         md.append("")
     for n in o.notes:
-        md.append(f"*Note:* {n}  ")
+        md.append(f"*Note:* {md_text(n)}  ")
     if o.tables:
         md += ["", "Tables: " + ", ".join(f"[{t}]({t})" for t in o.tables)]
     md.append("")
-    for fig in o.figures:
+    for fig in o.figures if o.produced else ():
         md += [f"![{s.label}: {fig}]({fig})", ""]
     runs = _run_lines(s, out)
     if runs:
@@ -123,7 +138,7 @@ def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, w
     counts = verdict_counts(sections)
     head = [
         "# The thesis, reproduced by bionav", "",
-        f"Command: `{command}`  ", f"Preset: **{preset.name}** ({preset.summary}).  ",
+        f"Command: `{command}`  ", f"Preset: **{preset.name}** ({md_text(preset.summary)}).  ",
         f"Wall time of this invocation: {wall_s:.0f} s" + (f" (CPU of the runs it executed: {cpu_s:.0f} s)" if cpu_s else "")
         + (f"; machine: {machine}" if machine else "") + ".",
         "",
@@ -134,9 +149,10 @@ def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, w
         *[f"| {v} | {counts.get(v, 0)} |" for v in ("holds", "partly", "does not hold", MISSING)], "",
     ]
     if preset.reductions:
-        head += ["Reductions of this preset against the thesis:", *[f"- {r}" for r in preset.reductions], ""]
+        head += ["Reductions of this preset against the thesis:", *[f"- {md_text(r)}" for r in preset.reductions], ""]
     head += ["| item | verdict | checks |", "|---|---|---|"]
-    head += [f"| [{s.label}](#{_anchor(s)}) | {s.outcome.verdict} | {s.outcome.score[0]}/{s.outcome.score[1]} |"
+    head += [f"| [{s.label}](#{_anchor(s)}) | {s.outcome.verdict} | "
+             + (f"{s.outcome.score[0]}/{s.outcome.score[1]} |" if s.outcome.produced else "no run completed |")
              for s in sections]
     head.append("")
     return "\n".join(head + [section_markdown(s, out) for s in sections])
@@ -156,12 +172,19 @@ def markdown_to_html(md: str, out: Path) -> str:
     body, table, in_list = [], [], False
 
     def inline(text: str) -> str:
-        t = html.escape(text, quote=False)
-        t = re.sub(r"`([^`]+)`", r"<code>\1</code>", t)
-        t = re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", t)
-        t = re.sub(r"\*([^*]+)\*", r"<i>\1</i>", t)
-        t = re.sub(r"\[([^\]]+)\]\(#([^)]+)\)", r'<a href="#\2">\1</a>', t)
-        return re.sub(r"\[([^\]]+)\]\(([^)]+)\)", r'<a href="\2">\1</a>', t)
+        # code spans verbatim; elsewhere "\*" is a literal asterisk, "**b**" bold, "*i*" italics, links
+        pieces = []
+        for part in _CODE_SPAN.split(text):
+            if part.startswith("`") and part.endswith("`") and len(part) > 1:
+                pieces.append(f"<code>{html.escape(part[1:-1], quote=False)}</code>")
+                continue
+            t = html.escape(part, quote=False).replace("\\*", "\x00")
+            t = re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", t)
+            t = re.sub(r"\*([^*]+)\*", r"<i>\1</i>", t)
+            t = re.sub(r"\[([^\]]+)\]\(#([^)]+)\)", r'<a href="#\2">\1</a>', t)
+            t = re.sub(r"\[([^\]]+)\]\(([^)]+)\)", r'<a href="\2">\1</a>', t)
+            pieces.append(t.replace("\x00", "*"))
+        return "".join(pieces)
 
     def flush_table():
         if table:
@@ -191,7 +214,7 @@ def markdown_to_html(md: str, out: Path) -> str:
         if line.startswith("#"):
             level = len(line) - len(line.lstrip("#"))
             text = line[level:].strip()
-            anchor = re.sub(r"[^a-z0-9 -]", "", text.lower()).replace(" ", "-")
+            anchor = re.sub(r"[^a-z0-9 -]", "", text.replace("\\*", "").lower()).replace(" ", "-")
             body.append(f'<h{level} id="{anchor}">{inline(text)}</h{level}>')
         elif line.startswith("- "):
             if not in_list:
