@@ -32,6 +32,7 @@ GROUPS: dict[str, str] = {
     "sensor": "bionav.sensors",
     "controller": "bionav.controllers",
     "decoder": "bionav.decoders",
+    "route_agent": "bionav.route_agents",
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"
