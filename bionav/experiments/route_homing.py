@@ -363,6 +363,21 @@ def _agent_kinds(agents: list[str]) -> dict[str, str]:
     return kinds
 
 
+def _check_agent_params(exp: RouteHomingConfig, kinds: dict[str, str]) -> None:
+    """Validate ``experiment.agent_params`` of the route agents before any work (key, value, range)."""
+    from bionav.config import plugin_config
+
+    for name, params in exp.agent_params.items():
+        if name not in kinds:
+            raise UserError(f"experiment.agent_params names {name!r}, which is not in experiment.agents="
+                            f"{list(exp.agents)}; add it there or drop its parameters.")
+        if not isinstance(params, dict):
+            raise UserError(f"experiment.agent_params.{name} must be a mapping of parameters, e.g. "
+                            "experiment.agent_params={mushroom_body:{n_kc:5000}}.")
+        if kinds[name] == "route_agent":
+            plugin_config("route_agent", {"name": name, **params}, key=f"experiment.agent_params.{name}")
+
+
 def _route_agent(name: str, exp: RouteHomingConfig, rng: np.random.Generator):
     from bionav.config import plugin_config
 
@@ -441,6 +456,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
 
     routes = list(exp.routes) or list(ARDIN_ROUTES)
     kinds = _agent_kinds(list(exp.agents))
+    _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, _routes_path(cfg))
     rows, paths, setups = [], {}, []
     timing = {a: [0.0, 0.0] for a in exp.agents}
@@ -477,8 +493,8 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
                         state["k"] = int(k)
                 res = follow_route(choose, route_xy=setup.xy, route_heading=setup.heading, nest_xy=setup.dense_xy[-1],
                                    step_m=exp.agent_step_m, putback_m=exp.putback_m, goal_m=exp.putback_m,
-                                   max_steps=max_steps, jitter_m=exp.position_jitter_m, rng=_rng(seed, name, agent_name, "jitter"),
-                                   on_putback=on_putback)
+                                   max_steps=max_steps, jitter_m=exp.position_jitter_m,
+                                   rng=_rng(seed, name, agent_name, "jitter"), on_putback=on_putback)
                 wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
                 timing[agent_name][0] += wall
                 timing[agent_name][1] += cpu

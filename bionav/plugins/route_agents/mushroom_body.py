@@ -47,14 +47,14 @@ class MushroomBody(RouteAgent):
 
     def train(self, views: np.ndarray) -> None:
         from bionav.errors import UserError
-        from bionav.homing.familiarity import kenyon_activity, kenyon_connections, mushroom_body_train
+        from bionav.homing.familiarity import kenyon_activity, kenyon_connections, kenyon_matrix, mushroom_body_train
 
         x = np.asarray(views, np.float64).reshape(len(views), -1)
         c = self.config
         if c.inputs_per_kc > x.shape[1]:
             raise UserError(f"route_agent mushroom_body: inputs_per_kc={c.inputs_per_kc} exceeds the {x.shape[1]} "
                             "pixels of a view; use a smaller inputs_per_kc.")
-        self.connections = kenyon_connections(x.shape[1], c.n_kc, c.inputs_per_kc, rng=self.rng)
+        self.connections = kenyon_matrix(kenyon_connections(x.shape[1], c.n_kc, c.inputs_per_kc, rng=self.rng), x.shape[1])
         active = kenyon_activity(x, self.connections, n_active=c.n_active)
         self.kc_to_en = mushroom_body_train(np.ones(c.n_kc), active, depression=c.depression)
 
