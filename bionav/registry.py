@@ -2,7 +2,8 @@
 
 Modelled on xarray's backend registry. Each *kind* of plugin has an
 entry-point group (``bionav.homing``, ``bionav.signatures``,
-``bionav.sensors``, ``bionav.controllers``); bionav's own built-ins are
+``bionav.sensors``, ``bionav.controllers``, ``bionav.decoders``,
+``bionav.route_agents``); bionav's own built-ins are
 registered through the same entry points as third-party plugins.
 
 * Entry points are read once per process and cached (:func:`entry_points_of`).

@@ -564,6 +564,10 @@ class RouteHomingConfig:
     putback_m : ``ardin2016``: distance from the route beyond which the agent is put back (an error),
         and the radius around the nest that ends the run, metres.
     view_size : ``ardin2016``: ``[W, H]`` of the agents' views (the paper's 36 x 10).
+    training_heading : ``ardin2016``: the training views face the direction of travel to the next route
+        view (``travel``) or the ant's recorded heading there (``recorded``); the put-back faces the same.
+    supersample : ``ardin2016``: rays per 4-degree pixel along each axis (1: one ray at the pixel centre;
+        2, 4: the mean of 2 x 2 or 4 x 4 rays, area pixels as the reference renderer's rasterised patches).
     """
 
     name: str = "route_homing"
@@ -593,6 +597,8 @@ class RouteHomingConfig:
     scan_step_deg: int = bounded(2, choices=(1, 2, 4))
     putback_m: float = bounded(0.2, gt=0.0, le=5.0)
     view_size: list[int] = bounded([36, 10], length=2, item=Range(ge=2, le=74))
+    training_heading: str = bounded("travel", choices=("travel", "recorded"))
+    supersample: int = bounded(4, choices=(1, 2, 4))
 
 
 @dataclass

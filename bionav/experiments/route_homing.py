@@ -401,11 +401,39 @@ def _homing_agent(name: str, cfg: DictConfig, ctx, exp: RouteHomingConfig, geome
 
 
 def scan_geometry(exp: RouteHomingConfig):
-    """The panorama the scans are cut from: columns every ``scan_step_deg``, 19 rows of 4 deg (+58 .. -14 deg)."""
+    """The panorama the scans are cut from: columns every ``scan_step_deg``, 19 rows of 4 deg (+58 .. -14 deg).
+
+    With ``supersample = s > 1`` the rendered panorama has columns and rows every ``4 / s`` degrees,
+    columns half a fine column off the heading (:func:`box_panorama` averages them to 4-degree pixels).
+    Returns ``(rendered geometry, scan-panorama column degrees, heading offset of the render, radians)``.
+    """
     from bionav.geometry import PanoramaGeometry
 
     col = float(exp.scan_step_deg)
-    return PanoramaGeometry(int(round(360.0 / col)), 19, 14.5, math.radians(4.0)), col
+    s = int(exp.supersample)
+    if s == 1:
+        return PanoramaGeometry(int(round(360.0 / col)), 19, 14.5, math.radians(4.0)), col, 0.0
+    fine = 4.0 / s
+    return PanoramaGeometry(int(round(360.0 / fine)), 19 * s, 60.0 / fine - 0.5, math.radians(fine)), col, \
+        math.radians(fine / 2.0)
+
+
+def box_panorama(fine: np.ndarray, *, supersample: int, column_deg: float) -> np.ndarray:
+    """4-degree pixels from a panorama rendered every ``4 / supersample`` degrees, one column every ``column_deg``.
+
+    ``fine`` column ``m`` looks at ``heading + (m + 1/2) * f`` (``f = 4 / supersample`` degrees), row ``r``
+    at ``60 - (r + 1/2) * f``. Output column ``k`` (at ``heading + k * column_deg``) is the mean of the
+    ``supersample x supersample`` fine pixels within +-2 degrees of its centre, row ``i`` of rows
+    ``i*s .. i*s + s - 1`` (centre ``58 - 4 i`` degrees): area pixels as the reference renderer's
+    rasterised patches, instead of one ray per pixel centre. Shape ``(19, 360 / column_deg)``.
+    """
+    s = int(supersample)
+    f = 4.0 / s
+    h, w = fine.shape
+    rows = fine.reshape(h // s, s, w).mean(axis=1)
+    box = sum(np.roll(rows, s // 2 - j, axis=1) for j in range(s)) / s  # box[c] = mean rows[c - s/2 .. c + s/2 - 1]
+    step = int(round(column_deg / f))
+    return box[:, ::step]
 
 
 def _scan_renderer(setup: _RouteSetup, exp: RouteHomingConfig, rng: np.random.Generator, *, half_deg=None):
@@ -414,14 +442,17 @@ def _scan_renderer(setup: _RouteSetup, exp: RouteHomingConfig, rng: np.random.Ge
     from bionav.evaluation.route import scan_views
     from bionav.world.mesh_render import render_mesh_panorama
 
-    geometry, col = scan_geometry(exp)
+    geometry, col, shift = scan_geometry(exp)
     half = exp.scan_half_deg if half_deg is None else half_deg
 
     def views(xy, heading):
         z = float(setup.world.terrain_height(np.array([xy]))[0])
         z = (setup.world.ground_z if not np.isfinite(z) else z) + setup.height
-        img = render_mesh_panorama(setup.world, position=(xy[0], xy[1], z), heading=heading, geometry=geometry)
-        img = quantise(img, noise=setup.noise, rng=rng).astype(np.float32).mean(axis=-1) / np.float32(255.0)
+        img = render_mesh_panorama(setup.world, position=(xy[0], xy[1], z), heading=heading + shift, geometry=geometry)
+        img = img.mean(axis=-1)
+        if exp.supersample > 1:
+            img = box_panorama(img, supersample=exp.supersample, column_deg=col)
+        img = quantise(img, noise=setup.noise, rng=rng).astype(np.float32) / np.float32(255.0)
         return scan_views(img, column_deg=col, scan_half_deg=half, scan_step_deg=float(exp.scan_step_deg),
                           size=list(exp.view_size))
 
@@ -442,6 +473,13 @@ def _familiarity_chooser(agent, views):
         return heading + float(off[s])
 
     return choose
+
+
+def travel_headings(xy: np.ndarray) -> np.ndarray:
+    """Direction of travel from each route view to the next (the last repeats its predecessor's), radians CCW from ``+x``."""
+    d = np.diff(np.asarray(xy, np.float64), axis=0)
+    h = np.arctan2(d[:, 1], d[:, 0])
+    return np.append(h, h[-1]) if len(h) else np.zeros(len(xy))
 
 
 def _rng(seed: int, *parts: str) -> np.random.Generator:
@@ -465,6 +503,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
         setups.append(setup)
         length = float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum())
         max_steps = int(math.ceil(exp.max_steps_factor * length / exp.agent_step_m))
+        route_heading = setup.heading if exp.training_heading == "recorded" else travel_headings(setup.xy)
         for seed in exp.seeds:
             train_views = None
             for agent_name in exp.agents:
@@ -473,7 +512,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
                 if kinds[agent_name] == "route_agent":
                     if train_views is None:  # the same training views for every agent of this route and seed
                         one = _scan_renderer(setup, exp, _rng(seed, name, "training"), half_deg=0.0)
-                        train_views = np.concatenate([one(p, float(h))[0] for p, h in zip(setup.xy, setup.heading)])
+                        train_views = np.concatenate([one(p, float(h))[0] for p, h in zip(setup.xy, route_heading)])
                     agent = _route_agent(agent_name, exp, rng)
                     agent.train(train_views)
                     choose = _familiarity_chooser(agent, _scan_renderer(setup, exp, rng))
@@ -491,7 +530,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
 
                     def on_putback(k, state=state):
                         state["k"] = int(k)
-                res = follow_route(choose, route_xy=setup.xy, route_heading=setup.heading, nest_xy=setup.dense_xy[-1],
+                res = follow_route(choose, route_xy=setup.xy, route_heading=route_heading, nest_xy=setup.dense_xy[-1],
                                    step_m=exp.agent_step_m, putback_m=exp.putback_m, goal_m=exp.putback_m,
                                    max_steps=max_steps, jitter_m=exp.position_jitter_m,
                                    rng=_rng(seed, name, agent_name, "jitter"), on_putback=on_putback)
