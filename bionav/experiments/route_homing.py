@@ -526,7 +526,10 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
                     def choose(pos, heading, f=f, render=render, state=state):
                         lo, hi = f.window_of(state["k"], centred=False)
                         _h, state["k"] = f.ridf_heading(render(pos, 0.0), lo, hi)
-                        return f.home_direction(render, pos, min(state["k"] + exp.lookahead, len(f.s.xy) - 1))
+                        h = f.home_direction(render, pos, min(state["k"] + exp.lookahead, len(f.s.xy) - 1))
+                        # the turn is limited to the scan range of the familiarity agents
+                        limit = math.radians(exp.scan_half_deg)
+                        return heading + float(np.clip(wrap_angle(h - heading), -limit, limit))
 
                     def on_putback(k, state=state):
                         state["k"] = int(k)
