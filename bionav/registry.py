@@ -2,7 +2,8 @@
 
 Modelled on xarray's backend registry. Each *kind* of plugin has an
 entry-point group (``bionav.homing``, ``bionav.signatures``,
-``bionav.sensors``, ``bionav.controllers``); bionav's own built-ins are
+``bionav.sensors``, ``bionav.controllers``, ``bionav.decoders``,
+``bionav.route_agents``); bionav's own built-ins are
 registered through the same entry points as third-party plugins.
 
 * Entry points are read once per process and cached (:func:`entry_points_of`).
@@ -33,6 +34,7 @@ GROUPS: dict[str, str] = {
     "sensor": "bionav.sensors",
     "controller": "bionav.controllers",
     "decoder": "bionav.decoders",
+    "route_agent": "bionav.route_agents",
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"

@@ -9,12 +9,24 @@ whole column against ``S``. A perfect-memory route follower (Baddeley et al.
 stores every view along the route and heads where the best-matching rotation
 of its current view points.
 
+The published route-following test (Ardin, Peng, Mangan, Lagogiannis & Webb
+2016, PLoS Comput. Biol. 12(2), e1004683, doi:10.1371/journal.pcbi.1004683):
+:func:`follow_route` walks an agent from the route's start in fixed steps
+along the heading it chooses, puts it back on the route (counting an error)
+whenever it strays too far, and stops at the nest or after a step budget;
+:func:`scan_views` cuts the views of a heading scan out of one panorama and
+preprocesses them as the paper (inversion, histogram equalisation, 36 x 10).
+
 Conventions: canonical panoramas (:mod:`bionav.geometry`); a current view
 rendered at heading ``phi`` rolled by ``-c`` columns is the view at heading
 ``phi + 2*pi*c/W``; headings in radians CCW from world ``+x``.
 """
 
 from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -107,6 +119,142 @@ def distance_to_route(points: np.ndarray, route_xy: np.ndarray) -> tuple[np.ndar
     dist = np.linalg.norm(p[:, None, :] - proj, axis=2)
     nearest_vertex = np.argmin(np.linalg.norm(p[:, None, :] - r[None], axis=2), axis=1)
     return dist.min(axis=1), nearest_vertex
+
+
+@dataclass
+class RouteRun:
+    """One closed-loop run of :func:`follow_route`.
+
+    Attributes
+    ----------
+    path : ndarray, shape (T, 2)
+        Positions in metres, world frame: the start, then every position after
+        a step; a put-back adds the route view it was put on.
+    errors : int
+        Put-backs (the agent strayed more than ``putback_m`` from the route).
+    reached_nest : bool
+        Came within ``goal_m`` of the nest before the step budget ran out.
+    steps : int
+        Steps taken.
+    putbacks : list of int
+        Route-view index of every put-back, in order.
+    """
+
+    path: np.ndarray
+    errors: int
+    reached_nest: bool
+    steps: int
+    putbacks: list
+
+
+def follow_route(choose_heading: Callable[[np.ndarray, float], float], *, route_xy: np.ndarray,
+                 route_heading: np.ndarray, nest_xy: np.ndarray, step_m: float, putback_m: float,
+                 goal_m: float, max_steps: int, jitter_m: float = 0.0, rng: np.random.Generator | None = None,
+                 on_putback: Callable[[int], None] | None = None) -> RouteRun:
+    """Walk an agent along a route with the put-back rule of Ardin et al. 2016 (doi:10.1371/journal.pcbi.1004683).
+
+    The agent starts on route view 0 facing ``route_heading[0]``. Each step:
+    ``heading = choose_heading(position, heading)``; move ``step_m`` along it,
+    then add isotropic Gaussian position noise of standard deviation
+    ``jitter_m`` per axis; stop when within ``goal_m`` of ``nest_xy``
+    (reached); otherwise, when farther than ``putback_m`` from the route
+    polyline, count an error and put the agent on the *nearest* route view,
+    facing that view's heading (``on_putback(index)`` tells the agent).
+
+    Parameters
+    ----------
+    choose_heading : callable ``(xy (2,), heading) -> heading``
+        Radians CCW from world ``+x``; a NaN keeps the current heading.
+    route_xy : ndarray, shape (K, 2)
+        Route views (training positions), metres.
+    route_heading : ndarray, shape (K,)
+        Radians CCW from ``+x``.
+    nest_xy : ndarray, shape (2,)
+    step_m, putback_m, goal_m : float
+        Metres.
+    max_steps : int
+        Step budget.
+    jitter_m : float
+        Metres; needs ``rng`` when positive.
+    """
+    route_xy = np.asarray(route_xy, np.float64)
+    nest = np.asarray(nest_xy, np.float64)
+    if jitter_m > 0 and rng is None:
+        raise ValueError("jitter_m > 0 needs an rng")
+    pos = route_xy[0].copy()
+    heading = float(route_heading[0])
+    path = [pos.copy()]
+    errors, steps, reached, putbacks = 0, 0, False, []
+    for steps in range(1, int(max_steps) + 1):
+        new = choose_heading(pos, heading)
+        if np.isfinite(new):
+            heading = float(new)
+        pos = pos + step_m * np.array([math.cos(heading), math.sin(heading)])
+        if jitter_m > 0:
+            pos = pos + rng.normal(0.0, jitter_m, 2)
+        path.append(pos.copy())
+        if np.linalg.norm(pos - nest) <= goal_m:
+            reached = True
+            break
+        dist, nearest = distance_to_route(pos[None], route_xy)
+        if dist[0] > putback_m:
+            k = int(nearest[0])
+            errors += 1
+            putbacks.append(k)
+            pos = route_xy[k].copy()
+            heading = float(route_heading[k])
+            path.append(pos.copy())
+            if on_putback is not None:
+                on_putback(k)
+    return RouteRun(np.array(path), errors, reached, steps if max_steps > 0 else 0, putbacks)
+
+
+def scan_views(panorama: np.ndarray, *, column_deg: float, scan_half_deg: float = 60.0, scan_step_deg: float = 2.0,
+               fov_deg: float = 296.0, pixel_deg: float = 4.0, size: Sequence[int] = (36, 10)) -> tuple[np.ndarray, np.ndarray]:
+    """The views of a heading scan, cut out of one panorama and preprocessed as Ardin et al. 2016.
+
+    The panorama's column ``m`` looks at ``heading + m * column_deg``
+    (counter-clockwise, :func:`bionav.world.render.ray_grid`), its rows at the
+    elevations of the wanted view. The scan view at offset ``o`` (degrees,
+    CCW, ``-scan_half_deg .. +scan_half_deg`` in ``scan_step_deg``) has
+    ``fov_deg / pixel_deg`` pixels, left (``o + fov/2 - pixel/2``) to right,
+    each the panorama column at its centre. Every view is then inverted
+    (``1 - v``), histogram-equalised (:func:`bionav.homing.imageops.equalize_histogram`)
+    and area-resized to ``size = [W, H]`` (doi:10.1371/journal.pcbi.1004683).
+
+    Parameters
+    ----------
+    panorama : ndarray, shape (H, W), float in [0, 1]
+    column_deg : float
+        Degrees per panorama column; ``scan_step_deg`` and ``pixel_deg`` must be
+        whole multiples of it.
+
+    Returns
+    -------
+    views : ndarray, shape (S, size[1], size[0]), float32 in [0, 1]
+    offsets : ndarray, shape (S,)
+        Scan offsets in radians (CCW positive), ``S = 2 * scan_half_deg / scan_step_deg + 1``.
+    """
+    from bionav.homing.imageops import equalize_histogram, resize_images
+
+    pano = np.asarray(panorama, np.float32)
+    w = pano.shape[1]
+    scan = int(round(scan_step_deg / column_deg))
+    pix = int(round(pixel_deg / column_deg))
+    if scan < 1 or pix < 1 or abs(scan * column_deg - scan_step_deg) > 1e-9 or abs(pix * column_deg - pixel_deg) > 1e-9:
+        raise ValueError(f"scan step {scan_step_deg} deg and pixel {pixel_deg} deg must be whole multiples "
+                         f"of the panorama's {column_deg} deg columns")
+    n_scan = int(round(scan_half_deg / scan_step_deg))
+    n_pix = int(round(fov_deg / pixel_deg))
+    k = np.arange(-n_scan, n_scan + 1)
+    # pixel j of the view at offset k*scan: azimuth k*scan + (n_pix - 1)/2*pix - j*pix (in columns)
+    half = (n_pix - 1) * pix / 2.0
+    if abs(half - round(half)) > 1e-9:
+        raise ValueError("fov_deg / pixel_deg must give pixel centres on panorama columns")
+    cols = (k[:, None] * scan + int(round(half)) - np.arange(n_pix)[None] * pix) % w
+    views = 1.0 - pano[:, cols].transpose(1, 0, 2)  # (S, H, n_pix), inverted
+    views = equalize_histogram(views)
+    return resize_images(views, size), np.deg2rad(k * scan * column_deg)
 
 
 def lateral_normals(headings: np.ndarray) -> np.ndarray:
