@@ -23,6 +23,12 @@ fixes everything but three gauges:
   to their geometric mean over the fitted channels;
 * a pointing offset common to all units (absorbed into the ring's phase, i.e.
   the heading offset): ``mean eps = 0``;
+* a gain pattern common to all units that varies with the polarizer angle
+  as ``cos 2 alpha`` or ``sin 2 alpha`` (absorbed into a constant added to
+  ``q`` or ``u``): fixed by making the channels as a whole most nearly nominal,
+  so what the units share of such a pattern is not recovered (at a degree of
+  polarization ``d`` a common 2 % gain pattern turns e-vectors by about
+  ``0.01 / d`` radians);
 * a polarizer offset common to all units (absorbed into a rotation of
   ``q, u``). It is fixed by the mirror symmetry of a clear sky about the
   solar meridian: the fitted e-vector angle ``chi(theta)`` must satisfy
@@ -34,10 +40,9 @@ fixes everything but three gauges:
 one gain gauge per session) into an :class:`ArrayCalibration` with standard
 errors from the spread across sessions; :meth:`ArrayCalibration.apply` returns
 the calibrated :class:`~bionav.polcompass.array.PolArray` (per-channel gains,
-angles and unit azimuths), whose e-vectors
-:func:`~bionav.polcompass.array.evectors_from_counts` then solves from all
-photodiodes by linear least squares (``solver="stokes"``), since calibrated
-polarizers are no longer exactly orthogonal pairs.
+angles and unit azimuths), read through the POL-OP chain with each pair at
+its mean calibrated orientation (default) or, ``solver="stokes"``, from all
+photodiodes by linear least squares at their own angles.
 
 Angles in radians internally; the JSON file (:meth:`ArrayCalibration.save`)
 stores degrees under keys ending ``_deg`` (schema in docs/polcompass.md).
@@ -46,6 +51,7 @@ stores degrees under keys ending ``_deg`` (schema in docs/polcompass.md).
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -262,7 +268,7 @@ def _nominal_gauge(m, alpha0, free=None):
     return b
 
 
-def calibrate_session(counts, yaw, valid, array, *, n_bins: int = 120, n_harmonics: int = 6,
+def calibrate_session(counts, yaw, valid, array, *, n_bins: int = 120, n_harmonics: int = 12,
                       iterations: int = 40, symmetric: bool = True) -> SessionCalibration:
     """Fit photodiode gains and polarizer offsets to one session (see the module docstring).
 
@@ -393,7 +399,7 @@ class ArrayCalibration:
     def shape(self) -> tuple:
         return tuple(self.gain.shape)
 
-    def apply(self, array, *, gains: bool = True, angles: bool = True, azimuths: bool = True):
+    def apply(self, array, *, gains: bool = True, angles: bool = True, azimuths: bool = True, solver: str = "pol_op"):
         """The calibrated array: nominal geometry plus the chosen parts of the calibration.
 
         Parameters
@@ -402,11 +408,14 @@ class ArrayCalibration:
             Nominal array with the same ``(K, P)``.
         gains, angles, azimuths : bool
             Which parts to apply.
+        solver : {'pol_op', 'stokes'}
+            ``pol_op`` keeps the POL-OP chain (eqs. 4.2-4.5: only each pair's gain ratio matters, and
+            each POL-OP takes the mean orientation of its two polarizers, ``(alpha_a + alpha_b - 90 deg) / 2``);
+            ``stokes`` reads every photodiode at its own calibrated angle by linear least squares.
 
         Returns
         -------
         PolArray
-            ``solver="stokes"`` (e-vectors from all photodiodes by linear least squares).
         """
         if array.polarizer_angles.shape != self.shape:
             raise UserError(
@@ -416,7 +425,13 @@ class ArrayCalibration:
         g = array.gains * (self.gain if gains else 1.0)
         pol = array.polarizer_angles + (self.angle_offset if angles else 0.0)
         az = array.unit_azimuths + (self.azimuth_offset if azimuths else 0.0)
-        return replace(array, unit_azimuths=az, polarizer_angles=pol, gains=g, solver="stokes")
+        if solver == "pol_op":
+            pol = pol.copy()
+            for a, b in array.pairs:
+                mean = 0.5 * np.angle(np.exp(2j * pol[:, a]) + np.exp(2j * (pol[:, b] - np.pi / 2.0)))
+                pol[:, a] = array.polarizer_angles[:, a] + wrap_axial(mean - array.polarizer_angles[:, a])
+                pol[:, b] = pol[:, a] + np.pi / 2.0
+        return replace(array, unit_azimuths=az, polarizer_angles=pol, gains=g, solver=solver)
 
     def to_dict(self) -> dict:
         """JSON-ready form (schema ``bionav.pol_array_calibration/1``, degrees; see docs/polcompass.md)."""
@@ -492,17 +507,22 @@ class ArrayCalibration:
         Path(path).write_text(json.dumps(self.to_dict(), indent=2))
 
 
-def combine_sessions(estimates, names=None, *, n_units: int | None = None, n_photodiodes: int | None = None) -> ArrayCalibration:
-    """Pool per-session estimates into one :class:`ArrayCalibration`.
+def combine_sessions(estimates, names=None) -> ArrayCalibration:
+    """Pool per-session estimates into one :class:`ArrayCalibration` (robustly).
 
     Gains: ``log g_skp = log g_kp + o_s`` (one gauge ``o_s`` per session, because each session's
-    gains are relative to its own fitted units) by alternating least squares; angle and pointing
-    offsets: means. Standard errors: sample standard deviation over sessions / sqrt(n).
+    gains are relative to its own fitted units), solved by alternating medians; angle offsets:
+    medians over sessions (a session whose symmetry gauge failed, e.g. with the sun near the zenith,
+    does not move them). Standard errors: ``1.4826 MAD / sqrt(n)`` over the sessions.
 
     Parameters
     ----------
     estimates : list of SessionCalibration
     names : list of str, optional
+
+    Returns
+    -------
+    ArrayCalibration
     """
     if not estimates:
         raise UserError("No session could be used for the self-calibration (it needs daylight rotations with two or "
@@ -511,26 +531,25 @@ def combine_sessions(estimates, names=None, *, n_units: int | None = None, n_pho
     an = np.stack([e.angle_offset for e in estimates])
     az = np.stack([e.azimuth_offset for e in estimates])
     has = np.isfinite(lg)
+    n = has.sum(axis=0)
+    any_has = n > 0
     offsets = np.zeros(len(estimates))
     g = np.zeros(lg.shape[1:])
-    for _ in range(50):
-        with np.errstate(invalid="ignore"):
-            g = np.nanmean(lg - offsets[:, None, None], axis=0)
-        g = np.where(np.isfinite(g), g, 0.0)
-        g = g - np.mean(g[has.any(axis=0)]) if has.any() else g
-        offsets = np.array([np.nanmean((lg[s] - g)[has[s]]) if has[s].any() else 0.0 for s in range(len(estimates))])
-    n = has.sum(axis=0)
-    nk = np.isfinite(az).sum(axis=0)
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slices: units no session calibrated
+        for _ in range(20):
+            g = np.where(any_has, np.nanmedian(lg - offsets[:, None, None], axis=0), 0.0)
+            g = g - np.mean(g[any_has])
+            offsets = np.array([np.median((lg[i] - g)[has[i]]) if has[i].any() else 0.0 for i in range(len(estimates))])
+        angle = np.where(any_has, np.nanmedian(an, axis=0), 0.0)
+        nk = np.isfinite(az).sum(axis=0)
+        azim = np.where(nk > 0, np.nanmedian(az, axis=0), 0.0)
 
-    def sem(v, count):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            sd = np.nanstd(v, axis=0, ddof=1) if v.shape[0] > 1 else np.full(v.shape[1:], np.nan)
-            return np.where(count > 1, sd / np.sqrt(np.maximum(count, 1)), np.nan)
+        def sem(v, centre, count):
+            mad = np.nanmedian(np.abs(v - centre), axis=0)
+            return np.where(count > 1, 1.4826 * mad / np.sqrt(np.maximum(count, 1)), np.nan)
 
-    with np.errstate(invalid="ignore"):
-        angle = np.where(n > 0, np.nanmean(an, axis=0), 0.0) if len(estimates) else np.zeros(lg.shape[1:])
-        azim = np.where(nk > 0, np.nanmean(az, axis=0), 0.0)
-    gain = np.where(n > 0, np.exp(g), 1.0)
-    return ArrayCalibration(gain, sem(lg - offsets[:, None, None], n), np.where(n > 0, angle, 0.0), sem(an, n),
-                            np.where(nk > 0, azim, 0.0), sem(az, nk), nk > 0, nk.astype(int),
-                            list(names) if names is not None else [])
+        out = ArrayCalibration(np.where(any_has, np.exp(g), 1.0), sem(lg - offsets[:, None, None], g, n), angle,
+                               sem(an, angle, n), azim, sem(az, azim, nk), nk > 0, nk.astype(int),
+                               list(names) if names is not None else [])
+    return out
