@@ -402,6 +402,13 @@ class RecordingsConfig:
     latitude_deg, longitude_deg, utc_offset_hours : the site and the folder names' time zone.
     dusk_elevation_deg : time-of-day sessions with the sun lower count as ``tod_dusk``.
     on_bad_file : ``error`` (score the good files, then stop naming the bad ones) or ``skip`` (warn).
+    calibration : ``none`` (nominal gains and polarizer angles), ``auto`` (self-calibration from the
+        recordings' daylight rotations, each day decoded with the calibration of the other days:
+        leave one day out; ``calibration.json`` of all days in the run folder) or the path of such a file.
+    calibration_parts : which parts to apply: ``gains`` (photodiode gains), ``angles`` (polarizer offsets).
+        Default ``[angles]``: on the recordings the estimated gains made every decoder worse (docs/polcompass.md).
+    calibration_solver : ``pol_op`` (the POL-OP chain, each pair at its mean calibrated orientation) or
+        ``stokes`` (every photodiode at its own angle, linear least squares).
     """
 
     path: Optional[str] = None
@@ -419,6 +426,9 @@ class RecordingsConfig:
     utc_offset_hours: float = bounded(2.0, ge=-14.0, le=14.0)
     dusk_elevation_deg: float = bounded(10.0, ge=-90.0, le=90.0)
     on_bad_file: str = bounded("error", choices=("error", "skip"))
+    calibration: str = "none"
+    calibration_parts: list[str] = bounded(["angles"], length=(1, 2), item=Range(choices=("gains", "angles")))
+    calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
 
 
 @dataclass

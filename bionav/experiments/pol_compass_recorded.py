@@ -21,6 +21,20 @@ def is_array_reading(message: dict) -> bool:
     return isinstance(message, dict) and "photodiodes" in message and "units" in message
 
 
+def _calibrated_array(array, how: str, counts, yaw, valid):
+    """``sensor.calibration``: ``none``, ``auto`` (self-calibrated from these samples) or a calibration file."""
+    from bionav.polcompass.array_calibration import ArrayCalibration, calibrate_session, combine_sessions
+
+    how = str(how or "none")
+    if how == "none":
+        return array
+    if how == "auto":
+        cal = combine_sessions([calibrate_session(counts, yaw, valid, array)])
+    else:
+        cal = ArrayCalibration.load(how)
+    return cal.apply(array, gains=False, azimuths=False)  # gains made the recorded compass worse (docs/polcompass.md)
+
+
 def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) -> dict:
     """Read every recorded sample, decode it, and score it against the recorded yaw.
 
@@ -60,6 +74,7 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
     )
     valid = sample_validity(counts, saturation_counts=sensor_config.saturation_counts,
                             dark_counts=sensor_config.dark_counts, imbalance_decades=sensor_config.imbalance_decades)
+    array = _calibrated_array(array, getattr(sensor_config, "calibration", "none"), counts, yaw, valid)
     with np.errstate(invalid="ignore", divide="ignore"):
         ev = evectors_from_counts(counts, array)
     est = decoder.decode(ev, valid & np.isfinite(ev.angle), array=array, sun_elevation=float(session.sun.elevation))
@@ -76,6 +91,8 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
         "decoded_fraction": float(np.mean(ok)),
         "resolved_fraction": float(np.mean(est.resolved)),
         "heading_offset_deg": float(np.degrees(errors.offset)),
+        "calibration": str(getattr(sensor_config, "calibration", "none")) if getattr(sensor_config, "calibration", "none")
+        in ("none", "auto") else "file",
     }
     if plots is not None:
         plots_mod.plot_rotation(plots / "heading_vs_pan.png", np.unwrap(yaw[ok]), heading[ok] - errors.offset, errors.errors,

@@ -58,6 +58,11 @@ class PolArray:
         its output is ``log10(s_a / s_b)``.
     gains : ndarray, shape ``(K, P)``
         Relative photodiode sensitivities (counts are divided by them).
+    solver : {'pol_op', 'stokes'}
+        How :func:`evectors_from_counts` reads a unit: ``pol_op`` from the POL-OPs' log ratios
+        (eqs. 4.2-4.5, orthogonal pairs assumed); ``stokes`` from all photodiodes at once by linear
+        least squares on ``s_p / g_p = I (1 + q cos 2 alpha_p + u sin 2 alpha_p) / 2`` (any
+        polarizer angles, e.g. calibrated ones: :mod:`bionav.polcompass.array_calibration`).
     """
 
     unit_azimuths: np.ndarray
@@ -65,6 +70,7 @@ class PolArray:
     polarizer_angles: np.ndarray
     pairs: np.ndarray
     gains: np.ndarray | None = None
+    solver: str = "pol_op"
 
     def __post_init__(self):
         az = np.atleast_1d(np.asarray(self.unit_azimuths, float))
@@ -77,6 +83,8 @@ class PolArray:
             raise ValueError(f"polarizer_angles has {pol.shape[0]} rows for {az.size} units")
         if pairs.shape[1] != 2 or pairs.min() < 0 or pairs.max() >= pol.shape[1]:
             raise ValueError(f"pairs must be (J, 2) photodiode indices below {pol.shape[1]}, got {pairs.tolist()}")
+        if self.solver not in ("pol_op", "stokes"):
+            raise ValueError(f"solver must be 'pol_op' or 'stokes', got {self.solver!r}")
         gains = np.ones_like(pol) if self.gains is None else np.broadcast_to(np.asarray(self.gains, float), pol.shape).copy()
         object.__setattr__(self, "unit_azimuths", az)
         object.__setattr__(self, "unit_tilts", tilt)
@@ -104,7 +112,8 @@ class PolArray:
     def subset(self, units) -> "PolArray":
         """The array made of some units only (indices or a boolean mask)."""
         idx = np.arange(self.n_units)[np.asarray(units)]
-        return PolArray(self.unit_azimuths[idx], self.unit_tilts[idx], self.polarizer_angles[idx], self.pairs, self.gains[idx])
+        return PolArray(self.unit_azimuths[idx], self.unit_tilts[idx], self.polarizer_angles[idx], self.pairs, self.gains[idx],
+                        self.solver)
 
     @classmethod
     def thesis(cls, unit_angles_deg=(0.0, 60.0, 120.0)) -> "PolArray":
@@ -217,6 +226,35 @@ def evector_from_pol_ops(x, alphas):
     return wrap_axial(0.5 * np.arctan2(cs[..., 1], cs[..., 0])), np.hypot(cs[..., 0], cs[..., 1])
 
 
+def stokes_evector(counts, array: PolArray):
+    """E-vector angle and degree of each unit from all its photodiodes (``solver="stokes"``).
+
+    ``s_p / g_p = (I / 2) (1 + q cos 2 alpha_p + u sin 2 alpha_p)`` is linear in ``(I, I q, I u)``;
+    three or more polarizer angles give it by least squares (exactly the POL-OP result for two
+    ideal orthogonal pairs with equal pair totals).
+
+    Parameters
+    ----------
+    counts : ndarray, shape ``(..., K, P)``
+    array : PolArray
+
+    Returns
+    -------
+    angle, degree : ndarray, shape ``(..., K)``
+        Radians ``[-pi/2, pi/2)`` in the unit frame; NaN where a count is not positive or the intensity is.
+    """
+    s = np.asarray(counts, float) / array.gains
+    a2 = 2.0 * array.polarizer_angles
+    design = 0.5 * np.stack([np.ones_like(a2), np.cos(a2), np.sin(a2)], axis=-1)  # (K, P, 3)
+    pinv = np.linalg.pinv(design)  # (K, 3, P)
+    sol = np.einsum("kip,...kp->...ki", pinv, s)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = sol[..., 1] / sol[..., 0]
+        u = sol[..., 2] / sol[..., 0]
+    bad = ~(np.all(s > 0, axis=-1) & (sol[..., 0] > 0))
+    return (np.where(bad, np.nan, wrap_axial(0.5 * np.arctan2(u, q))), np.where(bad, np.nan, np.hypot(q, u)))
+
+
 def view_groups(array: PolArray) -> list[list[int]]:
     """Units sharing one unit frame (same view and same polarizer reference), in order of first appearance."""
     frames = np.round(array.unit_frames().reshape(array.n_units, -1), 9)
@@ -246,7 +284,9 @@ def evectors_from_counts(counts, array: PolArray) -> UnitEvectors:
     x = delogarithmise(log_ratios_from_counts(counts, array))
     frames = array.unit_frames()  # (K, 3, 3)
     groups = view_groups(array)
-    if all(len(g) == 1 for g in groups):
+    if array.solver == "stokes":
+        angle, degree = stokes_evector(counts, array)
+    elif all(len(g) == 1 for g in groups):
         angle, degree = evector_from_pol_ops(x, array.pair_angles)
     else:  # units looking at the same sky point (the thesis' zenith units) are solved together
         angle = np.empty(x.shape[:-1])

@@ -43,6 +43,9 @@ class RecordingConfig:
     same keys as ``recordings.*`` of ``experiment=pol_recordings``): tilt_deg, azimuth_sign (-1:
     file azimuths clockwise), photodiode_angles_deg (unit frame, file order), pairs (POL-OPs),
     saturation_counts, dark_counts, imbalance_decades.
+    calibration : ``none`` (nominal photodiode gains and polarizer angles), ``auto`` (self-calibrated from
+        the played rotations and their yaw, :mod:`bionav.polcompass.array_calibration`) or the path of a
+        ``calibration.json`` written by ``experiment=pol_recordings recordings.calibration=auto``.
     """
 
     path: str = ""
@@ -55,6 +58,7 @@ class RecordingConfig:
     saturation_counts: float = bounded(11000.0, gt=0.0, le=1e12)
     dark_counts: float = bounded(5.0, ge=0.0, le=1e12)
     imbalance_decades: float = bounded(0.15, gt=0.0, le=3.0)
+    calibration: str = "none"
 
 
 class Recording(SensorPlugin):
