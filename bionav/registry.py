@@ -254,6 +254,8 @@ def load_plugin(kind: str, name_or_class: str | type) -> type:
 #: plugin kinds whose classes may choose their config group (``config_group``); every other kind's
 #: plugins are selected in the group named like the kind, so they are listed without importing them
 KINDS_WITH_OWN_GROUPS = frozenset({"sensor"})
+#: plugin kinds selected inside an experiment's config (``experiment.agents=[...]``), not in a config group
+KINDS_WITHOUT_GROUP = frozenset({"route_agent"})
 
 
 def names_in_group(group: str) -> list[str]:
@@ -285,6 +287,8 @@ def names_by_group() -> dict[str, list[str]]:
 def _names_by_group() -> dict[str, tuple[str, ...]]:
     out: dict[str, list[str]] = {}
     for kind in GROUPS:
+        if kind in KINDS_WITHOUT_GROUP:
+            continue
         if kind in KINDS_WITH_OWN_GROUPS:
             for name, plugin in plugins_of(kind, warn=False).items():
                 for group in plugin.config_groups:
@@ -297,7 +301,7 @@ def _names_by_group() -> dict[str, tuple[str, ...]]:
 def kind_of_group(group: str) -> str | None:
     """The plugin kind whose plugins are selected in config group ``group`` (None: not a plugin group)."""
     if group in GROUPS:
-        return group
+        return None if group in KINDS_WITHOUT_GROUP else group
     if group == "pantilt":
         return "sensor"
     return None
