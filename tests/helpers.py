@@ -105,3 +105,17 @@ def run_into_closed_pipe(*args: str, module: str, cwd: Path, timeout: float = 30
         os.close(write_end)
     proc.stdout = ""
     return proc
+
+
+def source_copy(src: Path, dst: Path) -> Path:
+    """A copy of the source tree ``src`` in ``dst``, to build or install from without writing into the checkout.
+
+    pip builds a local directory in place (``build/``, ``*.egg-info``); tests build the copy instead.
+    Version-control files, virtual environments and caches are left out.
+    """
+    import shutil
+
+    ignore = shutil.ignore_patterns(".git", ".venv", ".ci-venv", "venv", "build", "*.egg-info", "__pycache__",
+                                    ".pytest_cache", ".ruff_cache", ".ci-cache", "outputs", "multirun", "dist")
+    shutil.copytree(src, dst, ignore=ignore, symlinks=True)
+    return Path(dst)

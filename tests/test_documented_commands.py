@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from helpers import source_copy
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -284,8 +285,9 @@ def plugin_site(tmp_path_factory):
     """Local packages the docs install before using them (``pip install -e examples/...``)."""
     target = tmp_path_factory.mktemp("site")
     for req in sorted({c.requires for c in documented_commands() if c.requires}):
+        src = source_copy(ROOT / req, tmp_path_factory.mktemp("src") / Path(req).name)  # never build in the checkout
         proc = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--no-build-isolation", "-q",
-                               "--target", str(target), str(ROOT / req)], capture_output=True, text=True)
+                               "--target", str(target), str(src)], capture_output=True, text=True)
         assert proc.returncode == 0, f"pip install {req} (documented before a command) failed:\n{proc.stderr}"
     return target
 

@@ -7,7 +7,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
-from helpers import run_bionav
+from helpers import run_bionav, source_copy
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -19,7 +19,8 @@ def _pip(*args, cwd):
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory):
     out = tmp_path_factory.mktemp("wheel")
-    proc = _pip("wheel", str(ROOT), "--no-deps", "--no-build-isolation", "-w", str(out), "-q", cwd=out)
+    src = source_copy(ROOT, out / "src")  # pip builds in place: never into the checkout
+    proc = _pip("wheel", str(src), "--no-deps", "--no-build-isolation", "-w", str(out), "-q", cwd=out)
     assert proc.returncode == 0, proc.stderr
     return next(out.glob("bionav-*.whl"))
 
@@ -57,7 +58,7 @@ def test_regular_install_runs_from_the_checkout_root(wheel, tmp_path):
 
 def test_example_plugin_selected_from_the_cli(tmp_path):
     target = tmp_path / "site"
-    example = ROOT / "examples" / "bionav-plugin-example"
+    example = source_copy(ROOT / "examples" / "bionav-plugin-example", tmp_path / "example")
     proc = _pip("install", "--no-deps", "--no-build-isolation", "--target", str(target), str(example), "-q", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     env = {"PYTHONPATH": os.pathsep.join([str(target), os.environ.get("PYTHONPATH", "")])}
