@@ -89,3 +89,12 @@ def test_split_cross_db_run_merges_to_the_unsplit_results(tmp_path):
     assert merged["tasks"] == 3
     assert (result.dir / "cross_db.csv").read_text() == (tmp_path / "whole" / "cross_db.csv").read_text()
     assert (result.dir / "plots" / "cross_db.png").is_file()
+
+
+def test_merge_of_no_run_is_one_clear_message(tmp_path):
+    (tmp_path / "empty").mkdir()
+    for args in ([str(tmp_path / "m"), str(tmp_path / "nowhere")], [str(tmp_path / "m"), str(tmp_path / "empty")]):
+        proc = run_bionav(*args, cwd=tmp_path, module="bionav.experiments.merge")
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+        assert "is not a run directory" in proc.stderr and args[1] in proc.stderr
+    assert not (tmp_path / "m").exists()  # nothing written for a refused merge

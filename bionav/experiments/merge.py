@@ -24,6 +24,10 @@ def merge_tasks(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
     """Merge the tasks in ``task_dirs`` into ``out`` with their experiment's ``merge``; the merged metrics."""
     if not task_dirs:
         raise UserError("no task directories given; name the run directories of the tasks to merge.")
+    for d in map(Path, task_dirs):
+        if not d.is_dir() or not (d / "metrics.json").is_file():
+            raise UserError(f"{d} is not a run directory (no metrics.json there); give the run directories of the "
+                            f"tasks, e.g. the hydra.run.dir of each experiment.block=[i,n] run.")
     first = read_metrics(task_dirs[0]) or {}
     name = first.get("experiment")
     if name not in SPLITTABLE:
@@ -54,4 +58,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from bionav.errors import run_main
+
+    run_main(main, "bionav.experiments.merge")
