@@ -181,49 +181,6 @@ def mirror_gauge(stokes, theta):
     return best
 
 
-def mirror_offset(chi, weight, theta):
-    """Common angle offset and symmetry axis of a ring of e-vector angles symmetric about one meridian.
-
-    Finds ``phi`` and ``delta0`` such that ``chi(phi + x) - delta0 = -(chi(phi - x) - delta0)``
-    (mod pi) best, weighting each pair by ``weight(phi + x) weight(phi - x)``.
-
-    Parameters
-    ----------
-    chi : ndarray, shape ``(G,)``
-        E-vector angle (radians, axial) at ``theta``, a regular grid over the full turn.
-    weight : ndarray, shape ``(G,)``
-        E.g. the degree of polarization.
-    theta : ndarray, shape ``(G,)``
-
-    Returns
-    -------
-    delta0 : float
-        Radians, in ``[-pi/4, pi/4)`` (the condition fixes it modulo 90 degrees; the offset nearest 0 is taken).
-    phi : float
-        Symmetry axis, radians (modulo pi: either end of the meridian).
-    strength : float
-        Mean resultant length of ``exp(4 i (chi(phi+x) + chi(phi-x)) / 2)`` in ``[0, 1]``.
-    """
-    g = theta.size
-    z = np.exp(2j * np.asarray(chi, float))
-    w = np.asarray(weight, float)
-    best = (0.0, 0.0, -1.0)
-    idx = np.arange(g)
-    for s in range(g):  # axis through grid point s (and between s and s+1 via the half-step shift)
-        for half in (0, 1):
-            plus = (s + idx) % g
-            minus = (s + half - idx) % g
-            pair_w = w[plus] * w[minus]
-            tot = np.sum(pair_w)
-            if tot <= 0:
-                continue
-            r = np.sum(pair_w * z[plus] * z[minus]) / tot  # exp(2i (chi+ + chi-)) = exp(4 i delta0)
-            if abs(r) > best[2]:
-                phi = theta[s] + half * np.pi / g
-                best = (float(np.angle(r) / 4.0), float(phi), float(abs(r)))
-    return best
-
-
 def _channel_fit(stokes, c, w):
     """Weighted least squares of each channel's counts on the ring Stokes vectors: ``c_kp(b) = m_kp . S(theta_bk)``."""
     # stokes (B, K, 3), c (B, K, P), w (B, K, P) -> m (K, P, 3)
