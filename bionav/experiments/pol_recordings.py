@@ -268,18 +268,24 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     """The same sensor, samples and exclusions under bionav's sky model at the session's time and place.
 
     Photodiode counts from :func:`bionav.polcompass.array.stokes_from_sky`
-    (point optics) scaled to the session's median count, with a log-normal
-    gain spread, proportional noise and the same saturation; canopy sessions
-    get a cloud field of ``sim_canopy_cover``.
+    (point optics) scaled to the session's median count, through a device
+    drawn with a log-normal photodiode gain spread ``sim_gain_sigma`` and
+    polarizer angle offsets ``sim_angle_sigma_deg`` (the decoder assumes the
+    nominal device), with proportional noise and the same saturation; canopy
+    sessions get a cloud field of ``sim_canopy_cover``.
     """
+    from dataclasses import replace
+
     from bionav.light import SkyModel, random_cloud_map
     from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
 
     clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
     model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
     mount = float(rng.uniform(-np.pi, np.pi))
-    intensity, q, u = stokes_from_sky(model, data.array, mount + data.yaw)
-    counts = counts_from_stokes(intensity, q, u, data.array)
+    offsets = np.deg2rad(exp.sim_angle_sigma_deg) * rng.standard_normal(data.array.polarizer_angles.shape)
+    device = replace(data.array, polarizer_angles=data.array.polarizer_angles + offsets)
+    intensity, q, u = stokes_from_sky(model, device, mount + data.yaw)
+    counts = counts_from_stokes(intensity, q, u, device)
     lit = data.counts[data.counts > 0]
     scale = (np.median(lit) if lit.size else 1000.0) / max(float(np.median(counts)), 1e-12)
     gains = np.exp(exp.sim_gain_sigma * rng.standard_normal(counts.shape[1:]))
@@ -427,7 +433,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             fault_rows.append(row)
         ctx.log.write(FAULT_TOPIC, {"session": session.name, "excluded": data.excluded,
                                     "units": [f.to_dict() for f in data.faults]}, schema_name="bionav.PolOpFaults")
-        sim_data = simulate_session(data, exp, rng_sim) if exp.simulate else None
+        sim_runs = [simulate_session(data, exp, rng_sim) for _ in range(exp.sim_repeats)] if exp.simulate else []
         data = calibrated(data, cal, rc.calibration_parts, rc.calibration_solver)
         base = {
             "session": session.name,
@@ -460,9 +466,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                 res_by_group[data.period].append(resolved)
                 real_err[data.period].append(err)
                 per_session_plot.append((session, data, err))
-                if sim_data is not None:
-                    sim_heading, _, _ = decode_session(dec, sim_data)
-                    s_err, _ = session_errors(sim_heading, sim_data.yaw)
+                if sim_runs:  # every repeat its own simulated device (gains) and cloud draw, errors pooled
+                    s_err = np.concatenate([session_errors(decode_session(dec, sd)[0], sd.yaw)[0] for sd in sim_runs])
                     s_stats = error_stats(s_err)
                     row["sim_mae_deg"] = s_stats["mae_deg"]
                     row["sim_rmse_deg"] = s_stats["rmse_deg"]
@@ -529,6 +534,12 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             metrics[f"{r['group']}_mae_deg"] = r["mae_deg"]
             metrics[f"{r['group']}_rmse_deg"] = r["rmse_deg"]
     if exp.simulate:
+        metrics["sim_repeats"] = int(exp.sim_repeats)
+        metrics["sim_gain_sigma"] = float(exp.sim_gain_sigma)
+        metrics["sim_angle_sigma_deg"] = float(exp.sim_angle_sigma_deg)
+        metrics["sim_noise"] = float(exp.sim_noise)
+        metrics["sim_canopy_cover"] = float(exp.sim_canopy_cover)
+        metrics["sim_max_degree"] = float(exp.sim_max_degree)
         for g in GROUPS:
             if sim_err[g]:
                 metrics[f"sim_{g}_mae_deg"] = error_stats(np.concatenate(sim_err[g]))["mae_deg"]

@@ -7,22 +7,21 @@ Lambrinos et al. 2000, doi:10.1016/S0921-8890(99)00064-0, with per-channel
 tolerances)::
 
     c_kp(t) = g_kp I(theta) (1 + q(theta) cos 2 alpha_kp + u(theta) sin 2 alpha_kp) / 2,
-    theta = yaw(t) + A_k + eps_k,     alpha_kp = alpha0_kp + delta_kp,
+    theta = yaw(t) + A_k,     alpha_kp = alpha0_kp + delta_kp,
 
 where ``I, q, u`` (radiance and normalised Stokes parameters in the unit
 frame, see :mod:`bionav.polcompass.array`) are one smooth function of the
 viewing azimuth ``theta`` around the ring, shared by all units (a Fourier
 series of ``n_harmonics``), ``A_k`` the nominal unit azimuth, and the unknowns
-per channel are the photodiode gain ``g_kp``, the polarizer angle offset
-``delta_kp`` and (optionally) a unit pointing offset ``eps_k``.
-:func:`calibrate_session` fits all of them to the log counts binned by yaw
-(nonlinear least squares, :func:`scipy.optimize.least_squares`). The ring
-fixes everything but three gauges:
+per channel are the photodiode gain ``g_kp`` and the polarizer angle offset
+``delta_kp`` (unit pointing offsets are not fitted: the file format keeps a
+per-unit ``azimuth_offset`` at 0 for them). :func:`calibrate_session` fits
+them to the counts binned by yaw by alternating linear least squares (the
+ring given the channels, each channel given the ring). The ring fixes
+everything but these gauges:
 
 * the overall gain scale (absorbed into ``I``): gains are reported relative
   to their geometric mean over the fitted channels;
-* a pointing offset common to all units (absorbed into the ring's phase, i.e.
-  the heading offset): ``mean eps = 0``;
 * a gain pattern common to all units that varies with the polarizer angle
   as ``cos 2 alpha`` or ``sin 2 alpha`` (absorbed into a constant added to
   ``q`` or ``u``): fixed by making the channels as a whole most nearly nominal,
@@ -31,14 +30,13 @@ fixes everything but three gauges:
   ``0.01 / d`` radians);
 * a polarizer offset common to all units (absorbed into a rotation of
   ``q, u``). It is fixed by the mirror symmetry of a clear sky about the
-  solar meridian: the fitted e-vector angle ``chi(theta)`` must satisfy
-  ``chi(phi + x) - delta0 = -(chi(phi - x) - delta0)`` for some ``phi``
-  (:func:`mirror_offset`), which holds for single and multiple scattering
-  alike; only clear (``symmetric=True``) sessions should be used.
+  solar meridian: ``I`` and ``I q`` are even and ``I u`` odd about some axis
+  ``phi`` (:func:`mirror_gauge`), which holds for single and multiple
+  scattering alike; only clear (``symmetric=True``) sessions should be used.
 
-:func:`combine_sessions` pools the per-session estimates (least squares with
-one gain gauge per session) into an :class:`ArrayCalibration` with standard
-errors from the spread across sessions; :meth:`ArrayCalibration.apply` returns
+:func:`combine_sessions` pools the per-session estimates (medians, one gain
+gauge per session) into an :class:`ArrayCalibration` with standard errors
+from the spread across sessions; :meth:`ArrayCalibration.apply` returns
 the calibrated :class:`~bionav.polcompass.array.PolArray` (per-channel gains,
 angles and unit azimuths), read through the POL-OP chain with each pair at
 its mean calibrated orientation (default) or, ``solver="stokes"``, from all
@@ -180,49 +178,6 @@ def mirror_gauge(stokes, theta):
             if bad < best[2]:
                 # odd combination: annihilates the even part; even pair: annihilates the odd part
                 best = (np.stack([vto[-2], vto[-1], vte[-1]]), float(theta[sh] + half * np.pi / g), float(bad))
-    return best
-
-
-def mirror_offset(chi, weight, theta):
-    """Common angle offset and symmetry axis of a ring of e-vector angles symmetric about one meridian.
-
-    Finds ``phi`` and ``delta0`` such that ``chi(phi + x) - delta0 = -(chi(phi - x) - delta0)``
-    (mod pi) best, weighting each pair by ``weight(phi + x) weight(phi - x)``.
-
-    Parameters
-    ----------
-    chi : ndarray, shape ``(G,)``
-        E-vector angle (radians, axial) at ``theta``, a regular grid over the full turn.
-    weight : ndarray, shape ``(G,)``
-        E.g. the degree of polarization.
-    theta : ndarray, shape ``(G,)``
-
-    Returns
-    -------
-    delta0 : float
-        Radians, in ``[-pi/4, pi/4)`` (the condition fixes it modulo 90 degrees; the offset nearest 0 is taken).
-    phi : float
-        Symmetry axis, radians (modulo pi: either end of the meridian).
-    strength : float
-        Mean resultant length of ``exp(4 i (chi(phi+x) + chi(phi-x)) / 2)`` in ``[0, 1]``.
-    """
-    g = theta.size
-    z = np.exp(2j * np.asarray(chi, float))
-    w = np.asarray(weight, float)
-    best = (0.0, 0.0, -1.0)
-    idx = np.arange(g)
-    for s in range(g):  # axis through grid point s (and between s and s+1 via the half-step shift)
-        for half in (0, 1):
-            plus = (s + idx) % g
-            minus = (s + half - idx) % g
-            pair_w = w[plus] * w[minus]
-            tot = np.sum(pair_w)
-            if tot <= 0:
-                continue
-            r = np.sum(pair_w * z[plus] * z[minus]) / tot  # exp(2i (chi+ + chi-)) = exp(4 i delta0)
-            if abs(r) > best[2]:
-                phi = theta[s] + half * np.pi / g
-                best = (float(np.angle(r) / 4.0), float(phi), float(abs(r)))
     return best
 
 
