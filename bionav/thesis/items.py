@@ -156,7 +156,9 @@ def grid_spec(db: str, *, homing: str = "sift", size=None, preprocess: Sequence[
     snaps = snapshot_list(db, snapshots)
     if snaps is not None:
         ov.append(f"experiment.snapshots=[{','.join(map(str, snaps))}]")
-    return RunSpec(tuple([*ov, *extra]), group="grid_homing", blocks=int((blocks or {}).get(homing, 1)))
+    nx, ny = db_meta(db)["grid_shape"]
+    most = len(snaps) if snaps is not None else max(1, int(nx * ny * 0.85))  # never a block without a snapshot
+    return RunSpec(tuple([*ov, *extra]), group="grid_homing", blocks=min(int((blocks or {}).get(homing, 1)), most))
 
 
 def cutoff_preprocess(cutoff: float, *, equalize: bool = True) -> list[str]:
@@ -592,7 +594,10 @@ class _Fig55:
 def _cross_spec(preset: Preset, homing: str) -> RunSpec:
     ov = ["experiment=cross_db", f"homing={homing}", f"experiment.family=[{','.join(preset.cross_db_family)}]",
           f"experiment.snapshot_stride={preset.cross_db_stride}", *size_arg(preset.cross_db_size)]
-    return RunSpec(tuple(ov), group="cross_db", blocks=int(preset.cross_db_blocks.get(homing, 1)))
+    nx, ny = db_meta(preset.cross_db_family[0])["grid_shape"]
+    stride = preset.cross_db_stride
+    cells = max(1, int(-(-nx // stride) * -(-ny // stride) * 0.85))  # snapshots, never a block without one
+    return RunSpec(tuple(ov), group="cross_db", blocks=min(int(preset.cross_db_blocks.get(homing, 1)), cells))
 
 
 def _cross_matrix(res: RunResult, measure: str) -> tuple[list[str], np.ndarray]:
