@@ -32,7 +32,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--preset", default="quick", help=f"how much to run: {' | '.join(PUBLIC_PRESETS)} (default quick)")
     p.add_argument("--only", default=None, metavar="ITEMS", help="comma-separated items (ids or thesis numbers)")
-    p.add_argument("--out", required=True, metavar="DIR", help="report directory; runs go to DIR/runs (reused when re-run)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="report directory; runs go to DIR/runs (reused when re-run); needed unless --plan")
     p.add_argument("--launcher", default=None, metavar="NAME",
                    help="run through a Hydra launcher (joblib, submitit_slurm, submitit_local, ...) as multiruns")
     p.add_argument("--launcher-arg", action="append", default=[], metavar="KEY=VALUE",
@@ -42,6 +43,12 @@ def build_parser() -> argparse.ArgumentParser:
                         "multiruns in flight (default 1; submitit_slurm: all job arrays at once)")
     p.add_argument("--dry-run", action="store_true", help="print the bionav commands and write nothing")
     p.add_argument("--report-only", action="store_true", help="run nothing; report from the runs already in DIR")
+    plan = p.add_argument_group("plan (run nothing)")
+    plan.add_argument("--plan", action="store_true",
+                      help="print the tasks, the CPU each needs, the critical path and the expected wall time")
+    plan.add_argument("--nodes", type=int, default=1, help="machines of the plan (default 1)")
+    plan.add_argument("--cores", type=int, default=None, help="cores per machine (default: this machine's)")
+    plan.add_argument("--json", action="store_true", help="with --plan: one JSON object")
     return p
 
 
@@ -106,6 +113,10 @@ def run(args) -> int:
         raise UserError(f"--jobs {args.jobs} is out of range; give 1 (one run after the other) up to the number "
                         f"of runs to execute at once, e.g. --jobs {usable_cpus()}.")
     items = select_items(args.only)
+    if args.plan:
+        return _plan(args, items, preset)
+    if args.out is None:
+        raise UserError("--out DIR is needed: the report directory (runs go to DIR/runs), e.g. --out thesis_report.")
     out = user_path(args.out).resolve()
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out} is a file; give a directory.")
@@ -189,6 +200,22 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
     print(f"bionav.thesis: {len(sections)} items in {wall:.0f} s: " +
           ", ".join(f"{v} {counts.get(v, 0)}" for v in ("holds", "partly", "does not hold", "not produced")))
     print(f"report: {out / 'report.md'} ({out / 'report.html'}, {out / 'items.csv'})")
+    return 0
+
+
+def _plan(args, items, preset) -> int:
+    """``--plan``: the preset's tasks, their CPU, the critical path and the wall time; runs nothing."""
+    import json
+
+    from bionav.thesis.plan import format_plan, plan_for
+    from bionav.thesis.runs import usable_cpus
+
+    specs = [s for it in items for s in it.runs(preset)]
+    plan = plan_for(specs, nodes=args.nodes, cores=args.cores or usable_cpus())
+    if args.json:
+        print(json.dumps({"preset": preset.name, **plan}))
+    else:
+        print(format_plan(plan, preset=preset.name))
     return 0
 
 

@@ -61,7 +61,7 @@ class Preset:
     #: goes as 64 tasks of about 15 minutes each that a launcher spreads over cores and nodes
     grid_blocks: dict = field(default_factory=dict)
     #: tasks per cross-database run (fig. 5.6) by homing method: the thesis' 2D-warping over all 8 x 8
-    #: database pairs needs about 100 CPU hours, so 256 tasks of about 25 minutes
+    #: database pairs needs about 50 CPU hours (plan of 2026-11-27), so 128 tasks of two snapshots each
     cross_db_blocks: dict = field(default_factory=dict)
     reductions: tuple[str, ...] = ()
 
@@ -92,7 +92,7 @@ FULL = Preset(
     pol_vs_em_samples=100,
     cleaning_runs=10,
     grid_blocks={"warping2d_thesis": 64, "minwarping_thesis": 64, "sift": 8},
-    cross_db_blocks={"warping2d_thesis": 256, "sift": 16},
+    cross_db_blocks={"warping2d_thesis": 128, "sift": 16},
     reductions=(),
 )
 
@@ -123,6 +123,7 @@ QUICK = Preset(
     pol_samples=100,
     pol_vs_em_samples=100,
     cleaning_runs=2,
+    cross_db_blocks={"warping2d": 4},
     reductions=(
         "grid homing: 6 snapshots per database (evenly spread over the images) instead of all; "
         "min-/2D-warping: 2 snapshots",

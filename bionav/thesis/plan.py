@@ -1,0 +1,249 @@
+"""A plan before the run: ``python -m bionav.thesis --preset P --plan --nodes N --cores C [--json]``.
+
+The plan lists every task the preset's runs make (a run, or one ``experiment.block=[i,n]`` task of
+a split run, :meth:`bionav.thesis.runs.RunSpec.tasks`), the CPU seconds each is expected to need,
+the critical path and the expected wall time on ``nodes x cores`` cores.
+
+How the CPU of a task is estimated (:func:`task_cpu_s`), each figure with its basis:
+
+* grid homing and the cross-database test: home vectors x the method's CPU ms per home vector
+  (:data:`HOME_VECTOR_MS`, measured on this machine with ``python -m bionav.bench``, scaled
+  with the image's pixels where the method works on the database's own size), plus rendering its
+  databases once (:data:`RENDER_S_PER_MPX`);
+* the parameter sweep: its jobs x the CPU of one job (:data:`RUN_CPU_S`);
+* every other experiment: the CPU of one run (:data:`RUN_CPU_S`), measured or assumed as the
+  table says.
+
+The expected wall time schedules the renders first, then the tasks on ``nodes x cores`` slots of
+one core each (a task's own threads are not counted): the earliest free core takes the longest
+task whose render is done. The critical path is the longest chain on unlimited cores: a
+database's render, then its longest task.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import asdict, dataclass
+from typing import Any, Iterable, Sequence
+
+from bionav.thesis.runs import RunSpec
+
+#: CPU ms per home vector (method -> (ms, reference pixels or None when the method resizes to its own
+#: size, basis)); "measured" figures come from ``python -m bionav.bench`` and runs on this machine (AMD
+#: EPYC Zen 4, 2 cores, AVX-512, native code) while other work loaded it, so they are upper bounds
+HOME_VECTOR_MS: dict[str, tuple[float, int | None, str]] = {
+    "sift": (0.30, 1122 * 162, "measured: 8.6 s CPU for the 28,730 pairs of sim_original at 1122x162, per-image "
+                               "SIFT included (docs/performance.md section 0)"),
+    "minwarping": (4.0, None, "measured 2026-11-27: python -m bionav.bench --method minwarping, single search "
+                              "at 288x50, 96x96 steps, CPU ms per home vector (load 15-30)"),
+    "minwarping_cleaning": (4.0, None, "as minwarping"),
+    "warping2d": (16.7, None, "measured 2026-11-27: python -m bionav.bench --method warping2d, single search "
+                              "at 288x50 (load 15-30)"),
+    "warping1d": (23.6, None, "measured 2026-11-27: python -m bionav.bench --method warping1d (load 15-30)"),
+    "hiss": (1.0, None, "measured 2026-11-27: python -m bionav.bench --method hiss (load 15-30)"),
+    "minwarping_thesis": (28.0, None, "measured 2026-11-27: wall ms per home vector of homing=minwarping_thesis "
+                                      "on sim_original, 2 snapshots, workers=1, load about 15 (an upper bound of "
+                                      "its CPU)"),
+    "warping2d_thesis": (65.0, None, "measured 2026-11-27: wall ms per home vector of homing=warping2d_thesis "
+                                     "on sim_original, 2 snapshots, workers=1, load about 15 (an upper bound)"),
+    "mfdid": (0.05, 288 * 50, "assumed: an image difference and two shifts per pair (not timed)"),
+    "parameter": (0.02, None, "assumed: signature distances (not timed)"),
+}
+#: rendering a stand-in: CPU seconds per million pixels of all its images (measured: sim_original at
+#: 1122x162, 170 images, about 24 s; docs/performance.md section 0)
+RENDER_S_PER_MPX = 0.78
+#: default image size of the stand-ins when a run names none (W, H)
+DEFAULT_SIZE = (561, 81)
+#: CPU seconds of one run of the experiments without home-vector counts (experiment -> (s, basis))
+RUN_CPU_S: dict[str, tuple[float, str]] = {
+    "param_sweep_job": (4.0, "measured: 393 s CPU for the 15,606 configurations of three stand-ins in one run "
+                             "per database (docs/performance.md section 6), plus about 3 s of start-up per job"),
+    "cleaning_run": (3.5, "measured: 35.3 s CPU for 10 runs of long_lanes (docs/performance.md section 0)"),
+    "pol_compass": (60.0, "assumed (not timed at the full preset)"),
+    "contrast_lda": (60.0, "assumed (not timed at the full preset)"),
+    "contrast_scan": (120.0, "assumed (not timed at the full preset)"),
+    "skyline_homing": (300.0, "assumed (not timed at the full preset)"),
+    "standins": (60.0, "assumed"),
+}
+#: jobs of one parameter-sweep multirun per grid (19 signatures x sizes x preprocessings)
+PARAM_SWEEP_JOBS = {"full": 342, "ci": 19}
+
+
+@dataclass(frozen=True)
+class TaskEstimate:
+    """One task of the plan: its command, expected CPU seconds and their basis."""
+
+    command: str
+    experiment: str
+    cpu_s: float
+    basis: str
+    render: tuple[str, ...]
+    render_cpu_s: float
+
+
+def _overrides(spec: RunSpec) -> dict[str, str]:
+    return dict(o.lstrip("+~").partition("=")[::2] for o in spec.overrides)
+
+
+def _ints(text: str) -> list[int]:
+    return [int(v) for v in text.strip("[] ").split(",") if v.strip()]
+
+
+def _grid_images(db: str) -> int:
+    from bionav.thesis.items import db_meta
+
+    nx, ny = db_meta(db)["grid_shape"]
+    return int(nx) * int(ny)
+
+
+def _size(ov: dict[str, str]) -> tuple[int, int]:
+    if "db.image_size" in ov:
+        w, h = _ints(ov["db.image_size"])
+        return w, h
+    return DEFAULT_SIZE
+
+
+def _hv_ms(homing: str, size: tuple[int, int]) -> tuple[float, str]:
+    ms, ref, basis = HOME_VECTOR_MS.get(homing, (10.0, None, f"assumed for the unknown method {homing!r}"))
+    if ref is not None:
+        ms *= size[0] * size[1] / ref
+    return ms, basis
+
+
+def task_cpu_s(spec: RunSpec) -> TaskEstimate:
+    """The expected CPU seconds of one task (a run or a block of a split run) and their basis."""
+    ov = _overrides(spec)
+    experiment = ov.get("experiment", "grid_homing")
+    homing = ov.get("homing", "sift")
+    size = _size(ov)
+    block = _ints(ov["experiment.block"]) if "experiment.block" in ov else None
+    command = "python -m bionav " + (" -m " if spec.multirun else "") + " ".join(spec.overrides)
+    if experiment == "grid_homing":
+        db = ov.get("db", "sim_original")
+        n = _grid_images(db)
+        snaps = len(_ints(ov["experiment.snapshots"])) if "experiment.snapshots" in ov else n
+        if block:
+            snaps = math.ceil(snaps / block[1])
+        ms, basis = _hv_ms(homing, size)
+        render = n * size[0] * size[1] / 1e6 * RENDER_S_PER_MPX
+        return TaskEstimate(command, experiment, snaps * n * ms / 1e3, f"{snaps} x {n} home vectors; {basis}",
+                            (db, f"{size[0]}x{size[1]}"), render)
+    if experiment == "cross_db":
+        family = ov.get("experiment.family", "[sim_original]").strip("[]").split(",")
+        stride = int(ov.get("experiment.snapshot_stride", 2))
+        n = _grid_images(family[0].strip())
+        nx, ny = (math.ceil(v / stride) for v in _grid_shape(family[0].strip()))
+        snaps = nx * ny if not block else math.ceil(nx * ny / block[1])
+        ms, basis = _hv_ms(homing, size)
+        pairs = len(family) ** 2 * snaps * n
+        render = len(family) * n * size[0] * size[1] / 1e6 * RENDER_S_PER_MPX
+        return TaskEstimate(command, experiment, pairs * ms / 1e3,
+                            f"{len(family)}^2 database pairs x {snaps} x {n} home vectors; {basis}",
+                            tuple(sorted(family)) + (f"{size[0]}x{size[1]}",), render)
+    if experiment == "param_sweep":
+        jobs = PARAM_SWEEP_JOBS.get(ov.get("experiment.grid", "full"), 342)
+        s, basis = RUN_CPU_S["param_sweep_job"]
+        return TaskEstimate(command, experiment, jobs * s, f"{jobs} jobs; {basis}", (ov.get("db", ""),), 0.0)
+    if experiment == "cleaning":
+        s, basis = RUN_CPU_S["cleaning_run"]
+        runs = int(ov.get("runs", 10))
+        return TaskEstimate(command, experiment, runs * s, f"{runs} runs; {basis}", (), 0.0)
+    s, basis = RUN_CPU_S.get(experiment, (60.0, f"assumed for {experiment}"))
+    return TaskEstimate(command, experiment, s, basis, (), 0.0)
+
+
+def _grid_shape(db: str) -> tuple[int, int]:
+    from bionav.thesis.items import db_meta
+
+    nx, ny = db_meta(db)["grid_shape"]
+    return int(nx), int(ny)
+
+
+def make_plan(specs: Iterable[RunSpec], *, nodes: int, cores: int) -> dict[str, Any]:
+    """The tasks of ``specs`` with their CPU, the critical path and the expected wall time.
+
+    Parameters
+    ----------
+    specs : iterable of RunSpec
+        The runs of the selected items (duplicates counted once).
+    nodes, cores : int
+        Machines and cores per machine; every task takes one core.
+
+    Returns
+    -------
+    dict
+        ``tasks`` (list of :class:`TaskEstimate` as dicts), ``n_tasks``, ``largest_task_cpu_s``,
+        ``total_cpu_s`` (tasks and renders), ``critical_path_s``, ``expected_wall_s``, ``slots``.
+    """
+    unique: dict[str, RunSpec] = {}
+    for s in specs:
+        unique.setdefault(s.key, s)
+    tasks = [task_cpu_s(t) for s in unique.values() for t in s.tasks()]
+    renders: dict[tuple[str, ...], float] = {}
+    for t in tasks:
+        if t.render:
+            renders[t.render] = max(renders.get(t.render, 0.0), t.render_cpu_s)
+    slots = max(1, nodes * cores)
+    # renders first (longest first), then the tasks longest first, each on the earliest free slot and
+    # not before its render is done
+    free = [0.0] * slots
+    heapq.heapify(free)
+    ready: dict[tuple[str, ...], float] = {}
+    for key, cpu in sorted(renders.items(), key=lambda kv: -kv[1]):
+        start = heapq.heappop(free)
+        ready[key] = start + cpu
+        heapq.heappush(free, start + cpu)
+    end = 0.0
+    pending = sorted(tasks, key=lambda t: -t.cpu_s)
+    while pending:  # the earliest free core takes the longest task whose render is done (else the first ready)
+        at = heapq.heappop(free)
+        pick = next((t for t in pending if ready.get(t.render, 0.0) <= at), None)
+        if pick is None:
+            pick = min(pending, key=lambda t: ready.get(t.render, 0.0))
+        pending.remove(pick)
+        start = max(at, ready.get(pick.render, 0.0))
+        heapq.heappush(free, start + pick.cpu_s)
+        end = max(end, start + pick.cpu_s)
+    critical = max((renders.get(t.render, 0.0) + t.cpu_s for t in tasks), default=0.0)  # on unlimited cores
+    return {
+        "tasks": [asdict(t) for t in tasks],
+        "n_tasks": len(tasks),
+        "largest_task_cpu_s": max((t.cpu_s for t in tasks), default=0.0),
+        "total_cpu_s": sum(t.cpu_s for t in tasks) + sum(renders.values()),
+        "critical_path_s": critical,
+        "expected_wall_s": max(end, critical),
+        "slots": slots,
+        "nodes": nodes,
+        "cores": cores,
+    }
+
+
+def format_plan(plan: dict[str, Any], *, preset: str, top: int = 15) -> str:
+    """A human-readable summary: the totals and the ``top`` largest tasks."""
+    h = 3600.0
+    lines = [
+        f"plan for --preset {preset} on {plan['nodes']} node(s) x {plan['cores']} core(s) ({plan['slots']} slots, one "
+        f"task per core; CPU figures measured on this machine or assumed, as each task's basis says):",
+        f"  tasks: {plan['n_tasks']}",
+        f"  total CPU: {plan['total_cpu_s'] / h:.1f} h",
+        f"  largest task: {plan['largest_task_cpu_s'] / 60:.1f} min CPU",
+        f"  critical path: {plan['critical_path_s'] / 60:.1f} min",
+        f"  expected wall time: {plan['expected_wall_s'] / h:.2f} h",
+        f"largest tasks (of {plan['n_tasks']}):",
+    ]
+    for t in sorted(plan["tasks"], key=lambda t: -t["cpu_s"])[:top]:
+        lines.append(f"  {t['cpu_s'] / 60:8.1f} min  {t['command']}")
+        lines.append(f"               ({t['basis']})")
+    return "\n".join(lines)
+
+
+def plan_for(specs: Sequence[RunSpec], *, nodes: int, cores: int) -> dict[str, Any]:
+    """:func:`make_plan` with the arguments checked (one message naming the bad one)."""
+    from bionav.errors import UserError
+
+    if not 1 <= nodes <= 100_000:
+        raise UserError(f"--nodes {nodes} is out of range; give 1 or more machines, e.g. --nodes 8.")
+    if not 1 <= cores <= 10_000:
+        raise UserError(f"--cores {cores} is out of range; give the cores per machine, e.g. --cores 16.")
+    return make_plan(specs, nodes=nodes, cores=cores)

@@ -1,0 +1,56 @@
+"""Issue 29 item 3: ``python -m bionav.thesis --plan``: tasks, their CPU, critical path, wall time."""
+
+import json
+
+import pytest
+from helpers import run_bionav
+
+from bionav.thesis import plan as plan_mod
+from bionav.thesis.runs import RunSpec
+
+
+def test_grid_task_cpu_is_home_vectors_times_the_unit_cost():
+    ms = plan_mod.HOME_VECTOR_MS["minwarping"][0]
+    spec = RunSpec(("experiment=grid_homing", "db=sim_original", "homing=minwarping", "experiment.snapshots=[0,5,9]"))
+    est = plan_mod.task_cpu_s(spec)
+    assert est.cpu_s == pytest.approx(3 * 170 * ms / 1e3)  # sim_original: a 10 x 17 grid
+    split = RunSpec(spec.overrides, blocks=3).tasks()
+    assert [plan_mod.task_cpu_s(t).cpu_s for t in split] == pytest.approx([170 * ms / 1e3] * 3)
+
+
+def test_schedule_longest_first_after_the_renders(monkeypatch):
+    """Hand-computed: a 4 s render, then tasks of 10, 6, 6 and 4 s (one needs no render) on 2 slots."""
+    costs = {"a": (10.0, ("db1",)), "b": (6.0, ("db1",)), "c": (6.0, ()), "d": (4.0, ())}
+
+    def fake(spec):
+        name = spec.overrides[0]
+        cpu, render = costs[name]
+        return plan_mod.TaskEstimate(name, "x", cpu, "test", render, 4.0 if render else 0.0)
+
+    monkeypatch.setattr(plan_mod, "task_cpu_s", fake)
+    specs = [RunSpec((n,)) for n in costs]
+    p = plan_mod.make_plan(specs, nodes=1, cores=2)
+    assert p["n_tasks"] == 4 and p["largest_task_cpu_s"] == 10.0
+    assert p["total_cpu_s"] == pytest.approx(26.0 + 4.0)
+    assert p["critical_path_s"] == pytest.approx(14.0)  # render 4 s, then a (10 s)
+    # slot 1: render 0-4, a 4-14; slot 2: c 0-6 (b waits for the render: starts at 6), b 6-12, d 12-16
+    assert p["expected_wall_s"] == pytest.approx(16.0)
+    assert plan_mod.make_plan(specs, nodes=4, cores=1)["expected_wall_s"] == pytest.approx(14.0)
+
+
+def test_plan_command_prints_json_and_refuses_bad_sizes(tmp_path):
+    proc = run_bionav("--preset", "tiny", "--plan", "--nodes", "2", "--cores", "4", "--json", cwd=tmp_path,
+                      module="bionav.thesis")
+    assert proc.returncode == 0, proc.stderr
+    p = json.loads(proc.stdout)
+    assert {"tasks", "largest_task_cpu_s", "total_cpu_s", "critical_path_s", "expected_wall_s"} <= set(p)
+    assert p["slots"] == 8 and p["n_tasks"] == len(p["tasks"]) > 0
+    assert p["largest_task_cpu_s"] == max(t["cpu_s"] for t in p["tasks"])
+    assert p["expected_wall_s"] >= p["critical_path_s"] > 0
+    assert not list(tmp_path.glob("*report*"))  # a plan runs and writes nothing
+    text = run_bionav("--preset", "full", "--only", "table5_4", "--plan", cwd=tmp_path, module="bionav.thesis")
+    assert text.returncode == 0 and "expected wall time" in text.stdout and "experiment.block=[0,64]" in text.stdout
+    bad = run_bionav("--preset", "tiny", "--plan", "--nodes", "0", cwd=tmp_path, module="bionav.thesis")
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr and "--nodes 0" in bad.stderr
+    no_out = run_bionav("--preset", "tiny", "--only", "table3_1", cwd=tmp_path, module="bionav.thesis")
+    assert no_out.returncode == 2 and "--out DIR is needed" in no_out.stderr
