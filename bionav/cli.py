@@ -310,6 +310,25 @@ def _check_name_lengths(path: Path, key: str) -> None:
             )
 
 
+def _expand_output_dirs(argv: list[str]) -> list[str]:
+    """``hydra.run.dir=~/x`` (quoted for Hydra) with ``~`` expanded: Hydra itself would create a folder named ``~``."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    parser = OverridesParser.create()
+    out = []
+    for a in argv:
+        if a.split("=", 1)[0] in ("hydra.run.dir", "hydra.sweep.dir") and "~" in a:
+            try:
+                override = parser.parse_overrides([a])[0]
+                value = override.value()
+            except Exception:
+                value = None
+            if isinstance(value, str) and value.startswith("~"):
+                a = f'{override.key_or_group}="{user_path(value)}"'
+        out.append(a)
+    return out
+
+
 def _resuming(argv: list[str]) -> bool:
     """True when the command line says ``bionav.resume=true``."""
     words = [w.lstrip("+") for w in _override_words(argv)]
@@ -488,6 +507,7 @@ def main(argv: list[str] | None = None) -> None:
     except UserError as exc:
         _fail(str(exc))
 
+    argv = _expand_output_dirs(argv)
     multirun = any(a in ("-m", "--multirun") for a in argv)
     shows = [a for a in argv if a in ("--cfg", "-c", "--info", "--shell-completion", "-sc") or a.startswith("--info")]
     if multirun and shows:

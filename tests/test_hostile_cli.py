@@ -125,3 +125,13 @@ def test_help_into_a_closed_pipe_ends_quietly(tmp_path):
     proc = run_into_closed_pipe("--help", module="bionav", cwd=tmp_path)
     assert proc.returncode == 141, proc.stderr
     assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr
+
+
+def test_tilde_in_the_run_dir_is_the_home_folder(tmp_path, tiny):
+    home = tmp_path / "home"
+    home.mkdir()
+    proc = run_tiny(tiny, 'hydra.run.dir="~/myrun"', "experiment.snapshots=[0]", cwd=tmp_path,
+                    env={"HOME": str(home)})
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().splitlines()[-1] == f"run directory: {home / 'myrun'}"
+    assert (home / "myrun" / "metrics.json").is_file() and not (tmp_path / "~").exists()
