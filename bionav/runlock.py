@@ -59,12 +59,12 @@ def lock_owner(run_dir: str | Path) -> dict | None:
     info = _read(Path(run_dir) / LOCK_FILE)
     if info is None:
         return None
-    if info.get("host") != socket.gethostname():
-        return info
     try:
         pid = int(info.get("pid", -1))
     except (TypeError, ValueError):  # not written by bionav: nobody holds it
         return None
+    if info.get("host") != socket.gethostname():
+        return info
     if pid <= 0 or not _alive(pid):
         return None
     start = info.get("start_ticks")
