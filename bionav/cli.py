@@ -518,11 +518,15 @@ def main(argv: list[str] | None = None) -> None:
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    try:  # SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does
-        signal.signal(signal.SIGTERM, _terminate)
-        signal.signal(signal.SIGHUP, _terminate)
-    except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
-        pass
+    # SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does;
+    # a signal the caller chose to ignore stays ignored (`nohup python -m bionav ...` survives the hangup)
+    for name in ("SIGTERM", "SIGHUP"):
+        try:
+            sig = getattr(signal, name)
+            if signal.getsignal(sig) != signal.SIG_IGN:
+                signal.signal(sig, _terminate)
+        except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
+            pass
     try:
         hydra_main()
     except KeyboardInterrupt:
