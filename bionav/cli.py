@@ -310,6 +310,25 @@ def _check_name_lengths(path: Path, key: str) -> None:
             )
 
 
+def _expand_output_dirs(argv: list[str]) -> list[str]:
+    """``hydra.run.dir=~/x`` (quoted for Hydra) with ``~`` expanded: Hydra itself would create a folder named ``~``."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    parser = OverridesParser.create()
+    out = []
+    for a in argv:
+        if a.split("=", 1)[0] in ("hydra.run.dir", "hydra.sweep.dir") and "~" in a:
+            try:
+                override = parser.parse_overrides([a])[0]
+                value = override.value()
+            except Exception:
+                value = None
+            if isinstance(value, str) and value.startswith("~"):
+                a = f'{override.key_or_group}="{user_path(value)}"'
+        out.append(a)
+    return out
+
+
 def _resuming(argv: list[str]) -> bool:
     """True when the command line says ``bionav.resume=true``."""
     words = [w.lstrip("+") for w in _override_words(argv)]
@@ -519,6 +538,7 @@ def main(argv: list[str] | None = None) -> None:
     except UserError as exc:
         _fail(str(exc))
 
+    argv = _expand_output_dirs(argv)
     multirun = any(a in ("-m", "--multirun") for a in argv)
     shows = [a for a in argv if a in ("--cfg", "-c", "--info", "--shell-completion", "-sc") or a.startswith("--info")]
     if multirun and shows:
@@ -529,11 +549,15 @@ def main(argv: list[str] | None = None) -> None:
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    try:  # SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does
-        signal.signal(signal.SIGTERM, _terminate)
-        signal.signal(signal.SIGHUP, _terminate)
-    except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
-        pass
+    # SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does;
+    # a signal the caller chose to ignore stays ignored (`nohup python -m bionav ...` survives the hangup)
+    for name in ("SIGTERM", "SIGHUP"):
+        try:
+            sig = getattr(signal, name)
+            if signal.getsignal(sig) != signal.SIG_IGN:
+                signal.signal(sig, _terminate)
+        except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
+            pass
     try:
         if completion and any(a.startswith("query=") for a in argv):
             _completion_query(hydra_main)

@@ -39,10 +39,15 @@ def _alive(pid: int) -> bool:
 
 
 def _read(path: Path) -> dict | None:
+    from bionav.files import not_a_regular_file
+
+    if not_a_regular_file(path) not in (None, "does not exist"):  # a FIFO must not block: a broken lock
+        return {"pid": -1, "host": "?", "started": f"{path} {not_a_regular_file(path)}"}
     try:
-        return json.loads(path.read_text())
+        info = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
+    return info if isinstance(info, dict) else None
 
 
 def lock_owner(run_dir: str | Path) -> dict | None:
@@ -54,9 +59,12 @@ def lock_owner(run_dir: str | Path) -> dict | None:
     info = _read(Path(run_dir) / LOCK_FILE)
     if info is None:
         return None
+    try:
+        pid = int(info.get("pid", -1))
+    except (TypeError, ValueError):  # not written by bionav: nobody holds it
+        return None
     if info.get("host") != socket.gethostname():
         return info
-    pid = int(info.get("pid", -1))
     if pid <= 0 or not _alive(pid):
         return None
     start = info.get("start_ticks")

@@ -125,3 +125,34 @@ def test_help_into_a_closed_pipe_ends_quietly(tmp_path):
     proc = run_into_closed_pipe("--help", module="bionav", cwd=tmp_path)
     assert proc.returncode == 141, proc.stderr
     assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr
+
+
+def test_tilde_in_the_run_dir_is_the_home_folder(tmp_path, tiny):
+    home = tmp_path / "home"
+    home.mkdir()
+    proc = run_tiny(tiny, 'hydra.run.dir="~/myrun"', "experiment.snapshots=[0]", cwd=tmp_path,
+                    env={"HOME": str(home)})
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().splitlines()[-1] == f"run directory: {home / 'myrun'}"
+    assert (home / "myrun" / "metrics.json").is_file() and not (tmp_path / "~").exists()
+
+
+@pytest.mark.parametrize("name, kind", [("metrics.json", "fifo"), ("metrics.json", "list"),
+                                        (".bionav.lock", "garbage")])
+def test_odd_files_in_the_run_directory_do_not_block_or_crash(tmp_path, tiny, name, kind):
+    """A FIFO or a list as metrics.json, a lock file that bionav did not write: no hang, no traceback."""
+    import os
+
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    if kind == "fifo":
+        os.mkfifo(run_dir / name)
+    else:
+        (run_dir / name).write_text("[1, 2]" if kind == "list" else '{"pid": "abc"}')
+    proc = run_tiny(tiny, f"hydra.run.dir={run_dir}", "experiment.snapshots=[0]", cwd=tmp_path)
+    assert proc.seconds < 300 and "Traceback" not in proc.stderr, proc.stderr
+    if kind == "fifo":  # the run replaces the FIFO with its own metrics.json
+        assert proc.returncode == 0, proc.stderr
+        assert json.loads((run_dir / "metrics.json").read_text())["status"] == "completed"
+    else:
+        assert proc.returncode == 0, proc.stderr

@@ -70,12 +70,22 @@ def tiny(tmp_path_factory):
     return write_tiny_folder(tmp_path_factory.mktemp("db") / "tiny")
 
 
-def _start(tmp: Path, site: Path, tiny: Path, name: str) -> tuple[subprocess.Popen, Path, Path]:
+def _default_signals(ignore_hup: bool = False) -> None:
+    """In the child: the terminal's dispositions, whatever pytest was started with (``nohup``, ``&``)."""
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
+    if ignore_hup:
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)
+
+
+def _start(tmp: Path, site: Path, tiny: Path, name: str, *, nohup: bool = False
+           ) -> tuple[subprocess.Popen, Path, Path]:
     run_dir, pairs_log = tmp / name, tmp / f"{name}.pairs"
     env = dict(os.environ, BIONAV_CACHE=str(tmp / "cache"), SLOW_PAIRS_LOG=str(pairs_log), **pythonpath_with(site))
     cmd = [sys.executable, "-m", "bionav", "homing=slow", f"homing.delay_s={DELAY_S}", "db=folder",
            f"db.path={tiny}", "workers=1", "bionav.cache_prepared=false", f"hydra.run.dir={run_dir}"]
-    proc = subprocess.Popen(cmd, cwd=tmp, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, cwd=tmp, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: _default_signals(ignore_hup=nohup))
     return proc, run_dir, pairs_log
 
 
@@ -170,3 +180,24 @@ def test_hangup_and_term_inside_a_long_row_end_like_ctrl_c(tmp_path, slow_site, 
         assert make_reader(f).get_summary() is not None  # closed with summary and index
     assert logged_results(run_dir / "run.mcap")["n_home_vectors"] >= 1
     assert "interrupted" in (run_dir / "cli.log").read_text()
+
+
+def test_under_nohup_a_hangup_is_ignored(tmp_path, slow_site, tiny):
+    """`nohup python -m bionav ...` (SIGHUP ignored at start) survives the hangup; SIGTERM still ends it cleanly."""
+    proc, run_dir, log = _start(tmp_path, slow_site, tiny, "run", nohup=True)
+    try:
+        _wait_first_pair([(proc, run_dir, log)])
+        proc.send_signal(signal.SIGHUP)
+        time.sleep(2 * DELAY_S)
+        assert proc.poll() is None, proc.communicate()
+        n_before = len(_times(log))
+        time.sleep(DELAY_S + 0.5)
+        assert len(_times(log)) > n_before  # still computing
+        proc.send_signal(signal.SIGTERM)
+        _out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130 and "Traceback" not in err, err
+    assert json.loads((run_dir / "metrics.json").read_text())["status"] == "failed"

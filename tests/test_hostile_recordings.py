@@ -72,3 +72,18 @@ def test_tilde_in_the_recordings_path_is_expanded(tmp_path):
     proc = run_recordings('"~/no_such_recordings"', tmp_path, env={"HOME": str(tmp_path)})
     assert_fails_cleanly(proc, f"recordings.path={tmp_path / 'no_such_recordings'} does not exist", code=2,
                          max_seconds=BOUND_S)
+
+
+@pytest.mark.parametrize("kind", ["fifo", "utf16", "list"])
+def test_a_compass_calibration_that_is_a_fifo_utf16_or_a_list(tmp_path, kind):
+    from bionav.errors import UserError
+    from bionav.polcompass.calibration import UnitCalibration
+
+    path = tmp_path / "calibration.json"
+    if kind == "fifo":
+        os.mkfifo(path)
+    else:
+        path.write_bytes(json.dumps({"center_v": [1.0]}).encode("utf-16") if kind == "utf16" else b"[1, 2]")
+    needle = {"fifo": "FIFO", "utf16": "UTF-16", "list": "JSON list"}[kind]
+    with pytest.raises(UserError, match=needle):
+        UnitCalibration.load(path)

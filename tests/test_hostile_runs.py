@@ -48,8 +48,10 @@ def tiny_folder(tmp_path):
 
 def _start(args, cwd, cache) -> subprocess.Popen:
     env = dict(os.environ, BIONAV_CACHE=str(cache))
+    # Ctrl-C as in a terminal, also when pytest itself runs in the background (which ignores SIGINT)
     return subprocess.Popen([sys.executable, "-m", "bionav", *args], cwd=cwd, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _wait_for(predicate, timeout, proc=None, what=""):

@@ -29,11 +29,17 @@ LOG_FILE = "run.mcap"
 
 
 def read_metrics(run_dir: Path) -> dict | None:
-    """The metrics.json of a run directory, or ``None`` if absent or unreadable."""
+    """The metrics.json of a run directory, or ``None`` if absent, not a regular file, unreadable or not an object."""
+    from bionav.files import not_a_regular_file
+
+    path = Path(run_dir) / METRICS_FILE
+    if not_a_regular_file(path) is not None:  # a FIFO must not block
+        return None
     try:
-        return json.loads((Path(run_dir) / METRICS_FILE).read_text())
+        metrics = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
+    return metrics if isinstance(metrics, dict) else None
 
 
 def is_completed(run_dir: Path) -> bool:

@@ -80,14 +80,15 @@ class UnitCalibration:
     @classmethod
     def load(cls, path) -> "UnitCalibration":
         """Read a calibration written by :meth:`save`."""
-        p = Path(path)
-        try:
-            return cls.from_dict(json.loads(p.read_text()))
-        except (OSError, json.JSONDecodeError) as exc:
-            raise UserError(
-                f"Cannot read the compass calibration {p} ({exc}); point experiment.calibration_path at a "
-                "calibration.json written by a rotation run, or set it to null to calibrate from the scan."
-            ) from None
+        from bionav.files import read_json_file
+
+        data = read_json_file(path, what="The compass calibration", fix=(
+            "Point experiment.calibration_path at a calibration.json written by a rotation run, or set it to null "
+            "to calibrate from the scan."), max_bytes=16 * 2**20)
+        if not isinstance(data, dict):
+            raise UserError(f"The compass calibration {path} holds a JSON {type(data).__name__}, not an object; "
+                            "recalibrate with experiment.mode=rotation.")
+        return cls.from_dict(data)
 
     def save(self, path) -> None:
         """Write the calibration as JSON."""

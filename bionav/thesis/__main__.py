@@ -78,8 +78,8 @@ def main(argv: list[str] | None = None) -> int:
     import signal
 
     args = build_parser().parse_args(argv)
-    for sig in ("SIGTERM", "SIGHUP"):  # `kill` and a closed terminal end the command as Ctrl-C does
-        if hasattr(signal, sig):
+    for sig in ("SIGTERM", "SIGHUP"):  # `kill` and a closed terminal end the command as Ctrl-C does (unless ignored:
+        if hasattr(signal, sig) and signal.getsignal(getattr(signal, sig)) != signal.SIG_IGN:  # nohup)
             signal.signal(getattr(signal, sig), _interrupt)
     try:
         return run(args)
