@@ -345,13 +345,13 @@ def test_match_values_are_sums_of_template_minima(thresholds, step, quantised):
     windows = minwarp_windows(tmpl, max_level=2)
     levels = _window_minima(snap, cur, step, windows, quantised).copy()
     n = W // step
-    p_cols = np.array([0, 1, 5, W - 1], np.int64)
+    p_cols = np.array([0, 1, 5, W - 1, 7], np.int64)  # an odd count: rotations are taken two at a time
     big = np.uint8(255) if quantised else np.float32(np.inf)
-    out = np.zeros((4, n), np.uint16 if quantised else np.float32)
+    out = np.zeros((5, n), np.uint16 if quantised else np.float32)
     minwarp_scores(levels, n, p_cols, *windows, big, out)
     vlo, vhi, klo, khi = tmpl
     dist = levels[0]
-    want = np.zeros((4, n))
+    want = np.zeros((5, n))
     for ip, p in enumerate(p_cols):
         for a in range(n):
             for u in range(W):

@@ -142,14 +142,30 @@ def minwarp_scores(levels, n_alpha, p_cols, start, w_plane, w_level, w_v, big, o
                 pb = (w_level[e] * n_planes + w_plane[e]) * plane_size + rr * n
                 v0 = w_v[e] - u
                 first = e == e0
-                for ip in range(n_p):
-                    base = np.uint64(pb + _wrap(v0 - p_cols[ip], width) * row_stride)
-                    bb = np.uint64(ip) * un
-                    if first:
+                if first:
+                    for ip in range(n_p):
+                        base = np.uint64(pb + _wrap(v0 - p_cols[ip], width) * row_stride)
+                        bb = np.uint64(ip) * un
                         for a in range(n):
                             ua = np.uint64(a)
                             nxt[bb + ua] = flat[base + ua]
-                    else:
+                else:
+                    # two rotations per pass (a longer loop body: the
+                    # compiler's vector loop fits rows of n lanes)
+                    ip = 0
+                    while ip + 1 < n_p:
+                        base = np.uint64(pb + _wrap(v0 - p_cols[ip], width) * row_stride)
+                        base1 = np.uint64(pb + _wrap(v0 - p_cols[ip + 1], width) * row_stride)
+                        bb = np.uint64(ip) * un
+                        bb1 = bb + un
+                        for a in range(n):
+                            ua = np.uint64(a)
+                            nxt[bb + ua] = min(cur[bb + ua], flat[base + ua])
+                            nxt[bb1 + ua] = min(cur[bb1 + ua], flat[base1 + ua])
+                        ip += 2
+                    if ip < n_p:
+                        base = np.uint64(pb + _wrap(v0 - p_cols[ip], width) * row_stride)
+                        bb = np.uint64(ip) * un
                         for a in range(n):
                             ua = np.uint64(a)
                             nxt[bb + ua] = min(cur[bb + ua], flat[base + ua])
