@@ -103,3 +103,19 @@ def test_reference_command_times_the_same_8bit_images_interleaved(tmp_path):
         # ratio: median over the rounds of bionav's CPU / the reference's of the same round (2 rounds: the mean)
         assert r["cpu_ratio_to_reference"] == pytest.approx(r["cpu_ms_per_home_vector"] / (1.5 + k), abs=2e-3)
         assert r["reference_command"].endswith("fake_reference.py")
+
+
+def test_cpu_name_skylake_avx512_runs_only_where_the_cpu_has_avx512(tmp_path):
+    """AVX-512 code is timed on an AVX-512 machine and refused (naming the missing features) elsewhere."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CPU")}
+    env["BIONAV_CACHE"] = str(tmp_path / "cache")
+    missing = missing_host_features(KNOWN_TARGETS["skylake-avx512"])
+    argv = ["--json", "--method", "minwarping", "--cpu-name", "skylake-avx512", *TINY]
+    if missing:
+        proc = subprocess.run([sys.executable, "-m", "bionav.bench", *argv], capture_output=True, text=True, env=env,
+                              timeout=120)
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr
+        assert all(f in proc.stderr for f in missing) and "illegal instruction" in proc.stderr
+        return
+    rows = _bench(argv, env=env)
+    assert {(r["cpu"], r["isa"]) for r in rows} == {("skylake-avx512", "avx512")}
