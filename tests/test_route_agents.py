@@ -222,7 +222,8 @@ def test_route_agents_are_registered_plugins():
 def test_ardin2016_cli_small(tmp_path):
     proc = run_bionav("experiment=route_homing", "experiment.protocol=ardin2016", "experiment.routes=[Ant1_Route1]",
                       "experiment.agents=[perfect_memory,mushroom_body,mfdid]", "experiment.seeds=[0,1]",
-                      "experiment.agent_params={mushroom_body:{n_kc:4000,n_active:40}}", "experiment.plots=false",
+                      "+experiment.agent_params.mushroom_body.n_kc=4000",
+                      "+experiment.agent_params.mushroom_body.n_active=40", "experiment.plots=false",
                       f"hydra.run.dir={tmp_path / 'run'}", f"cache_dir={tmp_path}", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr[-2000:]
     run = tmp_path / "run"
@@ -244,7 +245,7 @@ def test_ardin2016_cli_small(tmp_path):
 @pytest.mark.parametrize("args, needle", [
     (["experiment.agent_step_m=0.0001"], "experiment.agent_step_m=0.0001 allows"),
     (["experiment.agents=[perfect_memory,nope]"], "unknown agent 'nope'"),
-    (["experiment.agents=[infomax]", "experiment.agent_params={infomax:{learning_rate:-1}}"],
+    (["experiment.agents=[infomax]", "+experiment.agent_params.infomax.learning_rate=-1"],
      "experiment.agent_params.infomax.learning_rate"),
     (["experiment.scan_step_deg=3"], "experiment.scan_step_deg"),
 ])

@@ -582,7 +582,8 @@ class RouteHomingConfig:
         ``windowed_memory``, ``infomax``, ``mushroom_body``) and homing methods (``bionav.homing``
         names, e.g. ``minwarping``, ``mfdid``, ``sift``, ``parameter``) following the route by homing
         to the view ``lookahead`` after the best match.
-    agent_params : ``ardin2016``: ``{agent: {parameter: value}}`` overrides of the agents' configs.
+    agent_params : ``ardin2016``: ``{agent: {parameter: value}}`` overrides of the agents' configs
+        (command line: ``+experiment.agent_params.mushroom_body.n_kc=5000``).
     seeds : ``ardin2016``: noise seeds (camera noise, position jitter, random networks); one run each.
     position_jitter_m : ``ardin2016``: Gaussian position noise added after each step, metres (std per axis).
     scan_half_deg, scan_step_deg : ``ardin2016``: the scan around the current heading, degrees.

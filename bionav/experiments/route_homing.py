@@ -32,6 +32,14 @@ Measures (all angles radians, distances metres):
   ``max_steps_factor`` x route length / step; ``route_distance_m`` = mean
   distance of the path from the route.
 
+``experiment.protocol=ardin2016`` runs instead the published test of Ardin,
+Peng, Mangan, Lagogiannis & Webb 2016 (doi:10.1371/journal.pcbi.1004683) for
+every agent of ``experiment.agents`` (``bionav.route_agents`` plugins and
+homing methods), route and seed (:func:`run_ardin2016`,
+:func:`bionav.evaluation.route.follow_route`): errors (put-backs) per route,
+error-free routes and arrivals at the nest, in metrics.json and
+``route_following.csv`` (docs/worlds.md).
+
 Writes metrics.json (``<measure>_<method>``: ``heading_error``,
 ``catchment_width_m``, ``completed``, ``route_distance_m``, each the mean over
 routes), ``route_homing.csv`` (one row per route and method), run.mcap
@@ -397,7 +405,7 @@ def _check_agent_params(exp: RouteHomingConfig, kinds: dict[str, str]) -> None:
                             f"{list(exp.agents)}; add it there or drop its parameters.")
         if not isinstance(params, dict):
             raise UserError(f"experiment.agent_params.{name} must be a mapping of parameters, e.g. "
-                            "experiment.agent_params={mushroom_body:{n_kc:5000}}.")
+                            "+experiment.agent_params.mushroom_body.n_kc=5000.")
         if kinds[name] == "route_agent":
             plugin_config("route_agent", {"name": name, **params}, key=f"experiment.agent_params.{name}")
 

@@ -17,14 +17,17 @@ class InfomaxConfig:
     Attributes
     ----------
     learning_rate : float
-        ``eta`` of the weight update (Baddeley et al. 2012 used 0.01).
+        ``eta`` of the weight update. Baddeley et al. 2012 and BoB's navbench use 0.01 with
+        their input scaling; with unit-length inputs (here) 0.01 barely moves the random
+        weights in one pass. Measured on Ant1..3_Route1 (ardin2016, 1 cm jitter, seed 0):
+        errors 6/9/11 at 0.01, 4/6/8 at 0.1, 2/2/2 at 1.0 (the default).
     hidden_ratio : float
         Hidden units per input pixel (1: as many as pixels, the paper's choice).
     epochs : int
         Passes over the training views (the paper: 1, each view seen once).
     """
 
-    learning_rate: float = bounded(0.01, gt=0.0, le=10.0)
+    learning_rate: float = bounded(1.0, gt=0.0, le=10.0)
     hidden_ratio: float = bounded(1.0, gt=0.0, le=10.0)
     epochs: int = bounded(1, ge=1, le=1000)
 
