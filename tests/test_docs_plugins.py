@@ -12,7 +12,7 @@ def _snippets() -> list[str]:
 
 def test_plugin_docs_snippets_run():
     snippets = _snippets()
-    assert len(snippets) == 10  # a plugin and its test, per kind
+    assert len(snippets) == 12  # a plugin and its test, per kind
     namespace: dict = {"__name__": "docs_plugins"}
     for snippet in snippets:
         exec(compile(snippet, str(DOC), "exec"), namespace)
@@ -21,7 +21,7 @@ def test_plugin_docs_snippets_run():
     from bionav.testing import assert_homing_plugin
 
     assert_homing_plugin(namespace["DarkCentroidHoming"])
-    for cls in ("DarkCentroidHoming", "RowMax", "NoisyCounter", "StraightController", "BrightSide"):
+    for cls in ("DarkCentroidHoming", "RowMax", "NoisyCounter", "StraightController", "BrightSide", "NearestView"):
         plugin_node_class("x", namespace[cls].Config)  # Hydra can store every Config
 
 
@@ -48,7 +48,7 @@ def test_render_pillar_panorama_is_exported():
 
 def test_plugin_docs_decoder_rejects_bad_values_through_its_config():
     namespace: dict = {"__name__": "docs_plugins"}
-    exec(compile(_snippets()[-2], str(DOC), "exec"), namespace)
+    exec(compile(next(s for s in _snippets() if "class BrightSide" in s), str(DOC), "exec"), namespace)
     import pytest
 
     from bionav.errors import UserError
