@@ -134,8 +134,10 @@ def test_check_config_names_key_value_and_range(field, value, needle):
 
 
 #: string options that are free text (paths, ports, names resolved elsewhere, times)
+#: keys whose values are free text or paths (``calibration``: none | auto | a calibration.json path, checked where
+#: the file is read)
 FREE_TEXT = {"port", "path", "topic", "signature", "time", "name", "calibration_path", "world", "grid", "route",
-             "routes_path"}
+             "routes_path", "calibration"}
 
 
 def _all_config_classes():
