@@ -78,22 +78,34 @@ def guard_closed_pipe() -> None:
         sys.stdout = _ClosedPipeGuard(sys.stdout)
 
 
-def run_main(main: Callable[[], "int | None"], prog: str) -> NoReturn:
+def run_main(main: Callable[[], "int | None"], prog: str, *,
+             interrupted: str = "interrupted; what was written so far is kept.") -> NoReturn:
     """Run a command's ``main()`` and exit with its status: the one wrapper of every ``__main__``.
 
-    * output into a closed pipe ends quietly (:func:`guard_closed_pipe`);
+    * output into a closed pipe ends quietly (:func:`guard_closed_pipe`), also argparse's
+      ``--help | head -1``;
     * a :class:`UserError` that escapes ``main`` becomes ``<prog>: error: <message>``
-      on stderr and exit status 2.
+      on stderr and exit status 2;
+    * Ctrl-C becomes ``<prog>: <interrupted>`` and exit status 130, never a traceback.
     """
     import sys
 
     guard_closed_pipe()
     try:
-        code = main()
+        try:
+            code = main()
+        except SystemExit as exc:  # argparse's --help and errors: their output is flushed below too
+            code = exc.code
+        except UserError as exc:
+            print(f"{prog}: error: {exc}", file=sys.stderr)
+            code = 2
+        except KeyboardInterrupt:
+            print(f"{prog}: {interrupted}", file=sys.stderr)
+            code = 130
         sys.stdout.flush()
     except BrokenPipeError:
         closed_pipe_exit()
-    except UserError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        code = 2
+    if isinstance(code, str):  # sys.exit("message")
+        print(code, file=sys.stderr)
+        code = 1
     sys.exit(code or 0)

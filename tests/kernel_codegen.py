@@ -24,20 +24,12 @@ import sys
 import tempfile
 from pathlib import Path
 
+from bionav.bench.cpu import KNOWN_TARGETS
+
 #: numba target per ISA: (NUMBA_CPU_NAME, NUMBA_CPU_FEATURES); the name alone does not change the features
-TARGETS = {
-    "avx2": (
-        "haswell",
-        "+64bit,+avx,+avx2,+bmi,+bmi2,+cmov,+cx16,+cx8,+f16c,+fma,+fxsr,+lzcnt,+mmx,+movbe,+popcnt,+sse,+sse2,"
-        "+sse3,+sse4.1,+sse4.2,+ssse3",
-    ),
-    "avx512": (
-        "skylake-avx512",
-        "+64bit,+adx,+aes,+avx,+avx2,+avx512bw,+avx512cd,+avx512dq,+avx512f,+avx512vl,+bmi,+bmi2,+cmov,+cx16,+cx8,"
-        "+f16c,+fma,+fsgsbase,+fxsr,+lzcnt,+mmx,+movbe,+pclmul,+popcnt,+prfchw,+rdrnd,+rdseed,+sahf,+sse,+sse2,"
-        "+sse3,+sse4.1,+sse4.2,+ssse3,+xsave",
-    ),
-}
+#: (the feature strings have one home: bionav.bench.cpu.KNOWN_TARGETS)
+TARGETS = {"avx2": ("haswell", KNOWN_TARGETS["haswell"]),
+           "avx512": ("skylake-avx512", KNOWN_TARGETS["skylake-avx512"])}
 
 
 def target_env(isa: str, cache_dir: str) -> dict:

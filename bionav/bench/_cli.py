@@ -12,14 +12,10 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from typing import Callable, NoReturn
 
-from bionav.errors import UserError
-
-#: exit status after output went into a closed pipe (128 + SIGPIPE, as a shell reports for ``yes | head -1``)
-EXIT_CLOSED_PIPE = 141
+from bionav.errors import run_main
 
 
 class BenchParser(argparse.ArgumentParser):
@@ -41,32 +37,7 @@ def bounded_int(parser: argparse.ArgumentParser, name: str, value: int, lo: int,
                      f"e.g. {name} {min(max(value, lo), hi)}")
 
 
-def _closed_pipe() -> NoReturn:
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-    except (OSError, ValueError, AttributeError):
-        pass
-    os._exit(EXIT_CLOSED_PIPE)
-
-
 def run(main: Callable[[], "int | None"], prog: str) -> NoReturn:
-    """Run ``main()`` and exit with its status (closed pipe: quiet 141; :class:`UserError`: message, 2)."""
-    try:
-        try:
-            code = main()
-        except SystemExit as exc:  # argparse's --help and errors: flush their output here too
-            code = exc.code
-        except UserError as exc:
-            print(f"{prog}: error: {exc}", file=sys.stderr)
-            code = 2
-        except KeyboardInterrupt:
-            print(f"{prog}: interrupted; nothing more was measured.", file=sys.stderr)
-            code = 130
-        sys.stdout.flush()
-    except BrokenPipeError:
-        _closed_pipe()
-    if isinstance(code, str):
-        print(code, file=sys.stderr)
-        code = 1
-    sys.exit(code or 0)
+    """Run ``main()`` and exit with its status: :func:`bionav.errors.run_main` (closed pipe: quiet 141;
+    :class:`UserError`: message, 2; Ctrl-C: message, 130)."""
+    run_main(main, prog, interrupted="interrupted; nothing more was measured.")
