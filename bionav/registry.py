@@ -254,8 +254,8 @@ def load_plugin(kind: str, name_or_class: str | type) -> type:
 #: plugin kinds whose classes may choose their config group (``config_group``); every other kind's
 #: plugins are selected in the group named like the kind, so they are listed without importing them
 KINDS_WITH_OWN_GROUPS = frozenset({"sensor"})
-#: plugin kinds selected inside an experiment's config (``experiment.agents=[...]``), not in a config group
-KINDS_WITHOUT_GROUP = frozenset({"route_agent"})
+#: plugin kinds selected inside an experiment's config, not in a config group -> how a user selects one
+KINDS_WITHOUT_GROUP: dict[str, str] = {"route_agent": "experiment.agents=[{name}]"}
 
 
 def names_in_group(group: str) -> list[str]:

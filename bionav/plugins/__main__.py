@@ -25,7 +25,10 @@ def main() -> int:
             print("  (none)")
         for name, plugin in sorted(loaded.items()):
             e = plugin.entry
-            select = " ".join(f"{group}={name}" for group in plugin.config_groups)
+            if kind in registry.KINDS_WITHOUT_GROUP:
+                select = registry.KINDS_WITHOUT_GROUP[kind].format(name=name)
+            else:
+                select = " ".join(f"{group}={name}" for group in plugin.config_groups)
             state = "ok" if plugin.cls is not None else "FAILED"
             print(f"  {select:28s} {e.distribution} {e.version:10s} {state}")
             if plugin.error:
