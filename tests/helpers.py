@@ -119,3 +119,9 @@ def source_copy(src: Path, dst: Path) -> Path:
                                     ".pytest_cache", ".ruff_cache", ".ci-cache", "outputs", "multirun", "dist")
     shutil.copytree(src, dst, ignore=ignore, symlinks=True)
     return Path(dst)
+
+
+def external_data() -> Path:
+    """Real data written by others: ``$BIONAV_EXTERNAL_DATA``, else ``../shared/data`` beside the checkout."""
+    env = os.environ.get("BIONAV_EXTERNAL_DATA")
+    return Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "data"

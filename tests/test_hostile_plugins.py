@@ -9,9 +9,9 @@ third-party plugin and ``python -m bionav.plugins`` stay usable.
 from __future__ import annotations
 
 import os
-import textwrap
 
 import pytest
+from helpers import install_plugin_dist as install
 from helpers import run_bionav
 
 PLUGIN = """
@@ -31,19 +31,6 @@ class Twin(HomingMethod):
     def home_vector(self, snapshot, current, *, neighbours=None):
         return HomeVector(0.0)
 """
-
-
-def install(site, dist, entry_points, modules):
-    info = site / f"{dist.replace('-', '_')}-1.0.dist-info"
-    info.mkdir(parents=True)
-    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: 1.0\n")
-    lines = []
-    for group, eps in entry_points.items():
-        lines.append(f"[{group}]")
-        lines += [f"{name} = {target}" for name, target in eps.items()]
-    (info / "entry_points.txt").write_text("\n".join(lines) + "\n")
-    for name, source in modules.items():
-        (site / f"{name}.py").write_text(textwrap.dedent(source))
 
 
 @pytest.fixture

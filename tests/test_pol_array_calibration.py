@@ -2,22 +2,18 @@
 
 import csv
 import json
-import os
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import run_bionav
+from helpers import external_data, run_bionav
 
 from bionav.errors import UserError
 from bionav.light import SkyModel, sun_position
 from bionav.polcompass.array import PolArray, counts_from_stokes, evectors_from_counts, stokes_from_sky
 from bionav.polcompass.array_calibration import ArrayCalibration, calibrate_session, combine_sessions
 
-REPO = Path(__file__).resolve().parents[1]
-EXTERNAL = Path(os.environ.get("BIONAV_EXTERNAL_DATA", REPO.parent / "shared" / "data"))
-COMPASS = EXTERNAL / "celestial-compass"
+COMPASS = external_data() / "celestial-compass"
 needs_data = pytest.mark.skipif(
     not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)"
 )

@@ -2,21 +2,17 @@
 
 import csv
 import json
-import os
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import run_bionav
+from helpers import external_data, run_bionav
 
 from bionav.light import SkyModel, sun_position
 from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
 from bionav.polcompass.recordings import RecordingError, detect_faults, load_rotation, load_sessions
 
-REPO = Path(__file__).resolve().parents[1]
-EXTERNAL = Path(os.environ.get("BIONAV_EXTERNAL_DATA", REPO.parent / "shared" / "data"))
-COMPASS = EXTERNAL / "celestial-compass"
+COMPASS = external_data() / "celestial-compass"
 needs_data = pytest.mark.skipif(
     not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)"
 )
