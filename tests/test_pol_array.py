@@ -120,4 +120,6 @@ def test_decoder_bench_prints_one_json_line_per_decoder(capsys):
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert [r["decoder"] for r in rows] == ["sky_fit", "two_unit", "sol", "four_zeros", "eigenvector", "mean_vector"]
     assert all(r["n_samples"] == 16 and r["wall_ms_per_session"] > 0 and r["cpu_ms_per_session"] >= 0 for r in rows)
-    assert main(["--repeat", "0"]) == 2
+    with pytest.raises(SystemExit) as refused:  # a bad option: one message naming it, status 2 (bench parser)
+        main(["--repeat", "0"])
+    assert refused.value.code == 2 and "--repeat 0 is out of range" in capsys.readouterr().err
