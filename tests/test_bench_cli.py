@@ -42,6 +42,7 @@ def test_bench_rejects_bad_arguments(capsys, argv, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_bench_whole_runs_print_cpu_and_wall(capsys, tmp_path):
     """--method sweep / cleaning run the documented commands (tiny inputs here) and report their times."""
     from helpers import write_tiny_folder
@@ -90,6 +91,7 @@ def test_bench_sift_rejects_bad_arguments(capsys, argv, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_bench_grid_mode_times_the_grid_runner_with_1_and_2_workers(capsys, tmp_path, monkeypatch):
     monkeypatch.setenv("BIONAV_CACHE", str(tmp_path))
     argv = ["--json", "--grid", "sim_original", "--grid-snapshots", "2", "--grid-rounds", "1", "--threads", "2",
@@ -112,6 +114,7 @@ def test_bench_grid_mode_names_an_unknown_database(capsys):
     assert "--grid no_such_db" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_bench_sweep_with_more_workers_than_cpus(tmp_path):
     """Issue 29: `--method sweep --workers N` with N > CPUs completes; the pool has min(tasks, CPUs) processes."""
     import os

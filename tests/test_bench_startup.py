@@ -2,9 +2,11 @@
 
 import json
 
+import pytest
 from helpers import run_bionav
 
 
+@pytest.mark.slow
 def test_startup_bench_times_help_cfg_and_completion(tmp_path):
     proc = run_bionav("--json", "--repeat", "1", cwd=tmp_path, module="bionav.bench.startup")
     assert proc.returncode == 0, proc.stderr

@@ -51,6 +51,7 @@ def test_each_target_has_its_own_numba_cache(tmp_path):
         target_environment("no-such-cpu")
 
 
+@pytest.mark.slow
 def test_rows_carry_the_host_target_and_cpu_name_recompiles(tmp_path):
     """Native rows name the host CPU; --cpu-name haswell rows name haswell / avx2 (or are refused without AVX2)."""
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CPU")}
@@ -105,6 +106,7 @@ def test_reference_command_times_the_same_8bit_images_interleaved(tmp_path):
         assert r["reference_command"].endswith("fake_reference.py")
 
 
+@pytest.mark.slow
 def test_cpu_name_skylake_avx512_runs_only_where_the_cpu_has_avx512(tmp_path):
     """AVX-512 code is timed on an AVX-512 machine and refused (naming the missing features) elsewhere."""
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CPU")}

@@ -184,6 +184,7 @@ def test_camera_images_are_rendered_at_the_perturbed_poses():
         assert np.array_equal(unfold_frame(raw, setup, geometry), moved[k])
 
 
+@pytest.mark.slow
 def test_camera_database_keeps_the_nominal_grid_and_caches(tmp_path):
     kw = dict(image_size=(64, 10), cache_dir=tmp_path)
     db = synthetic_database("sim_original", realism="camera", **kw)
@@ -256,6 +257,7 @@ def test_the_user_door_defaults_to_camera_and_ideal_gives_the_old_images(tmp_pat
     ("db.camera.rim_elevation_deg=20", ["db.camera.rim_elevation_deg", "top of the panorama"]),
     ("db.camera.rim_radius_px=300", ["db.camera.rim_radius_px", "raw_size"]),
 ])
+@pytest.mark.slow
 def test_bad_camera_values_are_rejected_with_one_clear_message(override, words, tmp_path):
     with pytest.raises(UserError) as info:
         _load(["sim_original", "db.image_size=[48,8]", override], tmp_path)
@@ -264,6 +266,7 @@ def test_bad_camera_values_are_rejected_with_one_clear_message(override, words, 
     assert "\n" not in msg.strip()
 
 
+@pytest.mark.slow
 def test_documented_camera_sheet_command_on_a_tiny_input(tmp_path):
     import cv2
     from helpers import run_bionav

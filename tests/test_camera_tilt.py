@@ -90,6 +90,7 @@ def test_tilts_have_the_stated_statistics_and_their_own_stream():
     assert np.all(tilt_offsets([[0, 0], [1, 2]], tilt_sigma_deg=0.0, seed=3) == 0)
 
 
+@pytest.mark.slow
 def test_the_world_floor_sets_the_tilt_unless_the_config_does():
     world = World(scene=Scene(), grid_origin=(0, 0), spacing=1.0, grid_shape=(1, 1), camera_height=0.5,
                   floor_tilt_deg=1.7)

@@ -43,6 +43,7 @@ def test_layout_files_match_the_thesis():
     assert (short.n_lanes, short.lane_length, short.spacing) == (14, 2.0, 0.30)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("controller", ["triangulation", "odometry", "random"])
 def test_cleaning_run_writes_everything(tmp_path, controllers, controller):
     metrics = run_experiment(config(controller), tmp_path, show_progress=False)
@@ -97,6 +98,7 @@ def _relative(messages):
     return out
 
 
+@pytest.mark.slow
 def test_runs_on_two_processes_give_the_same_runs_and_log(tmp_path):
     """The documented command with rendered vision: workers=2 simulates the runs in two processes and
     gives the same trajectories, coverage and log (times relative to the log's start) as workers=1."""

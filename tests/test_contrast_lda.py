@@ -13,6 +13,7 @@ from bionav.experiments import contrast_lda
 from bionav.light.bands import feature_subsets
 
 
+@pytest.mark.slow
 def test_contrast_lda_small_simulated_run(tmp_path):
     cfg = OmegaConf.create({"experiment": {"name": "contrast_lda", "sigma": 30.0, "n_resamples": 200},
                             "data": {"name": "sim_natural", "seed": 3, "n_objects": 60, "n_sky": 50}})
@@ -60,6 +61,7 @@ def test_contrast_lda_csv_round_trip_and_errors(tmp_path):
         contrast_lda.run(bad, FakeContext(tmp_path))
 
 
+@pytest.mark.slow
 def test_documented_command_runs_with_the_committed_data_configs(tmp_path):
     """`python -m bionav experiment=contrast_lda data=...` (conf/data/*.yaml, once hidden by .gitignore) runs;
     the per-feature criteria are logged before the bootstrap and equal metrics.json's."""

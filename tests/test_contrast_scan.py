@@ -87,6 +87,7 @@ def test_serial_scan_through_the_fake_board_equals_the_simulation(scene):
     assert fake.commands.count(b"M1") == 9
 
 
+@pytest.mark.slow
 def test_contrast_scan_experiment_small(tmp_path):
     cfg = OmegaConf.create({
         "seed": 0,

@@ -83,6 +83,7 @@ def test_clouds_are_seeded_by_the_recording_session():
     assert np.corrcoef(z[:-1], z[1:])[0, 1] > 0.6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["sim_moeller1", "sim_roeben1"])
 def test_living_rooms_are_recorded_in_daylight_and_ideal_ignores_it(name, tmp_path):
     world = get_spec(name).builder(0)

@@ -316,6 +316,7 @@ def test_sweeps_expand_into_jobs():
         ["homing=mfdid", "db=a", "seed=1"], ["homing=mfdid", "db=b", "seed=1"]]
 
 
+@pytest.mark.slow
 def test_every_documented_command_composes(sandbox, plugin_site):
     """Every documented command composes (``--cfg job``, or ``--help`` / a tiny real run) without error."""
     all_jobs = _jobs()

@@ -65,6 +65,7 @@ def test_clear_dusk_sky_at_sun_7_degrees_is_classified_as_sky():
 # Differt & Moeller 2016): the evening scene moves along the direction as a whole, and the border moves with it.
 @pytest.mark.parametrize("time, cover, depth", [("2009-06-17T20:43:36+02:00", 0.1, 10.0),   # sun 7.4 deg
                                                 ("2009-06-17T21:15:00+02:00", 0.1, 10.0)])  # sun 3.6 deg
+@pytest.mark.slow
 def test_local_threshold_keeps_the_dusk_sky_sky(time, cover, depth):
     learned, _ = _sky_recall(time, cover, depth)
     sky, objects = _sky_recall(time, cover, depth, threshold="local")
@@ -73,11 +74,13 @@ def test_local_threshold_keeps_the_dusk_sky_sky(time, cover, depth):
     assert sky["UV-IR"] > learned["UV-IR"] + 0.05  # where the day-time border fails
 
 
+@pytest.mark.slow
 def test_local_threshold_by_day_keeps_sky_and_objects_apart():
     sky, objects = _sky_recall("2009-06-17T11:27:04+02:00", 0.85, 35.0, threshold="local")
     assert sky["UV-IR"] > 0.95 and objects > 0.9
 
 
+@pytest.mark.slow
 def test_local_separation_through_the_contrast_scan_command(tmp_path):
     """``python -m bionav experiment=contrast_scan experiment.separation=local`` on the 20:43 scan (docs/spectral.md)."""
     import json

@@ -125,6 +125,7 @@ def test_recorded_panoramas_are_foxglove_images_and_replay_exactly(tmp_path):
         assert image_digest(run.images[k]) == image_digest(view)  # bit-identical for replay
 
 
+@pytest.mark.slow
 def test_oracle_cleaning_log_is_foxglove_valid(tmp_path):
     run_dir = tmp_path / "run"
     proc = run_bionav("experiment=cleaning", "experiment.vision=oracle", "runs=2", "layout=long_lanes",

@@ -49,6 +49,7 @@ def test_drift_is_a_random_walk_over_the_lane_turns():
     np.testing.assert_allclose(lane_heading_drift(cells[:40], drift_sigma_deg=8.0, seed=2, db_seed=1), 2 * d[:40])
 
 
+@pytest.mark.slow
 def test_the_world_floor_sets_the_drift_unless_the_config_does():
     world = World(scene=Scene(), grid_origin=(0, 0), spacing=1.0, grid_shape=(1, 1), camera_height=0.5,
                   heading_drift_deg=7.0)

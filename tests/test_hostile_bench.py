@@ -114,12 +114,14 @@ def _assert_refused(proc, elapsed, option):
     assert elapsed < BOUND_S, f"took {elapsed:.0f} s"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv, option", BENCH_CASES, ids=[" ".join(a)[:60] for a, _ in BENCH_CASES])
 def test_bench_refuses_hostile_input(argv, option, tmp_path):
     proc, elapsed = _run("bionav.bench", argv, cwd=tmp_path)
     _assert_refused(proc, elapsed, option)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("module, argv, option", OTHER_CASES, ids=[f"{m} {' '.join(a)}" for m, a, _ in OTHER_CASES])
 def test_other_bench_commands_refuse_hostile_input(module, argv, option, tmp_path):
     proc, elapsed = _run(module, argv, cwd=tmp_path)

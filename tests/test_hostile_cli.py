@@ -36,6 +36,7 @@ def finished(tiny, tmp_path_factory):
     return proc, root / "run"
 
 
+@pytest.mark.slow
 def test_a_run_prints_its_directory_last_and_logs_to_cli_log(finished):
     proc, run_dir = finished
     assert proc.stdout.strip().splitlines()[-1] == f"run directory: {run_dir}"
@@ -85,6 +86,7 @@ def test_a_300_character_directory_name_is_refused(tmp_path):
     assert_fails_cleanly(proc, "File name too long", "hydra.run.dir=", code=2, max_seconds=REFUSAL_S)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", ["file", "empty", "proc"])
 def test_bionav_cache_that_cannot_hold_a_cache(tmp_path, case):
     value = {"file": str(tmp_path / "a_file"), "empty": "", "proc": "/proc/bionav"}[case]
@@ -109,12 +111,14 @@ OPTUNA = ("-m", "hydra/sweeper=optuna", "hydra.sweeper.n_trials=1", "homing.lowp
     ("hydra.sweeper.n_trials=0", ("hydra.sweeper.n_trials=0", "at least one trial")),
     ("homing.vertical_sigma=interval(0.5,0.1)", ("lower bound", "homing.vertical_sigma=interval(0.1,0.5)")),
 ])
+@pytest.mark.slow
 def test_optuna_settings_that_would_crash_the_sweeper(tmp_path, override, needles):
     proc = run_bionav(*OPTUNA, override, f"hydra.sweep.dir={tmp_path / 's'}", cwd=tmp_path)
     assert_fails_cleanly(proc, *needles, code=2, max_seconds=REFUSAL_S)
     assert not (tmp_path / "s").exists()
 
 
+@pytest.mark.slow
 def test_optuna_objective_naming_a_missing_metric(tmp_path, tiny):
     proc = run_tiny(tiny, *OPTUNA, "objective.metric=nosuch", f"hydra.sweep.dir={tmp_path / 's'}", cwd=tmp_path)
     assert_fails_cleanly(proc, "objective.metric=nosuch", "aae", code=2, max_seconds=300)
@@ -127,6 +131,7 @@ def test_help_into_a_closed_pipe_ends_quietly(tmp_path):
     assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr
 
 
+@pytest.mark.slow
 def test_tilde_in_the_run_dir_is_the_home_folder(tmp_path, tiny):
     home = tmp_path / "home"
     home.mkdir()
@@ -139,6 +144,7 @@ def test_tilde_in_the_run_dir_is_the_home_folder(tmp_path, tiny):
 
 @pytest.mark.parametrize("name, kind", [("metrics.json", "fifo"), ("metrics.json", "list"),
                                         (".bionav.lock", "garbage")])
+@pytest.mark.slow
 def test_odd_files_in_the_run_directory_do_not_block_or_crash(tmp_path, tiny, name, kind):
     """A FIFO or a list as metrics.json, a lock file that bionav did not write: no hang, no traceback."""
     import os

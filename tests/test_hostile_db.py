@@ -50,6 +50,7 @@ def test_stray_far_file_is_named_instead_of_allocating_a_huge_grid(tmp_path):
     assert_fails_cleanly(proc, "99999_99999.png", "100000 x 100000", "db.grid_shape")
 
 
+@pytest.mark.slow
 def test_stray_file_outside_declared_grid_can_be_skipped(tmp_path):
     folder = make_folder(tmp_path / "db", grid(3, 3))
     write_image(folder / "99999_99999.png", np.zeros((SIZE[1], SIZE[0])))
@@ -68,6 +69,7 @@ def test_one_image_database_is_a_user_error_not_nan(tmp_path):
     assert metrics["status"] == "failed" and "at least 2" in metrics["error"]
 
 
+@pytest.mark.slow
 def test_directory_named_like_an_image_is_reported(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "1_1.png").unlink()
@@ -88,6 +90,7 @@ def test_symlink_loop_named_like_an_image_is_reported(tmp_path):
     assert_fails_cleanly(run_folder(tmp_path, folder), "1_0.png", "symbolic-link loop")
 
 
+@pytest.mark.slow
 def test_dangling_symlink_named_like_an_image_is_reported(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "0_1.png").unlink()
@@ -102,6 +105,7 @@ def test_fifo_named_like_an_image_is_reported_not_read(tmp_path):
     assert_fails_cleanly(run_folder(tmp_path, folder), "0_0.png", "not a regular file")
 
 
+@pytest.mark.slow
 def test_unreadable_image_is_an_error_or_skipped_with_a_warning(tmp_path):
     folder = make_folder(tmp_path / "db", grid(2, 2))
     (folder / "1_1.png").write_bytes(b"\x89PNG\r\n\x1a\n garbage")
@@ -111,6 +115,7 @@ def test_unreadable_image_is_an_error_or_skipped_with_a_warning(tmp_path):
     assert "1_1.png" in proc.stdout + proc.stderr
 
 
+@pytest.mark.slow
 def test_present_and_missing_cells_are_reported_at_load(tmp_path):
     """``db=original`` with 60 of its 170 images: the load says so."""
     cells = [(x, y) for x, y in grid(10, 17) if y < 6]  # 60 cells
@@ -122,6 +127,7 @@ def test_present_and_missing_cells_are_reported_at_load(tmp_path):
     assert "60 of 170 grid cells (10 x 17) have an image, 110 missing" in proc.stdout + proc.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("bad", ["db.image_size=[100000,20000]", "db.grid_shape=[0,3]", "db.spacing_m=-1"])
 def test_bad_db_values_on_a_folder(tmp_path, bad):
     folder = make_folder(tmp_path / "db", grid(2, 2))
@@ -154,6 +160,7 @@ def test_db_help_into_a_closed_pipe_ends_quietly(tmp_path):
     assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr, proc.stderr
 
 
+@pytest.mark.slow
 def test_db_export_into_a_folder_another_command_writes_is_refused(tmp_path):
     import json
     import socket

@@ -131,6 +131,7 @@ def _flipped_metadata_log(tmp_path, offset):
     return path
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("offset", [-6, -2, 0, 9, 20])
 def test_a_flipped_byte_in_the_metadata(tmp_path, offset):
     """A flipped byte in the metadata record (its length, its name, its values): info says the file is

@@ -108,6 +108,7 @@ def _wait_first_pair(runs, timeout=240.0) -> None:
     raise AssertionError("no home vector computed in time")
 
 
+@pytest.mark.slow
 def test_sigkill_in_long_rows_loses_at_most_about_two_seconds(tmp_path, slow_site, tiny):
     """Five runs, SIGKILLed 2.9, 5.3, 7.1, 10.5 and 15.3 s after their first home vector (four inside the first
     12.8 s row, one inside the second): each recovered log holds the home vectors computed until about
@@ -149,6 +150,7 @@ def test_sigkill_in_long_rows_loses_at_most_about_two_seconds(tmp_path, slow_sit
     print(f"measured crash loss (s of computed home vectors) at kills {offsets}: {[round(x, 2) for x in losses]}")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGHUP, signal.SIGTERM])
 def test_hangup_and_term_inside_a_long_row_end_like_ctrl_c(tmp_path, slow_site, tiny, sig):
     """Closing the terminal (SIGHUP) or `kill` (SIGTERM) 2.5 s into a 12.8 s row: the run ends within a
@@ -182,6 +184,7 @@ def test_hangup_and_term_inside_a_long_row_end_like_ctrl_c(tmp_path, slow_site, 
     assert "interrupted" in (run_dir / "cli.log").read_text()
 
 
+@pytest.mark.slow
 def test_under_nohup_a_hangup_is_ignored(tmp_path, slow_site, tiny):
     """`nohup python -m bionav ...` (SIGHUP ignored at start) survives the hangup; SIGTERM still ends it cleanly."""
     proc, run_dir, log = _start(tmp_path, slow_site, tiny, "run", nohup=True)

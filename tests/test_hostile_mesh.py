@@ -15,6 +15,7 @@ HEADER = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty f
 
 @pytest.mark.parametrize("faces, needle", [(["3 0 1 2", "3 0 1 7"], "face 1 names vertex 7"),
                                            (["3 0 -1 2"], "face 0 names vertex -1")])
+@pytest.mark.slow
 def test_a_face_naming_a_missing_vertex(tmp_path, faces, needle):
     path = tmp_path / "world.ply"
     path.write_text(HEADER.format(n=len(faces)) + "\n".join(faces) + "\n")

@@ -59,6 +59,7 @@ def test_duplicate_name_blocks_only_that_name(tmp_path, site):
     assert not (tmp_path / "run").exists() or not any((tmp_path / "run").iterdir())
 
 
+@pytest.mark.slow
 def test_other_plugins_and_builtins_stay_usable(tmp_path, site):
     env = env_with(site)
     for homing in ("mfdid", "solo"):  # a built-in and the other plugin of one of the two distributions

@@ -61,6 +61,7 @@ def test_utf16_json(tmp_path):
     assert_fails_cleanly(proc, str(path), "UTF-16", "iconv -f UTF-16 -t UTF-8", code=2, max_seconds=BOUND_S)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("bad", [b"", b"{", b"\xff\xfe\x00"])
 def test_empty_cut_or_binary_json(tmp_path, bad):
     path = session(tmp_path, bad)

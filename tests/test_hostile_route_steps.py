@@ -11,6 +11,7 @@ from helpers import assert_fails_cleanly, run_bionav
     ("db.step_m=1e-4", ("db.step_m=0.0001", "views along", "Ant1_Route1", "default 0.1")),
     ("experiment.agent_step_m=1e-4", ("experiment.agent_step_m=0.0001", "steps on Ant1_Route1", "experiment.agent_step_m >=")),
 ])
+@pytest.mark.slow
 def test_a_tiny_step_is_refused_before_rendering(tmp_path, override, needles):
     proc = run_bionav("experiment=route_homing", "db=seville_route", override, f"hydra.run.dir={tmp_path / 'run'}",
                       cwd=tmp_path, timeout=300)

@@ -94,6 +94,7 @@ def _rows_since(path: Path) -> int:
     return sum(1 for _ in _stream_messages(path))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("extra_wait_s", [None, 0.3, 1.2, 2.9])
 def test_sigkill_loses_at_most_the_last_two_seconds(tmp_path, render_cache, extra_wait_s):
     """SIGKILL early (per-image work) and at three points of the home-vector phase (odd offsets to the
@@ -133,6 +134,7 @@ def test_sigkill_loses_at_most_the_last_two_seconds(tmp_path, render_cache, extr
     assert all(len(m["angles"]) == 170 and m["angles"] for _, m in rows)
 
 
+@pytest.mark.slow
 def test_second_run_into_the_same_directory_is_refused(tmp_path, render_cache, tiny_folder):
     """While a run holds a directory, a second run into it is refused (first run's files untouched);
     after the first is SIGKILLed its stale lock does not block a new run."""
@@ -156,6 +158,7 @@ def test_second_run_into_the_same_directory_is_refused(tmp_path, render_cache, t
     assert _status(run_dir) == "completed" and not (run_dir / ".bionav.lock").exists()
 
 
+@pytest.mark.slow
 def test_lock_of_a_live_process_blocks_and_a_dead_one_does_not(tmp_path, tiny_folder):
     import socket
 
@@ -182,6 +185,7 @@ def test_lock_of_a_live_process_blocks_and_a_dead_one_does_not(tmp_path, tiny_fo
         sleeper.wait()
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_a_sweep_writes_the_summary(tmp_path, render_cache):
     """SIGINT while the second job runs: summary.csv/md list the finished job (completed) and the
     interrupted one (failed); exit 130 with one clean line."""
@@ -207,6 +211,7 @@ def test_ctrl_c_during_a_sweep_writes_the_summary(tmp_path, render_cache):
     assert "2 runs, 1 failed" in (sweep / "summary.md").read_text()
 
 
+@pytest.mark.slow
 def test_failed_jobs_fail_the_sweep_and_errors_stay_in_their_cell(tmp_path, tiny_folder):
     sweep = tmp_path / "sweep"
     bad = tmp_path / "mis|sing"
@@ -279,6 +284,7 @@ def test_disk_already_full_is_refused_before_hydra_writes(tmp_path, small_tmpfs,
     assert f"no space left on {small_tmpfs}" in proc.stderr
 
 
+@pytest.mark.slow
 def test_disk_fills_up_during_the_run(tmp_path, small_tmpfs, render_cache):
     """The disk fills while the run computes: one clean message naming the mount point; what was written
     before (metrics.json, the start of run.mcap) is kept and the log is recoverable."""
@@ -317,6 +323,7 @@ def test_disk_full_simulated_with_dev_full(tmp_path, tiny_folder):
     assert metrics["status"] == "failed" and "no space left" in metrics["error"]
 
 
+@pytest.mark.slow
 def test_outputs_follow_the_umask(tmp_path, tiny_folder):
     """metrics.json and cache files are readable by the group/others when the umask allows (not 600)."""
     run_dir = tmp_path / "run"
@@ -346,6 +353,7 @@ def test_corrupt_png_gives_one_clean_line_without_libpng_noise(tmp_path, tiny_fo
     assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_interrupt_or_terminate_a_run_keeps_its_results(tmp_path, render_cache, sig):
     """Ctrl-C or SIGTERM (kill, a cluster's time limit) during the home vectors: exit 130 with one clean

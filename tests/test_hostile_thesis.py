@@ -35,6 +35,7 @@ def test_an_unknown_launcher_is_named_with_the_installed_ones(tmp_path):
 
 @pytest.mark.parametrize("metrics, overrides", [("[1, 2]", "- homing=sift\n"), ('{"status": "completed"}', "5\n"),
                                                  ("null", "{a: 1}\n")])
+@pytest.mark.slow
 def test_odd_files_in_the_report_directory_are_not_runs(tmp_path, metrics, overrides):
     """metrics.json that is a list, overrides.yaml that is a number: not a run of ours, skipped, and the
     report is written (the item is 'not produced')."""
@@ -53,6 +54,7 @@ def _process_start(pid: int) -> str:
     return open(f"/proc/{pid}/stat").read().rsplit(")", 1)[-1].split()[19]
 
 
+@pytest.mark.slow
 def test_a_second_writer_of_one_out_is_refused_and_a_stale_lock_taken_over(tmp_path):
     out = tmp_path / "out"
     out.mkdir()

@@ -50,6 +50,7 @@ BAD_VALUES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("overrides,needles", BAD_VALUES, ids=[" ".join(o) for o, _ in BAD_VALUES])
 def test_bad_value_is_named_with_its_range(tmp_path, overrides, needles):
     proc = run_bionav(*overrides, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
@@ -73,12 +74,14 @@ MISSPELT = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("overrides,key,hint,listed", MISSPELT, ids=[" ".join(o) for o, *_ in MISSPELT])
 def test_misspelt_key_names_the_node_keys_and_the_closest(tmp_path, overrides, key, hint, listed):
     proc = run_bionav(*overrides, cwd=tmp_path)
     assert_fails_cleanly(proc, f"unknown key {key}", hint, listed, absent=("+homing.", "To append to your config use"))
 
 
+@pytest.mark.slow
 def test_snapshot_index_beyond_the_database_is_named(tmp_path):
     proc = run_bionav("homing=mfdid", "experiment.snapshots=[0,500]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
     assert_fails_cleanly(proc, "experiment.snapshots=[0, 500]", "0..169")
@@ -89,6 +92,7 @@ def test_wrong_type_names_key_and_value(tmp_path):
     assert_fails_cleanly(proc, "homing.n_features=abc", "Integer")
 
 
+@pytest.mark.slow
 def test_memory_bound_refuses_image_stack_before_allocating(tmp_path):
     # inside the per-side range, but 170 images of 16000 x 16000 pixels do not fit in memory
     proc = run_bionav("db.image_size=[16000,16000]", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)

@@ -47,6 +47,7 @@ def _complete(line: str, tmp_path) -> list[str]:
     return proc.stdout.split()
 
 
+@pytest.mark.slow
 def test_completion_query_for_python_m_bionav(tmp_path):
     assert _complete("python -m bionav homing=m", tmp_path) == [
         "homing=mfdid", "homing=minwarping", "homing=minwarping_cleaning", "homing=minwarping_thesis"]
@@ -95,6 +96,7 @@ def test_plugins_are_imported_only_when_selected(tmp_path):
     assert "bionav.plugins.homing.sift" not in composed and "bionav.plugins.homing.warping" not in composed
 
 
+@pytest.mark.slow
 def test_internal_groups_are_not_offered(tmp_path):
     proc = run_bionav("--help", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
@@ -103,6 +105,7 @@ def test_internal_groups_are_not_offered(tmp_path):
     assert _complete("python -m bionav pantilt=", tmp_path) == ["pantilt=ptu46", "pantilt=replay", "pantilt=sim"]
 
 
+@pytest.mark.slow
 def test_help_shows_the_config_of_the_overrides_and_refuses_bad_ones(tmp_path):
     proc = run_bionav("homing=mfdid", "--help", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr

@@ -80,6 +80,7 @@ def asm():
         return {isa: {k: _instructions(a) for k, a in job.result().items()} for isa, job in jobs.items()}
 
 
+@pytest.mark.slow
 def test_every_kernel_is_compiled_for_both_targets(asm):
     names = set(PACKED) | set(SIFT_SCANS) | set(SCALAR)
     for isa in ("avx2", "avx512"):

@@ -74,6 +74,7 @@ def test_automatic_exposure_makes_up_for_dim_light_until_its_limits():
     assert noise_dark.std() / dark.mean() > 2 * noise_full.std() / full.mean()
 
 
+@pytest.mark.slow
 def test_only_the_night_hall_is_dim_and_bad_levels_are_refused():
     levels = {n: get_spec(n).builder(0).light_level for n in SYNTHETIC_DATABASES}
     assert levels["sim_hall1"] == levels["sim_hall2"] < 0.2
@@ -84,6 +85,7 @@ def test_only_the_night_hall_is_dim_and_bad_levels_are_refused():
                   light_level=bad)
 
 
+@pytest.mark.slow
 def test_the_kiosk_takes_the_hall_grid_corner_and_no_obstacle_stands_inside_the_grid():
     from bionav.geometry import PanoramaGeometry
     from bionav.world.render import render_depth

@@ -25,6 +25,7 @@ def wheel(tmp_path_factory):
     return next(out.glob("bionav-*.whl"))
 
 
+@pytest.mark.slow
 def test_wheel_ships_configs_and_entry_points(wheel):
     with zipfile.ZipFile(wheel) as z:
         names = set(z.namelist())
@@ -56,6 +57,7 @@ def test_regular_install_runs_from_the_checkout_root(wheel, tmp_path):
     assert "grid_homing" in proc.stdout and "sim_original" in proc.stdout
 
 
+@pytest.mark.slow
 def test_example_plugin_selected_from_the_cli(tmp_path):
     target = tmp_path / "site"
     example = source_copy(ROOT / "examples" / "bionav-plugin-example", tmp_path / "example")
@@ -76,6 +78,7 @@ def test_example_plugin_selected_from_the_cli(tmp_path):
     assert "quantile: 0.9" in preset.stdout and "dark_landmarks: false" in preset.stdout
 
 
+@pytest.mark.slow
 def test_installed_wheel_help_lists_each_group_once(wheel, tmp_path):
     """An installed bionav/conf must not appear a second time as `conf/<group>` groups (issue 20)."""
     target = tmp_path / "site"
@@ -97,6 +100,7 @@ def test_wheel_ships_the_seville_world_with_its_licence(wheel):
         assert required in names, required
 
 
+@pytest.mark.slow
 def test_seville_features_work_from_an_installed_wheel(wheel, tmp_path):
     target = tmp_path / "site"
     proc = _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path)

@@ -266,6 +266,7 @@ def test_dft_signatures_nest_over_the_number_of_coefficients():
             np.testing.assert_allclose(pot, potential_matrix(fk, fk), rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_grid_run_equals_the_multirun_jobs(tmp_path):
     """``experiment=param_sweep_grid`` (the whole grid in one run on 2 worker processes) writes the
     same configuration records as the multirun of ``experiment=param_sweep`` (one job per

@@ -111,6 +111,7 @@ def _write_session(root, day, when, real, *, rotations=2, n=180):
         (folder / f"{r + 1}.json").write_text(json.dumps(data))
 
 
+@pytest.mark.slow
 def test_the_command_self_calibrates_leaving_one_day_out(tmp_path):
     _arr, real, _g, _o = _device(3)
     root = tmp_path / "rec"
@@ -171,6 +172,7 @@ def test_a_real_daylight_session_self_calibrates():
     assert np.median(np.abs(np.degrees(est.angle_offset[both] - again.angle_offset[both]))) < 2.0
 
 
+@pytest.mark.slow
 def test_the_recording_sensor_applies_a_self_calibration(tmp_path):
     _arr, real, _g, _o = _device(4, gain_sigma=0.0)  # the sensor path applies polarizer offsets only
     root = tmp_path / "rec"

@@ -2,6 +2,7 @@
 
 import json
 
+import pytest
 from helpers import run_bionav
 
 from bionav.logs.reader import read_metadata
@@ -13,6 +14,7 @@ def _metrics(run_dir):
     return data
 
 
+@pytest.mark.slow
 def test_rotation_then_replay_from_the_command_line(tmp_path):
     rec = tmp_path / "rec"
     proc = run_bionav(
@@ -42,6 +44,7 @@ def test_rotation_then_replay_from_the_command_line(tmp_path):
     assert _metrics(rep) == recorded
 
 
+@pytest.mark.slow
 def test_unknown_mode_and_missing_port_are_clean_errors(tmp_path):
     proc = run_bionav("experiment=pol_compass", "mode=spin", cwd=tmp_path)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr

@@ -115,6 +115,7 @@ def check_mode_numbers(mode, metrics, run_dir):
         assert all(r["scan_resolved"] == "True" for r in rows if float(r["cloud_cover"]) == 0.0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mode", sorted(SMALL))
 def test_every_mode_runs_and_replays_to_identical_metrics(tmp_path, mode):
     exp = experiment_config(mode, **SMALL[mode])

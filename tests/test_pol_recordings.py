@@ -78,6 +78,7 @@ def test_fault_detection_finds_blind_and_bad_photodiode_units():
     assert faults[2].saturated_fraction == pytest.approx(0.25)
 
 
+@pytest.mark.slow
 def test_experiment_on_synthetic_recordings_recovers_the_heading(tmp_path):
     root = tmp_path / "rec"
     _synthetic_session(root)
@@ -100,6 +101,7 @@ def test_experiment_on_synthetic_recordings_recovers_the_heading(tmp_path):
     assert len(topics["/pol_recordings/rotation"]) == 2 and len(topics["/pol_recordings/session"]) == 6
 
 
+@pytest.mark.slow
 def test_bad_file_keeps_good_rows_and_names_file_and_field(tmp_path):
     root = tmp_path / "rec"
     folder = _synthetic_session(root)
@@ -127,6 +129,7 @@ def test_bad_file_keeps_good_rows_and_names_file_and_field(tmp_path):
     assert [r["time_of_day"] for r in rows] == ["13:00"]
 
 
+@pytest.mark.slow
 def test_bad_options_are_clean_errors(tmp_path):
     root = tmp_path / "rec"
     _synthetic_session(root, rotations=1)
@@ -153,6 +156,7 @@ def test_a_real_rotation_file_loads_with_the_documented_layout():
     assert faults[7].excluded and "blind" in faults[7].reason  # the recorded sensor's unit 7
 
 
+@pytest.mark.slow
 @needs_data
 def test_experiment_on_one_real_session(tmp_path):
     src = COMPASS / "tod_data" / "Thursday_12-05-22" / "17-01__Thursday_12-05-22"
@@ -170,6 +174,7 @@ def test_experiment_on_one_real_session(tmp_path):
     assert not errors and len(sessions) == 1
 
 
+@pytest.mark.slow
 def test_pol_compass_rotation_runs_on_recorded_counts_and_replays_exactly(tmp_path):
     folder = _synthetic_session(tmp_path / "rec", rotations=1, n=60)
     sky = ["experiment.sky.time=2022-05-12T13:00:00+02:00", "experiment.sky.latitude_deg=39.2",

@@ -219,6 +219,7 @@ def test_route_agents_are_registered_plugins():
 
 
 # --------------------------------------------------------------------------- the command line
+@pytest.mark.slow
 def test_ardin2016_cli_small(tmp_path):
     proc = run_bionav("experiment=route_homing", "experiment.protocol=ardin2016", "experiment.routes=[Ant1_Route1]",
                       "experiment.agents=[perfect_memory,mushroom_body,mfdid]", "experiment.seeds=[0,1]",
@@ -249,6 +250,7 @@ def test_ardin2016_cli_small(tmp_path):
      "experiment.agent_params.infomax.learning_rate"),
     (["experiment.scan_step_deg=3"], "experiment.scan_step_deg"),
 ])
+@pytest.mark.slow
 def test_ardin2016_bad_input_one_message_before_work(tmp_path, args, needle):
     proc = run_bionav("experiment=route_homing", "experiment.protocol=ardin2016", "experiment.routes=[Ant1_Route1]",
                       *args, f"hydra.run.dir={tmp_path / 'run'}", f"cache_dir={tmp_path}", cwd=tmp_path, timeout=120)

@@ -151,6 +151,7 @@ def test_sim_seville_grid_database_and_cli(tmp_path):
     assert np.abs(again - db.images[0]).mean() < 0.02
 
 
+@pytest.mark.slow
 def test_db_mesh_on_an_unseen_obj_runs_grid_homing_from_the_cli(tmp_path):
     trimesh = pytest.importorskip("trimesh")
     rng = np.random.default_rng(5)
@@ -181,12 +182,14 @@ def test_db_mesh_on_an_unseen_obj_runs_grid_homing_from_the_cli(tmp_path):
     (["db=sim_seville", "db.camera_height_m=-1"], "camera_height_m"),
     (["experiment=route_homing", "experiment.test_stride=0"], "experiment.test_stride"),
 ])
+@pytest.mark.slow
 def test_bad_input_gives_one_message_and_exit_2(tmp_path, args, needle):
     proc = run_bionav(*args, f"hydra.run.dir={tmp_path / 'run'}", f"cache_dir={tmp_path}", cwd=tmp_path)
     assert proc.returncode == 2, proc.stderr[-2000:]
     assert needle in proc.stderr and "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_route_homing_cli_small(tmp_path):
     proc = run_bionav("experiment=route_homing", "db.step_m=0.5", "db.image_size=[72,16]",
                       "experiment.methods=[perfect_memory,windowed,zernike,homing]", "experiment.test_stride=4",
@@ -208,6 +211,7 @@ def test_route_homing_cli_small(tmp_path):
         assert (run / "plots" / name).stat().st_size > 1000
 
 
+@pytest.mark.slow
 def test_commands_in_docs_worlds_compose(tmp_path):
     import re
     import shlex

@@ -100,6 +100,7 @@ def test_campus_world_in_five_bands():
     assert uv_ir[is_sky[0]].mean() > uv_ir[~is_sky[0]].mean() + 300  # sky is UV-rich, the world is not
 
 
+@pytest.mark.slow
 def test_local_skylines_through_the_command_keep_homing_across_the_day(tmp_path):
     """``experiment=skyline_homing experiment.separation=local``: changed light homes as well as the same light."""
     import json

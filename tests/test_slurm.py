@@ -80,6 +80,7 @@ def folders(tmp_path):
     return paths, tmp_path / "missing"
 
 
+@pytest.mark.slow
 def test_sweep_on_slurm_with_failure_cancellations_and_resume(tmp_path, folders):
     reason = _slurm_answers()
     if reason:

@@ -39,6 +39,7 @@ def _spread_cells(world, n: int = 6) -> list[tuple[int, int]]:
     return [tuple(map(int, c)) for c in cells[np.linspace(0, len(cells) - 1, n).round().astype(int)]]
 
 
+@pytest.mark.slow
 def test_the_hall_at_night_is_darker_and_sparser_than_the_lab():
     def light(name):
         w = get_spec(name).builder(0)

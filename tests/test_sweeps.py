@@ -18,6 +18,7 @@ def _rows(path):
         return list(csv.DictReader(f))
 
 
+@pytest.mark.slow
 def test_sweep_summary_includes_the_failing_job(tmp_path, tiny_folder):
     sweep = tmp_path / "sweep"
     proc = run_bionav(
@@ -36,6 +37,7 @@ def test_sweep_summary_includes_the_failing_job(tmp_path, tiny_folder):
     assert "2 runs, 1 failed" in md
 
 
+@pytest.mark.slow
 def test_resumed_sweep_does_not_recompute_finished_jobs(tmp_path, tiny_folder):
     sweep = tmp_path / "sweep"
     args = ["-m", "homing=mfdid,sift", "db=folder", f"db.path={tiny_folder}", f"hydra.sweep.dir={sweep}"]
@@ -53,6 +55,7 @@ def test_resumed_sweep_does_not_recompute_finished_jobs(tmp_path, tiny_folder):
     assert {p: p.stat().st_mtime_ns for p in sweep.glob("*/metrics.json")} == before
 
 
+@pytest.mark.slow
 def test_report_rebuilds_table_and_compares_methods(tmp_path, tiny_folder):
     sweep = tmp_path / "sweep"
     assert run_bionav("-m", "homing=mfdid,sift", "db=folder", f"db.path={tiny_folder}",
@@ -66,6 +69,7 @@ def test_report_rebuilds_table_and_compares_methods(tmp_path, tiny_folder):
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
 
 
+@pytest.mark.slow
 def test_single_run_writes_metrics_log_and_plots(tmp_path, tiny_folder):
     run_dir = tmp_path / "run"
     proc = run_bionav("homing=mfdid", "db=folder", f"db.path={tiny_folder}", f"hydra.run.dir={run_dir}", cwd=tmp_path)
@@ -92,6 +96,7 @@ def test_missing_real_database_says_where_it_looked(tmp_path):
         assert needle in proc.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("launcher", ["joblib", "submitit_local"])
 def test_parallel_and_cluster_launchers(tmp_path, tiny_folder, launcher):
     sweep = tmp_path / "sweep"

@@ -61,6 +61,7 @@ def test_table_matches_thesis_table_3_1():
         assert spec.n_images == n and spec.mirror == mirror
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(SYNTHETIC_DATABASES))
 def test_world_grid_cells_and_free_cameras(name):
     spec = get_spec(name)

@@ -163,6 +163,7 @@ def _rows(path: Path) -> list[dict]:
         return list(csv.DictReader(f))
 
 
+@pytest.mark.slow
 def test_cli_tiny_preset_end_to_end(tmp_path):
     out = tmp_path / "report"
     args = ("--preset", "tiny", "--only", "table3_1,fig5_5,table6_2,fig4_4", "--out", str(out))
@@ -258,6 +259,7 @@ def test_cli_dry_run_prints_launcher_multiruns(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.slow
 def test_grid_homing_reports_sift_keypoints_per_image(tmp_path):
     """Tables B.1-B.4 need "Keys": grid homing reports the mean SIFT keypoint count, checked against OpenCV."""
     import cv2
@@ -276,6 +278,7 @@ def test_grid_homing_reports_sift_keypoints_per_image(tmp_path):
     assert metrics["keypoints_per_image"] > 0
 
 
+@pytest.mark.slow
 def test_cli_runs_through_a_hydra_launcher(tmp_path):
     """--launcher joblib: the runs become multiruns under DIR/sweeps and the report reads their jobs."""
     out = tmp_path / "rep"

@@ -38,6 +38,7 @@ def test_schedule_longest_first_after_the_renders(monkeypatch):
     assert plan_mod.make_plan(specs, nodes=4, cores=1)["expected_wall_s"] == pytest.approx(14.0)
 
 
+@pytest.mark.slow
 def test_plan_command_prints_json_and_refuses_bad_sizes(tmp_path):
     proc = run_bionav("--preset", "tiny", "--plan", "--nodes", "2", "--cores", "4", "--json", cwd=tmp_path,
                       module="bionav.thesis")

@@ -55,6 +55,7 @@ def test_bad_direction_is_a_user_error(tmp_path, textured_folder):
     assert "objective.direction must be minimize or maximize" in proc.stderr and "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_optuna_study_of_sift_homing_parameters(tmp_path, textured_folder):
     pytest.importorskip("hydra_plugins.hydra_optuna_sweeper", reason="needs the tune extra: pip install 'bionav[tune]'")
     sweep = tmp_path / "study"
@@ -84,6 +85,7 @@ def test_optuna_study_of_sift_homing_parameters(tmp_path, textured_folder):
     assert len(rows) == 5
 
 
+@pytest.mark.slow
 def test_optuna_ranks_failed_jobs_worst(tmp_path):
     pytest.importorskip("hydra_plugins.hydra_optuna_sweeper", reason="needs the tune extra: pip install 'bionav[tune]'")
     sweep = tmp_path / "study"

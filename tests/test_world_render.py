@@ -176,6 +176,7 @@ def test_result_does_not_depend_on_the_number_of_threads():
     np.testing.assert_array_equal(one, two)
 
 
+@pytest.mark.slow
 def test_binned_shadow_rays_equal_brute_force():
     from bionav.world import kernels as K
 
