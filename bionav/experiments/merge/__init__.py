@@ -7,9 +7,7 @@ files into OUT (``experiment=grid_homing`` and ``experiment=cross_db`` split thi
 
 from __future__ import annotations
 
-import argparse
 import importlib
-import sys
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -34,30 +32,3 @@ def merge_tasks(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
         raise UserError(f"{task_dirs[0]} is not a task of a splittable run (its metrics.json names experiment "
                         f"{name!r}); the experiments that split into tasks are {', '.join(SPLITTABLE)}.")
     return importlib.import_module(f"bionav.experiments.{name}").merge([Path(d) for d in task_dirs], Path(out))
-
-
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m bionav.experiments.merge",
-                                description="Join the tasks (experiment.block=[i,n]) of a split run into one run "
-                                            "directory with the unsplit run's files (grid_homing, cross_db).")
-    p.add_argument("out", help="directory for the merged run")
-    p.add_argument("tasks", nargs="+", help="the tasks' run directories")
-    args = p.parse_args(argv)
-    try:
-        metrics = merge_tasks([Path(t) for t in args.tasks], Path(args.out))
-    except UserError as exc:
-        print(f"bionav.experiments.merge: error: {exc}", file=sys.stderr)
-        return 2
-    except OSError as exc:
-        print(f"bionav.experiments.merge: error: cannot write {exc.filename or args.out}: {exc.strerror or exc}. "
-              f"Free space or choose another OUT; the tasks are untouched.", file=sys.stderr)
-        return 1
-    print(f"merged {metrics['tasks']} {metrics['experiment']} tasks: AAE*={metrics['aae']:.4f} rad, "
-          f"MAE*={metrics['mae']:.4f} rad, RR*={metrics['rr']:.4f} -> {args.out}")
-    return 0
-
-
-if __name__ == "__main__":
-    from bionav.errors import run_main
-
-    run_main(main, "bionav.experiments.merge")
