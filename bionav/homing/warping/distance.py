@@ -181,11 +181,12 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
             nb = cn2[k, d:d + width]
             ac = acc[d]
             for i in range(width):
-                den = np.float32(na[i] + nb[i])
-                val = np.float32(0.5)
-                if den > 0:
-                    val = np.float32(ac[i]) * qf / den + np.float32(0.5)
-                t[i] = np.uint8(val)
+                # the norms' sum in 32 bits (AVX2 has no packed 64-bit integer to float
+                # conversion, so an int64 sum kept this loop scalar there); a zero sum
+                # means two zero columns, whose distance sum is 0 as well: dividing it by 1
+                # gives the old 0.5 without a branch
+                den = np.float32(max(np.int32(na[i] + nb[i]), np.int32(1)))
+                t[i] = np.uint8(np.float32(ac[i]) * qf / den + np.float32(0.5))
             o = out[k, d]
             if step == 1:
                 o0 = o[0]
