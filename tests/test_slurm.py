@@ -144,3 +144,44 @@ def test_sweep_on_slurm_with_failure_cancellations_and_resume(tmp_path, folders)
         metrics = json.loads((sweep / j / "metrics.json").read_text())
         assert metrics["n_pairs"] == 72 and "resumed" not in metrics
     print(f"\nSLURM sweep: first run {first_s:.1f} s (2 cancellations), resume {resume_s:.1f} s")
+
+
+def _item_values(path) -> dict[tuple[str, str], str]:
+    with open(path) as f:
+        return {(r["item"], r["quantity"]): r["bionav"] for r in csv.DictReader(f)}
+
+
+@pytest.mark.slow
+def test_thesis_tiny_preset_on_slurm_gives_the_local_numbers(tmp_path):
+    """``python -m bionav.thesis --launcher submitit_slurm``: the tiny preset's runs go to SLURM as job
+    arrays, and every number of the report equals the one of the same runs made locally (issue 29)."""
+    reason = _slurm_answers()
+    if reason:
+        pytest.skip(reason)
+    name = f"bionav-thesis-{uuid.uuid4().hex[:8]}"
+    env = dict(os.environ, BIONAV_CACHE=str(tmp_path / "cache"))
+    items = ("--preset", "tiny", "--only", "fig4_4,fig4_6")
+
+    def thesis(*args):
+        return subprocess.run([sys.executable, "-m", "bionav.thesis", *items, *args], cwd=tmp_path, env=env,
+                              capture_output=True, text=True, timeout=OUTER_TIMEOUT_S)
+
+    local = thesis("--out", str(tmp_path / "local"), "--jobs", "1")
+    assert local.returncode == 0, local.stderr + local.stdout
+    started = time.monotonic()
+    slurm = thesis("--out", str(tmp_path / "slurm"), "--launcher", "submitit_slurm",
+                   "--launcher-arg", f"hydra.launcher.name={name}", "--launcher-arg", "hydra.launcher.cpus_per_task=1",
+                   "--launcher-arg", "hydra.launcher.mem_gb=1", "--launcher-arg", "hydra.launcher.timeout_min=10",
+                   "--launcher-arg", "hydra.launcher.bionav_poll_s=0.5")
+    wall = time.monotonic() - started
+    assert slurm.returncode == 0, slurm.stderr + slurm.stdout
+    assert "Traceback" not in slurm.stderr
+    # the jobs ran under SLURM: submitit's job folders hold the slurm job ids, and sacct knows the name
+    submitted = list((tmp_path / "slurm" / "sweeps").glob("*/.submitit/*"))
+    assert submitted, "no submitit job folder: the runs did not go through SLURM"
+    assert not (tmp_path / "slurm" / "runs").exists()
+    got, want = _item_values(tmp_path / "slurm" / "items.csv"), _item_values(tmp_path / "local" / "items.csv")
+    assert set(got) == set(want) and len(want) >= 4
+    numbers = {k: v for k, v in want.items() if v not in ("", "not produced")}
+    assert numbers and all(got[k] == v for k, v in numbers.items()), {k: (got[k], v) for k, v in want.items()}
+    print(f"\nthesis tiny preset (fig4_4, fig4_6) on SLURM: {wall:.1f} s wall")

@@ -436,12 +436,18 @@ class Runner:
         return results
 
     def _run_pool(self, todo: Sequence[RunSpec]) -> dict[str, RunResult]:
-        """Run ``todo`` on :attr:`jobs` slots; a database's first run goes before its other runs."""
+        """Run ``todo`` on :attr:`jobs` slots; a database's first run goes before its other runs.
+
+        Longest expected task first (the plan's CPU estimate, :func:`bionav.thesis.plan.task_cpu_s`):
+        the largest tasks then overlap the many small ones instead of running alone at the end.
+        """
         from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+
+        from bionav.thesis.plan import task_cpu_s
 
         cores = usable_cpus()
         extra = [f"workers={max(1, cores // self.jobs)}"]
-        waiting = list(todo)
+        waiting = sorted(todo, key=lambda sp: -task_cpu_s(sp).cpu_s)  # stable: equal estimates keep their order
         rendering: set[tuple[str, ...]] = set()  # databases whose first run is running
         rendered: set[tuple[str, ...]] = set()  # databases with a finished run (cached renders)
         results: dict[str, RunResult] = {}
