@@ -55,3 +55,18 @@ def test_plan_command_prints_json_and_refuses_bad_sizes(tmp_path):
     assert bad.returncode == 2 and "Traceback" not in bad.stderr and "--nodes 0" in bad.stderr
     no_out = run_bionav("--preset", "tiny", "--only", "table3_1", cwd=tmp_path, module="bionav.thesis")
     assert no_out.returncode == 2 and "--out DIR is needed" in no_out.stderr
+
+
+def test_run_costs_scale_with_the_size_the_overrides_give():
+    """Start-up plus the measured unit cost times the run's size (hand-computed from RUN_CPU_S)."""
+    c = {k: v[0] for k, v in plan_mod.RUN_CPU_S.items()}
+    scan = RunSpec(("experiment=contrast_scan", "experiment.times=[2009-06-17T10:00:00+02:00,2009-06-17T11:00:00+02:00]",
+                    "experiment.n_pan=10", "experiment.n_tilt=3"))
+    assert plan_mod.task_cpu_s(scan).cpu_s == pytest.approx(c["contrast_scan_start"] + 2 * 30 * c["contrast_scan_direction"])
+    lda = RunSpec(("experiment=contrast_lda", "data=sim_natural", "experiment.n_resamples=2000"))
+    assert plan_mod.task_cpu_s(lda).cpu_s == pytest.approx(c["contrast_lda_start"] + 2000 * c["contrast_lda_resample"])
+    sky = [plan_mod.task_cpu_s(RunSpec(("experiment=skyline_homing", "homing=sift", f"experiment.snapshot_stride={s}")))
+           for s in (2, 4)]
+    assert sky[0].cpu_s - c["skyline_homing_start"] == pytest.approx(4 * (sky[1].cpu_s - c["skyline_homing_start"]))
+    cleaning = RunSpec(("experiment=cleaning", "layout=long_lanes", "runs=4"))
+    assert plan_mod.task_cpu_s(cleaning).cpu_s == pytest.approx(c["cleaning_start"] + 4 * c["cleaning_run"])

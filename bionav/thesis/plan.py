@@ -55,15 +55,24 @@ HOME_VECTOR_MS: dict[str, tuple[float, int | None, str]] = {
 RENDER_S_PER_MPX = 0.78
 #: default image size of the stand-ins when a run names none (W, H)
 DEFAULT_SIZE = (561, 81)
-#: CPU seconds of one run of the experiments without home-vector counts (experiment -> (s, basis))
+#: CPU seconds of one run of the experiments without home-vector counts (experiment -> (s, basis)); the
+#: "measured" ones are the process CPU (os.wait4) of the quick preset's runs, ``python -m bionav.thesis
+#: --preset quick --jobs 2`` on this machine, 2026-11-27 (render caches warm), start-up included
 RUN_CPU_S: dict[str, tuple[float, str]] = {
-    "param_sweep_job": (4.0, "measured: 393 s CPU for the 15,606 configurations of three stand-ins in one run "
-                             "per database (docs/performance.md section 6), plus about 3 s of start-up per job"),
+    "param_sweep_job": (1.3, "measured: 17-25 s CPU for the 19 jobs of one ci-grid sweep (quick preset)"),
+    "param_sweep_job_full": (1.7, "measured: 1.3 s per job on the ci grid plus 393 s CPU for the 15,606 "
+                                  "configurations of three stand-ins (docs/performance.md section 6) over 3 x 342 "
+                                  "jobs"),
+    "cleaning_start": (10.0, "measured: 13-14 s CPU for 2 runs (quick preset), minus the runs"),
     "cleaning_run": (3.5, "measured: 35.3 s CPU for 10 runs of long_lanes (docs/performance.md section 0)"),
-    "pol_compass": (60.0, "assumed (not timed at the full preset)"),
-    "contrast_lda": (60.0, "assumed (not timed at the full preset)"),
-    "contrast_scan": (120.0, "assumed (not timed at the full preset)"),
-    "skyline_homing": (300.0, "assumed (not timed at the full preset)"),
+    "pol_compass": (5.0, "measured: 3-5 s CPU per mode (quick preset; the full preset's runs are the same)"),
+    "contrast_lda_start": (3.0, "measured: 7-8 s CPU at 1000 resamples (quick preset): about 3 s of start-up"),
+    "contrast_lda_resample": (0.005, "and 5 ms per resample"),
+    "contrast_scan_start": (3.0, "measured: 8-9 s CPU for one cloudy 57 x 13 scan and 20 s for 14 clear "
+                                 "38 x 9 scans (quick preset): about 3 s of start-up"),
+    "contrast_scan_direction": (0.008, "and at most 8 ms per scan direction (the cloudy ones; clear 3.5 ms)"),
+    "skyline_homing_start": (3.0, "measured: 42 s CPU at snapshot_stride=4 (quick preset): about 3 s of start-up"),
+    "skyline_homing_stride4": (39.0, "and 39 s at stride 4, scaled by the snapshots (1 / stride^2)"),
     "standins": (60.0, "assumed"),
 }
 #: jobs of one parameter-sweep multirun per grid (19 signatures x sizes x preprocessings)
@@ -142,15 +151,43 @@ def task_cpu_s(spec: RunSpec) -> TaskEstimate:
                             f"{len(family)}^2 database pairs x {snaps} x {n} home vectors; {basis}",
                             tuple(sorted(family)) + (f"{size[0]}x{size[1]}",), render)
     if experiment == "param_sweep":
-        jobs = PARAM_SWEEP_JOBS.get(ov.get("experiment.grid", "full"), 342)
-        s, basis = RUN_CPU_S["param_sweep_job"]
+        grid = ov.get("experiment.grid", "full")
+        jobs = PARAM_SWEEP_JOBS.get(grid, 342)
+        s, basis = RUN_CPU_S["param_sweep_job" if grid == "ci" else "param_sweep_job_full"]
         return TaskEstimate(command, experiment, jobs * s, f"{jobs} jobs; {basis}", (ov.get("db", ""),), 0.0)
     if experiment == "cleaning":
+        s0, basis0 = RUN_CPU_S["cleaning_start"]
         s, basis = RUN_CPU_S["cleaning_run"]
         runs = int(ov.get("runs", 10))
-        return TaskEstimate(command, experiment, runs * s, f"{runs} runs; {basis}", (), 0.0)
+        return TaskEstimate(command, experiment, s0 + runs * s, f"{runs} runs; {basis0}; {basis}", (), 0.0)
+    scaled = _scaled_run_cpu_s(experiment, ov)
+    if scaled is not None:
+        return TaskEstimate(command, experiment, scaled[0], scaled[1], (), 0.0)
     s, basis = RUN_CPU_S.get(experiment, (60.0, f"assumed for {experiment}"))
     return TaskEstimate(command, experiment, s, basis, (), 0.0)
+
+
+def _scaled_run_cpu_s(experiment: str, ov: dict[str, str]) -> tuple[float, str] | None:
+    """Start-up plus a measured unit cost times the run's size, for the experiments whose size the
+    overrides give (defaults: the experiment's config dataclass); None for the others."""
+    from bionav.experiments import configs
+
+    if experiment == "contrast_lda":
+        n = int(ov.get("experiment.n_resamples", configs.ContrastLdaConfig.n_resamples))
+        (s0, b0), (s1, b1) = RUN_CPU_S["contrast_lda_start"], RUN_CPU_S["contrast_lda_resample"]
+        return s0 + n * s1, f"{n} resamples; {b0}, {b1}"
+    if experiment == "contrast_scan":
+        d = configs.ContrastScanConfig()
+        given = ov.get("experiment.times")
+        n_times = len([t for t in given.strip("[] '").split(",") if t.strip()]) if given else len(d.times)
+        n_dir = int(ov.get("experiment.n_pan", d.n_pan)) * int(ov.get("experiment.n_tilt", d.n_tilt))
+        (s0, b0), (s1, b1) = RUN_CPU_S["contrast_scan_start"], RUN_CPU_S["contrast_scan_direction"]
+        return s0 + n_times * n_dir * s1, f"{n_times} scans x {n_dir} directions; {b0}, {b1}"
+    if experiment == "skyline_homing":
+        stride = int(ov.get("experiment.snapshot_stride", configs.SkylineHomingConfig.snapshot_stride))
+        (s0, b0), (s1, b1) = RUN_CPU_S["skyline_homing_start"], RUN_CPU_S["skyline_homing_stride4"]
+        return s0 + s1 * (4 / stride) ** 2, f"snapshot_stride={stride}; {b0}, {b1}"
+    return None
 
 
 def _grid_shape(db: str) -> tuple[int, int]:
