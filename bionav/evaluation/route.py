@@ -12,8 +12,9 @@ of its current view points.
 The published route-following test (Ardin, Peng, Mangan, Lagogiannis & Webb
 2016, PLoS Comput. Biol. 12(2), e1004683, doi:10.1371/journal.pcbi.1004683):
 :func:`follow_route` walks an agent from the route's start in fixed steps
-along the heading it chooses, puts it back on the route (counting an error)
-whenever it strays too far, and stops at the nest or after a step budget;
+(:func:`protocol_step`) along the heading it chooses, puts it back on the
+route (counting an error) whenever it strays too far, and stops at the nest or
+after a step budget; :func:`least_unfamiliar` is the familiarity agents' choice;
 :func:`scan_views` cuts the views of a heading scan out of one panorama and
 preprocesses them as the paper (inversion, histogram equalisation, 36 x 10).
 
@@ -147,19 +148,90 @@ class RouteRun:
     putbacks: list
 
 
+@dataclass
+class StepResult:
+    """One step of :func:`protocol_step`.
+
+    Attributes
+    ----------
+    position : ndarray, shape (2,)
+        Metres, world frame: where the agent is after the step (after a put-back: on the route view).
+    heading : float
+        Radians CCW from world ``+x``: the heading it walked (after a put-back: the route view's).
+    stepped_to : ndarray, shape (2,)
+        Where the step itself ended (before any put-back), metres.
+    put_back : int
+        Route-view index the agent was put on, ``-1`` when it was not put back.
+    reached_nest : bool
+        The step ended within ``goal_m`` of the nest (checked before the put-back rule).
+    """
+
+    position: np.ndarray
+    heading: float
+    stepped_to: np.ndarray
+    put_back: int
+    reached_nest: bool
+
+
+def protocol_step(choose_heading: Callable[[np.ndarray, float], float], position: np.ndarray, heading: float, *,
+                  route_xy: np.ndarray, route_heading: np.ndarray, nest_xy: np.ndarray, step_m: float,
+                  putback_m: float, goal_m: float, jitter_m: float = 0.0,
+                  rng: np.random.Generator | None = None) -> StepResult:
+    """One step of the route-following test of Ardin et al. 2016 (doi:10.1371/journal.pcbi.1004683).
+
+    ``heading = choose_heading(position, heading)`` (the agent's scan and choice; NaN keeps
+    the heading), a step of ``step_m`` along it, isotropic Gaussian position noise of
+    ``jitter_m`` per axis; the nest is reached within ``goal_m`` of ``nest_xy``; otherwise,
+    farther than ``putback_m`` from the route polyline (strictly), the agent is put on the
+    *nearest* route view, facing ``route_heading`` there (an error).
+
+    Parameters
+    ----------
+    choose_heading : callable ``(xy (2,), heading) -> heading``
+        Radians CCW from world ``+x``.
+    position : ndarray, shape (2,)
+        Metres, world frame.
+    heading : float
+        Radians CCW from ``+x``.
+    route_xy : ndarray, shape (K, 2)
+        Route views (training positions), metres.
+    route_heading : ndarray, shape (K,)
+        Radians CCW from ``+x``.
+    nest_xy : ndarray, shape (2,)
+    step_m, putback_m, goal_m, jitter_m : float
+        Metres; ``jitter_m > 0`` needs ``rng``.
+
+    Returns
+    -------
+    StepResult
+    """
+    new = choose_heading(position, heading)
+    if np.isfinite(new):
+        heading = float(new)
+    pos = np.asarray(position, np.float64) + step_m * np.array([math.cos(heading), math.sin(heading)])
+    if jitter_m > 0:
+        if rng is None:
+            raise ValueError("jitter_m > 0 needs an rng")
+        pos = pos + rng.normal(0.0, jitter_m, 2)
+    if np.linalg.norm(pos - np.asarray(nest_xy, np.float64)) <= goal_m:
+        return StepResult(pos, heading, pos, -1, True)
+    dist, nearest = distance_to_route(pos[None], route_xy)
+    if dist[0] > putback_m:
+        k = int(nearest[0])
+        return StepResult(np.asarray(route_xy[k], np.float64).copy(), float(route_heading[k]), pos, k, False)
+    return StepResult(pos, heading, pos, -1, False)
+
+
 def follow_route(choose_heading: Callable[[np.ndarray, float], float], *, route_xy: np.ndarray,
                  route_heading: np.ndarray, nest_xy: np.ndarray, step_m: float, putback_m: float,
                  goal_m: float, max_steps: int, jitter_m: float = 0.0, rng: np.random.Generator | None = None,
                  on_putback: Callable[[int], None] | None = None) -> RouteRun:
     """Walk an agent along a route with the put-back rule of Ardin et al. 2016 (doi:10.1371/journal.pcbi.1004683).
 
-    The agent starts on route view 0 facing ``route_heading[0]``. Each step:
-    ``heading = choose_heading(position, heading)``; move ``step_m`` along it,
-    then add isotropic Gaussian position noise of standard deviation
-    ``jitter_m`` per axis; stop when within ``goal_m`` of ``nest_xy``
-    (reached); otherwise, when farther than ``putback_m`` from the route
-    polyline, count an error and put the agent on the *nearest* route view,
-    facing that view's heading (``on_putback(index)`` tells the agent).
+    The agent starts on route view 0 facing ``route_heading[0]`` and takes
+    :func:`protocol_step` after step until it reaches the nest or ``max_steps``
+    steps are taken; every put-back is an error, and ``on_putback(index)``
+    tells the agent where it was put.
 
     Parameters
     ----------
@@ -178,35 +250,49 @@ def follow_route(choose_heading: Callable[[np.ndarray, float], float], *, route_
         Metres; needs ``rng`` when positive.
     """
     route_xy = np.asarray(route_xy, np.float64)
-    nest = np.asarray(nest_xy, np.float64)
     if jitter_m > 0 and rng is None:
         raise ValueError("jitter_m > 0 needs an rng")
     pos = route_xy[0].copy()
     heading = float(route_heading[0])
     path = [pos.copy()]
-    errors, steps, reached, putbacks = 0, 0, False, []
+    steps, reached, putbacks = 0, False, []
     for steps in range(1, int(max_steps) + 1):
-        new = choose_heading(pos, heading)
-        if np.isfinite(new):
-            heading = float(new)
-        pos = pos + step_m * np.array([math.cos(heading), math.sin(heading)])
-        if jitter_m > 0:
-            pos = pos + rng.normal(0.0, jitter_m, 2)
-        path.append(pos.copy())
-        if np.linalg.norm(pos - nest) <= goal_m:
+        r = protocol_step(choose_heading, pos, heading, route_xy=route_xy, route_heading=route_heading,
+                          nest_xy=nest_xy, step_m=step_m, putback_m=putback_m, goal_m=goal_m, jitter_m=jitter_m,
+                          rng=rng)
+        path.append(r.stepped_to.copy())
+        pos, heading = r.position, r.heading
+        if r.reached_nest:
             reached = True
             break
-        dist, nearest = distance_to_route(pos[None], route_xy)
-        if dist[0] > putback_m:
-            k = int(nearest[0])
-            errors += 1
-            putbacks.append(k)
-            pos = route_xy[k].copy()
-            heading = float(route_heading[k])
+        if r.put_back >= 0:
+            putbacks.append(r.put_back)
             path.append(pos.copy())
             if on_putback is not None:
-                on_putback(k)
-    return RouteRun(np.array(path), errors, reached, steps if max_steps > 0 else 0, putbacks)
+                on_putback(r.put_back)
+    return RouteRun(np.array(path), len(putbacks), reached, steps if max_steps > 0 else 0, putbacks)
+
+
+def least_unfamiliar(unfamiliarity: np.ndarray, offsets: np.ndarray) -> int:
+    """Index of the least unfamiliar scan view; ties go to the one nearest straight ahead.
+
+    Parameters
+    ----------
+    unfamiliarity : ndarray, shape (S,)
+        Lower = more familiar; NaN counts as infinitely unfamiliar.
+    offsets : ndarray, shape (S,)
+        Scan offsets from the current heading, radians.
+
+    Returns
+    -------
+    int
+        ``-1`` when no value is finite (the agent has no opinion).
+    """
+    u = np.nan_to_num(np.asarray(unfamiliarity, np.float64), nan=np.inf)
+    if not np.isfinite(u).any():
+        return -1
+    best = np.flatnonzero(u == u.min())
+    return int(best[np.argmin(np.abs(np.asarray(offsets)[best]))])
 
 
 def scan_views(panorama: np.ndarray, *, column_deg: float, scan_half_deg: float = 60.0, scan_step_deg: float = 2.0,
