@@ -22,6 +22,7 @@ database's render, then its longest task.
 
 from __future__ import annotations
 
+import functools
 import heapq
 import math
 from dataclasses import asdict, dataclass
@@ -170,24 +171,34 @@ def task_cpu_s(spec: RunSpec) -> TaskEstimate:
 def _scaled_run_cpu_s(experiment: str, ov: dict[str, str]) -> tuple[float, str] | None:
     """Start-up plus a measured unit cost times the run's size, for the experiments whose size the
     overrides give (defaults: the experiment's config dataclass); None for the others."""
-    from bionav.experiments import configs
-
+    if experiment not in ("contrast_lda", "contrast_scan", "skyline_homing"):
+        return None
+    d = _experiment_defaults(experiment)
     if experiment == "contrast_lda":
-        n = int(ov.get("experiment.n_resamples", configs.ContrastLdaConfig.n_resamples))
+        n = int(ov.get("experiment.n_resamples", d["n_resamples"]))
         (s0, b0), (s1, b1) = RUN_CPU_S["contrast_lda_start"], RUN_CPU_S["contrast_lda_resample"]
         return s0 + n * s1, f"{n} resamples; {b0}, {b1}"
     if experiment == "contrast_scan":
-        d = configs.ContrastScanConfig()
         given = ov.get("experiment.times")
-        n_times = len([t for t in given.strip("[] '").split(",") if t.strip()]) if given else len(d.times)
-        n_dir = int(ov.get("experiment.n_pan", d.n_pan)) * int(ov.get("experiment.n_tilt", d.n_tilt))
+        n_times = len([t for t in given.strip("[] '").split(",") if t.strip()]) if given else len(d["times"])
+        n_dir = int(ov.get("experiment.n_pan", d["n_pan"])) * int(ov.get("experiment.n_tilt", d["n_tilt"]))
         (s0, b0), (s1, b1) = RUN_CPU_S["contrast_scan_start"], RUN_CPU_S["contrast_scan_direction"]
         return s0 + n_times * n_dir * s1, f"{n_times} scans x {n_dir} directions; {b0}, {b1}"
     if experiment == "skyline_homing":
-        stride = int(ov.get("experiment.snapshot_stride", configs.SkylineHomingConfig.snapshot_stride))
+        stride = int(ov.get("experiment.snapshot_stride", d["snapshot_stride"]))
         (s0, b0), (s1, b1) = RUN_CPU_S["skyline_homing_start"], RUN_CPU_S["skyline_homing_stride4"]
         return s0 + s1 * (4 / stride) ** 2, f"snapshot_stride={stride}; {b0}, {b1}"
     return None
+
+
+@functools.lru_cache(maxsize=None)
+def _experiment_defaults(experiment: str) -> dict:
+    """The ``experiment`` node of ``experiment=<name>`` as composed (its structured config's defaults)."""
+    from omegaconf import OmegaConf
+
+    from bionav.config import compose
+
+    return OmegaConf.to_container(compose([f"experiment={experiment}"]).experiment, resolve=True)
 
 
 def _grid_shape(db: str) -> tuple[int, int]:
