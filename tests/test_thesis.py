@@ -256,6 +256,8 @@ def test_cli_dry_run_prints_launcher_multiruns(tmp_path):
     assert len(sift) == 1 and "db=sim_hall1,sim_moeller1,sim_original,sim_roeben1,sim_uni" in sift[0]
     assert all("hydra/launcher=submitit_slurm" in ln and "hydra.launcher.partition=cpu" in ln for ln in lines)
     assert any("experiment=param_sweep" in ln and "experiment.grid=full" in ln for ln in lines)
+    # longest expected task first: a full-grid parameter sweep (342 jobs) before the SIFT multirun's blocks
+    assert "experiment=param_sweep" in lines[0] and lines.index(sift[0]) > 0
     assert not (tmp_path / "x").exists()
 
 

@@ -493,6 +493,11 @@ class Runner:
             if spec.multirun:
                 run_dir = self.out / "runs" / spec.group / spec.slug
                 commands.append((spec.command(run_dir, launcher=self.launcher), [spec], run_dir))
+        # the multirun holding the longest expected task first (queued first on SLURM), as the pool does
+        from bionav.thesis.plan import task_cpu_s
+
+        commands.sort(key=lambda c: -max(task_cpu_s(s).cpu_s for s in c[1]))
+
         def launch(i: int, cmd: list[str], covered: list[RunSpec], sweep_dir: Path) -> None:
             self.echo(f"[{i}/{len(commands)}] python " + " ".join(_quote(c) for c in cmd[1:]))
             sweep_dir.parent.mkdir(parents=True, exist_ok=True)
