@@ -71,22 +71,46 @@ def test_merge_refuses_an_incomplete_split(folder_db, tmp_path):
     assert bad.returncode != 0 and "Traceback" not in bad.stderr and "0 <= i < n" in bad.stderr
 
 
-def test_split_cross_db_run_merges_to_the_unsplit_results(tmp_path):
+def test_cross_db_units_cover_every_pair_and_snapshot_once():
+    """Known answer: up to as many tasks as snapshots, task i holds every n-th snapshot for all pairs
+    (the old split); beyond, every n-th (snapshot, pair) unit, balanced, each exactly once."""
+    from bionav.experiments.cross_db import task_units
+
+    snaps = [3, 7, 11]
+    whole = task_units(None, snaps, 2)
+    assert list(whole) == [(0, 0), (0, 1), (1, 0), (1, 1)] and all(list(v) == snaps for v in whole.values())
+    assert {p: list(v) for p, v in task_units([1, 2], snaps, 2).items()} == {p: [7] for p in whole}
+    # 3 snapshots x 4 pairs = 12 units in 5 tasks: units k = 1, 6, 11 for task 1
+    assert {p: list(v) for p, v in task_units([1, 5], snaps, 2).items()} == {(0, 1): [3], (1, 0): [7], (1, 1): [11]}
+    seen = {}
+    sizes = []
+    for i in range(12):
+        part = task_units([i, 12], snaps, 2)
+        sizes.append(sum(len(v) for v in part.values()))
+        for p, v in part.items():
+            for s in v:
+                seen[(p, int(s))] = seen.get((p, int(s)), 0) + 1
+    assert sizes == [1] * 12 and len(seen) == 12 and set(seen.values()) == {1}
+
+
+@pytest.mark.parametrize("blocks", [3, 8])
+def test_split_cross_db_run_merges_to_the_unsplit_results(tmp_path, blocks):
+    """3 tasks: snapshot blocks for every pair; 8 tasks, more than the 6 snapshots: (snapshot, pair) units."""
     overrides = ("experiment=cross_db", "homing=mfdid", "experiment.family=[sim_original,sim_doorlit]",
-                 "db.image_size=[120,18]", "experiment.snapshot_stride=4")
+                 "db.image_size=[120,18]", "experiment.snapshot_stride=8")
     cache = {"BIONAV_CACHE": str(tmp_path / "cache")}
     whole = run_bionav(*overrides, f"hydra.run.dir={tmp_path / 'whole'}", "workers=1", cwd=tmp_path, env=cache)
     assert whole.returncode == 0, whole.stderr[-2000:]
     expected = json.loads((tmp_path / "whole" / "metrics.json").read_text())
 
-    spec = RunSpec(overrides, group="cross", blocks=3)
+    spec = RunSpec(overrides, group="cross", blocks=blocks)
     result = Runner(out=tmp_path / "report", jobs=2, echo=lambda s: None,
                     env={**tool_env(), **cache}).run_all([spec])[spec.key]
     assert result.ok, result.error
     merged = json.loads((result.dir / "metrics.json").read_text())
     for key in ("aae", "mae", "rr", "n_databases", "n_snapshots", "homing"):
         assert merged[key] == expected[key], key
-    assert merged["tasks"] == 3
+    assert merged["tasks"] == blocks and expected["n_snapshots"] == 6
     assert (result.dir / "cross_db.csv").read_text() == (tmp_path / "whole" / "cross_db.csv").read_text()
     assert (result.dir / "plots" / "cross_db.png").is_file()
 

@@ -25,8 +25,10 @@ from bionav.files import write_json_atomic
 BLOCK_KEY = "experiment.block"
 
 
-def block_of(block: Sequence[int] | None, indices: Sequence[int]) -> list[int]:
+def block_of(block: Sequence[int] | None, indices: Sequence[int], *, what: str = "snapshot") -> list[int]:
     """The snapshot indices of task ``block = [i, n]``: every n-th of ``indices`` from the i-th.
+
+    ``what`` names the items in the message of a block that selects nothing.
 
     Raises
     ------
@@ -40,7 +42,7 @@ def block_of(block: Sequence[int] | None, indices: Sequence[int]) -> list[int]:
     if n < 1 or not 0 <= i < n:
         raise UserError(f"bad value {BLOCK_KEY}=[{i}, {n}]: give [i, n] with 0 <= i < n (task i of n).")
     if i >= len(indices):
-        raise UserError(f"{BLOCK_KEY}=[{i}, {n}] selects no snapshot: there are {len(indices)}; split into at most "
+        raise UserError(f"{BLOCK_KEY}=[{i}, {n}] selects no {what}: there are {len(indices)}; split into at most "
                         f"{len(indices)} tasks.")
     return indices[i::n]
 

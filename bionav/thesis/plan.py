@@ -144,12 +144,16 @@ def task_cpu_s(spec: RunSpec) -> TaskEstimate:
         stride = int(ov.get("experiment.snapshot_stride", 2))
         n = _grid_images(family[0].strip())
         nx, ny = (math.ceil(v / stride) for v in _grid_shape(family[0].strip()))
-        snaps = nx * ny if not block else math.ceil(nx * ny / block[1])
+        snaps, n_pairs = nx * ny, len(family) ** 2
+        if block and block[1] <= snaps:  # every n-th snapshot, all pairs (bionav.experiments.cross_db.task_units)
+            snaps = math.ceil(snaps / block[1])
+        elif block:  # every n-th (snapshot, pair) unit
+            snaps, n_pairs = 1, math.ceil(snaps * n_pairs / block[1])
         ms, basis = _hv_ms(homing, size)
-        pairs = len(family) ** 2 * snaps * n
+        pairs = n_pairs * snaps * n
         render = len(family) * n * size[0] * size[1] / 1e6 * RENDER_S_PER_MPX
         return TaskEstimate(command, experiment, pairs * ms / 1e3,
-                            f"{len(family)}^2 database pairs x {snaps} x {n} home vectors; {basis}",
+                            f"{n_pairs} database pairs x {snaps} x {n} home vectors; {basis}",
                             tuple(sorted(family)) + (f"{size[0]}x{size[1]}",), render)
     if experiment == "param_sweep":
         grid = ov.get("experiment.grid", "full")

@@ -123,7 +123,7 @@ QUICK = Preset(
     pol_samples=100,
     pol_vs_em_samples=100,
     cleaning_runs=2,
-    cross_db_blocks={"warping2d": 4},
+    cross_db_blocks={"warping2d": 16},
     reductions=(
         "grid homing: 6 snapshots per database (evenly spread over the images) instead of all; "
         "min-/2D-warping: 2 snapshots",
