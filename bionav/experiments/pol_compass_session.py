@@ -19,6 +19,7 @@ from bionav.errors import UserError
 from bionav.plugins.sensors.replay import PANTILT_INFO_TOPIC, PANTILT_TOPIC, SENSOR_TOPIC
 
 SESSION_TOPIC = "/pol_compass/session"
+CALIBRATION_TOPIC = "/pol_compass/calibration"
 REFERENCE_TOPIC = "/reference/raw"
 
 PANTILT_INFO_SCHEMA = {
@@ -37,6 +38,18 @@ SESSION_SCHEMA = {
         "sun_elevation": {"type": "number", "description": "radians"},
         "true_mount_heading": {"type": ["number", "null"], "description": "simulated mount heading, radians CCW from east"},
     },
+}
+CALIBRATION_SCHEMA = {
+    "type": "object",
+    "title": "Calibration the compass was decoded with (sensor.calibration, or recorded for a replay)",
+    "properties": {
+        "kind": {"type": "string", "enum": ["units", "array"], "description": "units: UnitCalibration (thesis "
+                 "compass); array: ArrayCalibration (POL-OP array)"},
+        "source": {"type": "string", "description": "file path, 'auto' (self-calibrated) or 'none'"},
+        "calibration": {"type": ["object", "null"], "description": "the calibration's to_dict(); null: nominal"},
+        "array_config": {"type": ["object", "null"], "description": "how the recorded array reads (sensor=recording)"},
+    },
+    "required": ["kind", "source", "calibration"],
 }
 
 
@@ -62,6 +75,10 @@ class Session:
     true_mount_heading : float or None
         The simulated mount heading (radians CCW from east), recorded so that
         replays report the same simulation-only metrics; ``None`` for hardware.
+    fixed_calibration : dict or None
+        A calibration message (:data:`CALIBRATION_SCHEMA`) that replaces
+        ``experiment.calibration``: the file ``sensor.calibration`` names, or
+        the one a replayed run recorded; ``None``: ``experiment.calibration``.
     """
 
     sensor: Any
@@ -72,6 +89,7 @@ class Session:
     sun: Any
     progress: Callable = field(default=lambda it, desc="", total=None: it)
     true_mount_heading: float | None = None
+    fixed_calibration: dict | None = None
 
     def read(self) -> dict:
         """Take and record one compass reading."""
