@@ -393,7 +393,8 @@ class RecordingsConfig:
     exclude_units : ``auto`` (faults detected from each session's counts), ``none``, or a list of unit
         numbers (checked against the recordings' units).
     saturation_counts : counts at or above: saturated or overflowing (the recorded sensor plateaus near
-        11,300 and overflows at 32,768). dark_counts : counts below: too dark.
+        11,300 and overflows at 32,768). dark_counts : counts below: no light (1: a zero count has no log ratio; how
+        much light is enough is the decoder's business, ``decoder.noise_counts``).
     imbalance_decades : POL-OP light imbalance beyond which a reading (per sample) or a unit (median
         over the session) is bad. blind_fraction : share of identical orthogonal readings that makes a
         unit polarization-blind.
@@ -414,7 +415,7 @@ class RecordingsConfig:
     path: Optional[str] = None
     exclude_units: Any = bounded("auto")  # auto | none | [unit, ...]: checked in pol_recordings.excluded_units
     saturation_counts: float = bounded(11000.0, gt=0.0, le=1e12)
-    dark_counts: float = bounded(5.0, ge=0.0, le=1e12)
+    dark_counts: float = bounded(1.0, ge=0.0, le=1e12)
     imbalance_decades: float = bounded(0.15, gt=0.0, le=3.0)
     blind_fraction: float = bounded(0.5, gt=0.0, le=1.0)
     tilt_deg: float = bounded(45.0, ge=0.0, le=90.0)

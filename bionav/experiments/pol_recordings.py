@@ -397,6 +397,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     errors = {n: {g: [] for g in GROUPS} for n in names}
     chosen_err, chosen_res = [], []
     res_by_group = {g: [] for g in GROUPS}
+    valid_by_group = {g: [] for g in GROUPS}
     sim_err = {g: [] for g in GROUPS}
     real_err = {g: [] for g in GROUPS}
     per_session_plot = []
@@ -464,6 +465,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                 chosen_err.append(err)
                 chosen_res.append(resolved)
                 res_by_group[data.period].append(resolved)
+                valid_by_group[data.period].append(decoded)
                 real_err[data.period].append(err)
                 per_session_plot.append((session, data, err))
                 if sim_runs:  # every repeat its own simulated device (gains) and cloud draw, errors pooled
@@ -529,6 +531,11 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             metrics[f"{g}_resolved_fraction"] = float(np.mean(np.concatenate(res_by_group[g])))
             # the eq. 4.6 pair chosen right: the error is less than a quarter turn (undecoded samples count as wrong)
             metrics[f"{g}_correct_side_fraction"] = float(np.mean(np.abs(e) < np.pi / 2.0 - 1e-9))
+            # the decoder's per-sample valid flag: a heading was given (enough units above the noise floor);
+            # <group>_mae_deg counts the others as 90 degrees, <group>_mae_valid_deg leaves them out
+            ok = np.concatenate(valid_by_group[g])
+            metrics[f"{g}_valid_fraction"] = float(np.mean(ok))
+            metrics[f"{g}_mae_valid_deg"] = error_stats(e[ok])["mae_deg"]
     for r in pooled_rows:
         if r["decoder"] == chosen and r["group"] in GROUPS:
             metrics[f"{r['group']}_mae_deg"] = r["mae_deg"]
