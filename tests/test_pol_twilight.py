@@ -103,3 +103,23 @@ def test_noise_weighting_leaves_daylight_alone():
     assert with_noise.valid.all()
     assert np.max(np.abs(np.degrees(wrap_angle(with_noise.azimuth - without.azimuth)))) < 0.05
     assert np.median(_errors(with_noise, sun, yaw)) < 1.0
+
+
+def test_readable_counts_inverts_the_angle_noise_and_the_limit_sits_where_the_counts_run_out():
+    from bionav.light.twilight import twilight_zenith_radiance
+    from bionav.polcompass.array import UnitEvectors
+    from bionav.polcompass.twilight import lowest_readable_elevation, readable_counts
+
+    need = readable_counts(0.5, degree=0.4, max_angle_noise=np.deg2rad(10.0))
+    ev = UnitEvectors(np.zeros((1, 1, 2)), np.zeros((1, 1)), np.full((1, 1), 0.4), np.full((1, 1), need),
+                      np.zeros((1, 1, 3)))
+    assert angle_noise(ev, 0.5)[0, 0] == pytest.approx(np.deg2rad(10.0))
+    ref = np.deg2rad(5.0)
+    limit = lowest_readable_elevation(200.0, ref, noise_counts=0.5, degree=0.4, max_angle_noise=np.deg2rad(10.0))
+    predicted = 200.0 * twilight_zenith_radiance(limit) / twilight_zenith_radiance(ref)
+    assert predicted == pytest.approx(need, rel=0.02)
+    assert np.deg2rad(-8.0) < limit < 0.0
+    # more light at the reference: a lower limit; too little already: the reference elevation itself
+    assert lowest_readable_elevation(2000.0, ref, noise_counts=0.5, degree=0.4,
+                                     max_angle_noise=np.deg2rad(10.0)) < limit
+    assert lowest_readable_elevation(1.0, ref, noise_counts=0.5, degree=0.4, max_angle_noise=np.deg2rad(10.0)) == ref
