@@ -227,7 +227,11 @@ class PolSkyConfig:
     """Simulated sky, and the sun the compass assumes (azimuths counter-clockwise from east).
 
     time : ISO-8601 time (or ``now``): sun from time and place via ephem; None: the angles below.
-    turbidity : Preetham turbidity; sets the maximum degree of polarization (``max_degree`` overrides it).
+    turbidity : Preetham turbidity; sets the maximum degree of polarization with ``parameters=thesis``
+        (``max_degree`` overrides it).
+    parameters : ``fitted`` (default): the maximum degree of polarization fitted on the real POL-OP recordings
+        (0.5: the simulated units then read the measured median degree, docs/polcompass.md "Sim-to-real");
+        ``thesis``: from ``turbidity`` (``0.946 / T``).
     neutral_point_separation_deg : > 0: Berry et al. (2004) model with four neutral points.
     mount_heading_deg : simulated heading of the pan-tilt mount at pan 0.
     """
@@ -239,6 +243,7 @@ class PolSkyConfig:
     sun_azimuth_deg: float = bounded(0.0, ge=-360.0, le=360.0)
     turbidity: float = bounded(1.25, ge=1.0, le=100.0)
     max_degree: Optional[float] = bounded(None, ge=0.0, le=1.0)
+    parameters: str = bounded("fitted", choices=("fitted", "thesis"))
     neutral_point_separation_deg: float = bounded(0.0, ge=0.0, le=90.0)
     cloud_cover: float = bounded(0.0, ge=0.0, le=1.0)
     cloud_correlation_deg: float = bounded(15.0, gt=0.0, le=180.0)
@@ -459,6 +464,9 @@ class PolRecordingsConfig:
     sim_repeats: int = bounded(4, ge=1, le=100)
     sim_angle_sigma_deg: float = bounded(2.0, ge=0.0, le=45.0)
     sim_max_degree: float = bounded(0.5, gt=0.0, le=1.0)
+    sim_tilt_sigma_deg: float = bounded(0.0, ge=0.0, le=45.0)
+    sim_azimuth_sigma_deg: float = bounded(0.0, ge=0.0, le=45.0)
+    sim_view_sigma: float = bounded(0.1, ge=0.0, le=2.0)
     record_samples: bool = True
 
 

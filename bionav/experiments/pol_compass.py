@@ -424,8 +424,10 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
     sun, time_utc = resolve_sun(exp.sky, recorded_session=recorded)
     if recorded is not None:
         true_mount = recorded.get("true_mount_heading")
+        sim_info = recorded.get("sim")
     else:
         true_mount = None if scene is None or mode == "partial_sky" else float(scene.mount_heading)
+        sim_info = None if scene is None else simulation_parameters(exp, sensor)
     session = Session(
         sensor,
         devices.get("pantilt"),
@@ -444,6 +446,7 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
             "sun_azimuth": float(sun.azimuth),
             "sun_elevation": float(sun.elevation),
             "true_mount_heading": true_mount,
+            "sim": sim_info,
         },
         schema_name="bionav.PolCompassSession",
         schema=SESSION_SCHEMA,
@@ -454,6 +457,35 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
         if session.fixed_calibration is not None:
             write(CALIBRATION_TOPIC, session.fixed_calibration, schema_name="bionav.PolCompassCalibration",
                   schema=CALIBRATION_SCHEMA)
+    if sim_info:  # say which simulation parameters were used (also in a replay of a simulated run)
+        metrics = _run_mode(session, exp, devices, mode, scene=scene, rng=rng, plots=plots, out_dir=out_dir)
+        return {**metrics, **sim_info}
+    return _run_mode(session, exp, devices, mode, scene=scene, rng=rng, plots=plots, out_dir=out_dir)
+
+
+def simulation_parameters(exp, sensor) -> dict:
+    """The simulation's parameters for ``metrics.json``: ``sim_parameters`` (``fitted`` to the real recordings or
+    ``thesis``), the sky's maximum degree and the simulated device's tolerances where the sensor has them."""
+    from bionav.experiments.pol_compass_session import FITTED_MAX_DEGREE
+
+    sky = exp.sky
+    how = str(sky.get("parameters", "fitted"))
+    max_degree = sky.get("max_degree")
+    if max_degree is None:
+        from bionav.light import max_degree_from_turbidity
+
+        max_degree = FITTED_MAX_DEGREE if how == "fitted" else max_degree_from_turbidity(float(sky.turbidity))
+    info = {"sim_parameters": how, "sim_max_degree": float(max_degree)}
+    config = getattr(sensor, "config", None)
+    for key in ("angle_sigma_deg", "sensitivity_sigma", "gain_sigma", "noise_v"):
+        if config is not None and hasattr(config, key):
+            info[f"sim_{key}"] = float(getattr(config, key))
+    return info
+
+
+def _run_mode(session, exp, devices, mode, *, scene, rng, plots, out_dir) -> dict:
+    """Run ``mode`` on an opened session (see :func:`run_session`)."""
+    sun = session.sun
     if devices.get("decoder") is not None:  # recorded POL-OP array counts (sensor=recording, or its replay)
         from bionav.experiments.pol_compass_recorded import recorded_rotation_mode
 

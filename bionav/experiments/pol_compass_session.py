@@ -19,6 +19,9 @@ from bionav.errors import UserError
 from bionav.plugins.sensors.replay import PANTILT_INFO_TOPIC, PANTILT_TOPIC, SENSOR_TOPIC
 
 SESSION_TOPIC = "/pol_compass/session"
+# Fitted on the real POL-OP recordings (experiment=pol_recordings, docs/polcompass.md "Sim-to-real"): with this
+# maximum degree the simulated units read the measured median degree of the daylight sessions (0.36-0.40).
+FITTED_MAX_DEGREE = 0.5
 CALIBRATION_TOPIC = "/pol_compass/calibration"
 REFERENCE_TOPIC = "/reference/raw"
 
@@ -37,6 +40,7 @@ SESSION_SCHEMA = {
         "sun_azimuth": {"type": "number", "description": "radians CCW from east"},
         "sun_elevation": {"type": "number", "description": "radians"},
         "true_mount_heading": {"type": ["number", "null"], "description": "simulated mount heading, radians CCW from east"},
+        "sim": {"type": ["object", "null"], "description": "simulation parameters (sim_parameters: fitted|thesis, ...)"},
     },
 }
 CALIBRATION_SCHEMA = {
@@ -155,7 +159,8 @@ def sky_model(sky, sun, *, clouds=None):
 
     max_degree = sky.get("max_degree")
     if max_degree is None:
-        max_degree = max_degree_from_turbidity(float(sky.turbidity))
+        fitted = str(sky.get("parameters", "fitted")) == "fitted"
+        max_degree = FITTED_MAX_DEGREE if fitted else max_degree_from_turbidity(float(sky.turbidity))
     return SkyModel(
         sun,
         max_degree=float(max_degree),
