@@ -570,6 +570,9 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         metrics["sim_noise"] = float(exp.sim_noise)
         metrics["sim_canopy_cover"] = float(exp.sim_canopy_cover)
         metrics["sim_max_degree"] = float(exp.sim_max_degree)
+        metrics["sim_view_sigma"] = float(exp.sim_view_sigma)
+        metrics["sim_tilt_sigma_deg"] = float(exp.sim_tilt_sigma_deg)
+        metrics["sim_azimuth_sigma_deg"] = float(exp.sim_azimuth_sigma_deg)
         for g in GROUPS:
             if sim_err[g]:
                 metrics[f"sim_{g}_mae_deg"] = error_stats(np.concatenate(sim_err[g]))["mae_deg"]
