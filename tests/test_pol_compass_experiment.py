@@ -111,7 +111,9 @@ def check_mode_numbers(mode, metrics, run_dir):
         rows = list(csv.DictReader(open(run_dir / "partial_sky.csv")))
         assert len(rows) == 4 and metrics["n_samples"] == 4
         clear = [float(r["scan_error_deg"]) for r in rows if float(r["cloud_cover"]) == 0.0]
-        assert max(clear) < 1.0  # a clear sky: the scan fit finds the heading, resolved
+        # a clear sky: the scan fit finds the heading, resolved (within 2 degrees: the device fitted on the real
+        # recordings has 2 degree polarizer and 14 % sensitivity spreads, the sky a maximum degree of 0.5)
+        assert max(clear) < 2.0
         assert all(r["scan_resolved"] == "True" for r in rows if float(r["cloud_cover"]) == 0.0)
 
 
@@ -131,7 +133,7 @@ def test_serial_path_against_fake_devices_and_replay(tmp_path):
     exp = experiment_config("rotation", samples_per_step=2, fake_devices=True, pan_range_deg=[-90.0, 90.0], step_deg=6.0)
     metrics, log = run(tmp_path, "serial", exp, sensor={"name": "polcompass_serial"}, pantilt={"name": "ptu46", "settle_s": 0.02})
     assert metrics["status"] == "completed" and metrics["n_samples"] == 62
-    assert metrics["heading_rmse_deg"] <= 1.0
+    assert metrics["heading_rmse_deg"] <= 1.5  # the fitted device (see check_mode_numbers)
     states = [m for t, _, m in read_messages(log, topics=["/pantilt/state"])]
     assert states[0]["pan_pos"] == round(np.deg2rad(-90.0) / np.deg2rad(185.1428 / 3600))
     assert replay(tmp_path, "replay", exp, log) == metrics
@@ -191,3 +193,18 @@ def test_unplug_mid_scan_keeps_readings_in_the_log(tmp_path):
     assert [replayed.read() for _ in range(24)] == readings
     with pytest.raises(UserError, match="holds only 24 messages"):
         replayed.read()
+
+
+def test_the_simulation_uses_the_parameters_fitted_on_the_recordings_and_says_so(tmp_path):
+    from bionav.light import max_degree_from_turbidity
+
+    small = {"samples_per_step": 1, "step_deg": 9.0}
+    fitted, log = run(tmp_path, "fitted", experiment_config("rotation", **small))
+    assert fitted["sim_parameters"] == "fitted" and fitted["sim_max_degree"] == 0.5
+    assert fitted["sim_angle_sigma_deg"] == 2.0 and fitted["sim_sensitivity_sigma"] == 0.14
+    thesis, _ = run(tmp_path, "thesis", experiment_config("rotation", **{"sky.parameters": "thesis"}, **small),
+                    sensor={"name": "polcompass_sim", "angle_sigma_deg": 1.0, "sensitivity_sigma": 0.05})
+    assert thesis["sim_parameters"] == "thesis" and thesis["sim_max_degree"] == pytest.approx(max_degree_from_turbidity(1.25))
+    # a higher degree and a tighter device: the thesis' simulated compass is the more optimistic one
+    assert thesis["heading_rmse_deg"] < fitted["heading_rmse_deg"]
+    assert replay(tmp_path, "replay", experiment_config("rotation", **small), log) == fitted

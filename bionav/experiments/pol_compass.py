@@ -43,6 +43,8 @@ from omegaconf import DictConfig, OmegaConf
 from bionav.errors import UserError
 from bionav.experiments.configs import experiment_config
 from bionav.experiments.pol_compass_session import (
+    CALIBRATION_SCHEMA,
+    CALIBRATION_TOPIC,
     SESSION_SCHEMA,
     SESSION_TOPIC,
     Session,
@@ -70,11 +72,39 @@ def summarize(errors, *, axial: bool, n: int) -> dict[str, Any]:
     return {"heading_rmse_deg": errors.rmse_deg, "heading_mae_deg": errors.mae_deg, "n_samples": int(n), "axial": bool(axial)}
 
 
-def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir):
+def sensor_calibration(sensor) -> dict | None:
+    """The calibration message of the sensor: the file ``sensor.calibration`` names, or the one a replayed run recorded.
+
+    Returns ``None`` where ``experiment.calibration`` decides (``sensor.calibration=none``, or a replay of a
+    run without a sensor calibration). The message follows
+    :data:`~bionav.experiments.pol_compass_session.CALIBRATION_SCHEMA`.
+    """
+    if hasattr(sensor, "recorded"):  # sensor=replay: what the recorded run applied
+        messages = sensor.recorded(CALIBRATION_TOPIC)
+        return dict(messages[-1]) if messages else None
+    cal = getattr(sensor, "calibration", None)
+    if cal is None or not hasattr(cal, "center_v"):
+        return None
+    return {"kind": "units", "source": str(sensor.config.calibration), "calibration": cal.to_dict(), "array_config": None}
+
+
+def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir, fixed=None):
     from bionav.polcompass import UnitCalibration, calibrate_from_rotation
 
     nominal = UnitCalibration.nominal(unit_angles)
     how = str(exp.calibration)
+    if fixed is not None:  # sensor.calibration=FILE (or a replay of such a run) replaces experiment.calibration
+        if fixed.get("kind") != "units" or not fixed.get("calibration"):
+            raise UserError(f"The compass calibration {fixed.get('source')!r} is not a per-unit calibration of the "
+                            "thesis compass; use the calibration.json of an experiment=pol_compass rotation run.")
+        cal = UnitCalibration.from_dict(fixed["calibration"])
+        if len(cal.unit_angles) != len(unit_angles):
+            raise UserError(f"The compass calibration {fixed.get('source')} has {len(cal.unit_angles)} units, the "
+                            f"compass {len(unit_angles)} (experiment.unit_angles_deg); use a calibration of this compass.")
+        how = "sensor_file"
+        if out_dir is not None:
+            cal.save(out_dir / "calibration.json")
+        return cal, how
     if how == "auto":
         how = "rotation" if np.all(np.abs(tilts) < 1e-12) else "nominal"
     if how == "nominal":
@@ -145,7 +175,8 @@ def rotation_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=Non
     )
     counts = counts_of(readings)
     volts = counts_to_volts(counts)
-    cal, how = _calibration(exp, volts, pans, tilts, unit_angles=unit_angles, out_dir=out_dir)
+    cal, how = _calibration(exp, volts, pans, tilts, unit_angles=unit_angles, out_dir=out_dir,
+                            fixed=session.fixed_calibration)
     angle, degree, x = evectors_from_counts(counts, cal, solver=str(exp.solver))
     predictor = EvectorPredictor(sky_model(exp.sky, session.sun), CompassOptics(unit_angles=tuple(cal.unit_angles)))
     heading, resolved = pose_headings(
@@ -188,7 +219,8 @@ def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) 
         session, [(p, 0.0) for p in positions], int(exp.vs_em.samples), desc="vs TCM2", with_reference=True
     )
     counts = counts_of(readings)
-    cal, _ = _calibration(exp, counts_to_volts(counts), pans, tilts, unit_angles=unit_angles, out_dir=out_dir)
+    cal, how = _calibration(exp, counts_to_volts(counts), pans, tilts, unit_angles=unit_angles, out_dir=out_dir,
+                            fixed=session.fixed_calibration)
     angle, _, _ = evectors_from_counts(counts, cal, solver=str(exp.solver))
     pol = np.asarray(zenith_heading(angle, sun_azimuth=session.sun.azimuth))
     tcm2 = np.asarray(compass_to_azimuth(np.deg2rad([r["heading_deg"] for r in refs])))
@@ -203,6 +235,7 @@ def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) 
         heading_offset_deg=float(np.degrees(errors.offset)),
         averaged_rmse_deg=avg_errors.rmse_deg,
         n_positions=int(len(steps)),
+        calibration=how,
     )
     if plots is not None:
         plots_mod.plot_vs_em(plots / "fig4_4_averaged.png", pol_avg - avg_errors.offset, tcm2_avg, averaged=True)
@@ -274,6 +307,9 @@ def _rotation_calibration(session: Session, exp, *, unit_angles, out_dir):
     from bionav.polcompass import UnitCalibration, counts_to_volts
 
     how = str(exp.calibration)
+    if session.fixed_calibration is not None:
+        return _calibration(exp, None, None, None, unit_angles=unit_angles, out_dir=out_dir,
+                            fixed=session.fixed_calibration)[0]
     if how == "nominal":
         return UnitCalibration.nominal(unit_angles)
     if how == "file":
@@ -388,8 +424,10 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
     sun, time_utc = resolve_sun(exp.sky, recorded_session=recorded)
     if recorded is not None:
         true_mount = recorded.get("true_mount_heading")
+        sim_info = recorded.get("sim")
     else:
         true_mount = None if scene is None or mode == "partial_sky" else float(scene.mount_heading)
+        sim_info = None if scene is None else simulation_parameters(exp, sensor)
     session = Session(
         sensor,
         devices.get("pantilt"),
@@ -408,11 +446,46 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
             "sun_azimuth": float(sun.azimuth),
             "sun_elevation": float(sun.elevation),
             "true_mount_heading": true_mount,
+            "sim": sim_info,
         },
         schema_name="bionav.PolCompassSession",
         schema=SESSION_SCHEMA,
     )
     session.record_pantilt_info()
+    if devices.get("decoder") is None:  # the thesis compass: sensor.calibration=FILE, or what a replayed run applied
+        session.fixed_calibration = sensor_calibration(sensor)
+        if session.fixed_calibration is not None:
+            write(CALIBRATION_TOPIC, session.fixed_calibration, schema_name="bionav.PolCompassCalibration",
+                  schema=CALIBRATION_SCHEMA)
+    if sim_info:  # say which simulation parameters were used (also in a replay of a simulated run)
+        metrics = _run_mode(session, exp, devices, mode, scene=scene, rng=rng, plots=plots, out_dir=out_dir)
+        return {**metrics, **sim_info}
+    return _run_mode(session, exp, devices, mode, scene=scene, rng=rng, plots=plots, out_dir=out_dir)
+
+
+def simulation_parameters(exp, sensor) -> dict:
+    """The simulation's parameters for ``metrics.json``: ``sim_parameters`` (``fitted`` to the real recordings or
+    ``thesis``), the sky's maximum degree and the simulated device's tolerances where the sensor has them."""
+    from bionav.experiments.pol_compass_session import FITTED_MAX_DEGREE
+
+    sky = exp.sky
+    how = str(sky.get("parameters", "fitted"))
+    max_degree = sky.get("max_degree")
+    if max_degree is None:
+        from bionav.light import max_degree_from_turbidity
+
+        max_degree = FITTED_MAX_DEGREE if how == "fitted" else max_degree_from_turbidity(float(sky.turbidity))
+    info = {"sim_parameters": how, "sim_max_degree": float(max_degree)}
+    config = getattr(sensor, "config", None)
+    for key in ("angle_sigma_deg", "sensitivity_sigma", "gain_sigma", "noise_v"):
+        if config is not None and hasattr(config, key):
+            info[f"sim_{key}"] = float(getattr(config, key))
+    return info
+
+
+def _run_mode(session, exp, devices, mode, *, scene, rng, plots, out_dir) -> dict:
+    """Run ``mode`` on an opened session (see :func:`run_session`)."""
+    sun = session.sun
     if devices.get("decoder") is not None:  # recorded POL-OP array counts (sensor=recording, or its replay)
         from bionav.experiments.pol_compass_recorded import recorded_rotation_mode
 
@@ -510,12 +583,16 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             stack.callback(plugin.close)
             devices[role] = plugin
         if recorded_array:
-            from bionav.plugins.sensors.recording import RecordingConfig
-
             cfg_dec = cfg.get("decoder")
             node = cfg_dec if cfg_dec is not None and cfg_dec.get("name") else {"name": "sky_fit"}
             devices["decoder"] = ctx.plugin("decoder", node)
-            devices["array_config"] = devices["sensor"].config if nodes["sensor"]["name"] == "recording" else RecordingConfig()
+            if nodes["sensor"]["name"] == "recording":
+                devices["array_config"] = devices["sensor"].config
+            else:  # a replay: the array keys (and calibration) the recorded run used
+                from bionav.experiments.pol_compass_recorded import recorded_array_config
+
+                recorded = devices["sensor"].recorded(CALIBRATION_TOPIC)
+                devices["array_config"] = recorded_array_config(recorded[-1] if recorded else None)
         metrics = run_session(
             exp,
             devices,

@@ -21,18 +21,62 @@ def is_array_reading(message: dict) -> bool:
     return isinstance(message, dict) and "photodiodes" in message and "units" in message
 
 
-def _calibrated_array(array, how: str, counts, yaw, valid):
-    """``sensor.calibration``: ``none``, ``auto`` (self-calibrated from these samples) or a calibration file."""
+ARRAY_KEYS = ("photodiodes", "tilt_deg", "azimuth_sign", "photodiode_angles_deg", "pairs", "saturation_counts",
+              "dark_counts", "imbalance_decades", "calibration")
+
+
+def array_message(sensor_config, source: str, calibration: dict | None) -> dict:
+    """The ``/pol_compass/calibration`` message of a recorded-array run: the calibration applied and the array keys.
+
+    ``calibration`` is the file's JSON object (``source`` a path), the self-calibration's ``to_dict()``
+    (``source="auto"``) or ``None`` (``source="none"``); ``array_config`` the ``sensor.*`` keys that say how
+    the recorded array reads, so that ``sensor=replay`` decodes the replayed counts the same way.
+    """
+    config = {k: getattr(sensor_config, k) for k in ARRAY_KEYS if hasattr(sensor_config, k)}
+    config = {k: (list(v) if isinstance(v, (list, tuple)) else v) for k, v in config.items()}
+    config["pairs"] = [list(p) for p in config.get("pairs", [])]
+    return {"kind": "array", "source": source, "calibration": calibration, "array_config": config}
+
+
+def recorded_array_config(message: dict | None):
+    """The :class:`~bionav.plugins.sensors.recording.RecordingConfig` a recorded run read its array with (defaults
+    for a log without one)."""
+    from bionav.plugins.sensors.recording import RecordingConfig
+
+    config = RecordingConfig()
+    for key, value in ((message or {}).get("array_config") or {}).items():
+        if key in ARRAY_KEYS:
+            setattr(config, key, value)
+    return config
+
+
+def _calibrated_array(array, how: str, counts, yaw, valid, *, recorded: dict | None = None):
+    """``sensor.calibration``: ``none``, ``auto`` (self-calibrated from these samples) or a calibration file.
+
+    ``recorded``: the calibration message of a replayed run, applied instead (``auto`` is recomputed from the
+    replayed counts, which are the recorded ones). Returns the calibrated array and the message to record.
+    """
     from bionav.polcompass.array_calibration import ArrayCalibration, calibrate_session, combine_sessions
 
     how = str(how or "none")
+    raw = None
+    if recorded is not None:
+        how, raw = str(recorded.get("source") or "none"), recorded.get("calibration")
     if how == "none":
-        return array
+        return array, "none", None
     if how == "auto":
         cal = combine_sessions([calibrate_session(counts, yaw, valid, array)])
+        raw = cal.to_dict()
     else:
-        cal = ArrayCalibration.load(how)
-    return cal.apply(array, gains=False, azimuths=False)  # gains made the recorded compass worse (docs/polcompass.md)
+        if raw is None:
+            from bionav.files import read_json_file
+
+            raw = read_json_file(how, what="The POL-OP calibration", fix=(
+                "Point sensor.calibration at a calibration.json written by experiment=pol_recordings "
+                "recordings.calibration=auto, or use sensor.calibration=auto or none."), max_bytes=16 * 2**20)
+        cal = ArrayCalibration.from_dict(raw, source=f"The calibration {how}")
+    # gains made the recorded compass worse (docs/polcompass.md): polarizer angle offsets only
+    return cal.apply(array, gains=False, azimuths=False), how, raw
 
 
 def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) -> dict:
@@ -74,7 +118,13 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
     )
     valid = sample_validity(counts, saturation_counts=sensor_config.saturation_counts,
                             dark_counts=sensor_config.dark_counts, imbalance_decades=sensor_config.imbalance_decades)
-    array = _calibrated_array(array, getattr(sensor_config, "calibration", "none"), counts, yaw, valid)
+    from bionav.experiments.pol_compass_session import CALIBRATION_SCHEMA, CALIBRATION_TOPIC
+
+    recorded = sensor.recorded(CALIBRATION_TOPIC) if hasattr(sensor, "recorded") else []
+    array, how, raw = _calibrated_array(array, getattr(sensor_config, "calibration", "none"), counts, yaw, valid,
+                                        recorded=recorded[-1] if recorded else None)
+    session.write(CALIBRATION_TOPIC, array_message(sensor_config, how, raw), schema_name="bionav.PolCompassCalibration",
+                  schema=CALIBRATION_SCHEMA)
     with np.errstate(invalid="ignore", divide="ignore"):
         ev = evectors_from_counts(counts, array)
     est = decoder.decode(ev, valid & np.isfinite(ev.angle), array=array, sun_elevation=float(session.sun.elevation))
@@ -91,8 +141,7 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
         "decoded_fraction": float(np.mean(ok)),
         "resolved_fraction": float(np.mean(est.resolved)),
         "heading_offset_deg": float(np.degrees(errors.offset)),
-        "calibration": str(getattr(sensor_config, "calibration", "none")) if getattr(sensor_config, "calibration", "none")
-        in ("none", "auto") else "file",
+        "calibration": how if how in ("none", "auto") else "file",
     }
     if plots is not None:
         plots_mod.plot_rotation(plots / "heading_vs_pan.png", np.unwrap(yaw[ok]), heading[ok] - errors.offset, errors.errors,

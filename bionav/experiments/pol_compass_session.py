@@ -19,6 +19,10 @@ from bionav.errors import UserError
 from bionav.plugins.sensors.replay import PANTILT_INFO_TOPIC, PANTILT_TOPIC, SENSOR_TOPIC
 
 SESSION_TOPIC = "/pol_compass/session"
+# Fitted on the real POL-OP recordings (experiment=pol_recordings, docs/polcompass.md "Sim-to-real"): with this
+# maximum degree the simulated units read the measured median degree of the daylight sessions (0.36-0.40).
+FITTED_MAX_DEGREE = 0.5
+CALIBRATION_TOPIC = "/pol_compass/calibration"
 REFERENCE_TOPIC = "/reference/raw"
 
 PANTILT_INFO_SCHEMA = {
@@ -36,7 +40,20 @@ SESSION_SCHEMA = {
         "sun_azimuth": {"type": "number", "description": "radians CCW from east"},
         "sun_elevation": {"type": "number", "description": "radians"},
         "true_mount_heading": {"type": ["number", "null"], "description": "simulated mount heading, radians CCW from east"},
+        "sim": {"type": ["object", "null"], "description": "simulation parameters (sim_parameters: fitted|thesis, ...)"},
     },
+}
+CALIBRATION_SCHEMA = {
+    "type": "object",
+    "title": "Calibration the compass was decoded with (sensor.calibration, or recorded for a replay)",
+    "properties": {
+        "kind": {"type": "string", "enum": ["units", "array"], "description": "units: UnitCalibration (thesis "
+                 "compass); array: ArrayCalibration (POL-OP array)"},
+        "source": {"type": "string", "description": "file path, 'auto' (self-calibrated) or 'none'"},
+        "calibration": {"type": ["object", "null"], "description": "the calibration's to_dict(); null: nominal"},
+        "array_config": {"type": ["object", "null"], "description": "how the recorded array reads (sensor=recording)"},
+    },
+    "required": ["kind", "source", "calibration"],
 }
 
 
@@ -62,6 +79,10 @@ class Session:
     true_mount_heading : float or None
         The simulated mount heading (radians CCW from east), recorded so that
         replays report the same simulation-only metrics; ``None`` for hardware.
+    fixed_calibration : dict or None
+        A calibration message (:data:`CALIBRATION_SCHEMA`) that replaces
+        ``experiment.calibration``: the file ``sensor.calibration`` names, or
+        the one a replayed run recorded; ``None``: ``experiment.calibration``.
     """
 
     sensor: Any
@@ -72,6 +93,7 @@ class Session:
     sun: Any
     progress: Callable = field(default=lambda it, desc="", total=None: it)
     true_mount_heading: float | None = None
+    fixed_calibration: dict | None = None
 
     def read(self) -> dict:
         """Take and record one compass reading."""
@@ -137,7 +159,8 @@ def sky_model(sky, sun, *, clouds=None):
 
     max_degree = sky.get("max_degree")
     if max_degree is None:
-        max_degree = max_degree_from_turbidity(float(sky.turbidity))
+        fitted = str(sky.get("parameters", "fitted")) == "fitted"
+        max_degree = FITTED_MAX_DEGREE if fitted else max_degree_from_turbidity(float(sky.turbidity))
     return SkyModel(
         sun,
         max_degree=float(max_degree),

@@ -264,6 +264,23 @@ def decode_session(decoder, data: SessionData):
     return heading, np.asarray(est.resolved, bool), time.perf_counter() - t0
 
 
+def view_field(rng, heading, unit_azimuths, n_photodiodes: int, *, n_harmonics: int = 12):
+    """A random smooth field of unit variance per photodiode over the world azimuth it looks at, shape ``(N, K, P)``.
+
+    ``g_kp(theta) = sum_{h=1..H} a_kph cos(h theta) + b_kph sin(h theta)`` with ``a, b ~ N(0, 1/H)``, evaluated
+    at ``theta = heading + unit_azimuth_k`` (radians). The simulation multiplies counts by
+    ``exp(sim_view_sigma g)``: what makes the real units depart from one shared sky ring (about 11 % rms on
+    the recordings, ``SessionCalibration.residual_rms``) -- e.g. each unit's own field of view, reflections,
+    the horizon -- which gains, polarizer offsets and pointing do not (docs/polcompass.md).
+    """
+    k = np.size(unit_azimuths)
+    theta = np.asarray(heading, float)[:, None] + np.asarray(unit_azimuths, float)[None, :]  # (N, K)
+    h = np.arange(1, n_harmonics + 1)
+    a, b = rng.standard_normal((2, k, n_photodiodes, n_harmonics)) / np.sqrt(n_harmonics)
+    ang = theta[:, :, None] * h  # (N, K, H)
+    return np.einsum("nkh,kph->nkp", np.cos(ang), a) + np.einsum("nkh,kph->nkp", np.sin(ang), b)
+
+
 def simulate_session(data: SessionData, exp, rng) -> SessionData:
     """The same sensor, samples and exclusions under bionav's sky model at the session's time and place.
 
@@ -283,13 +300,19 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
     mount = float(rng.uniform(-np.pi, np.pi))
     offsets = np.deg2rad(exp.sim_angle_sigma_deg) * rng.standard_normal(data.array.polarizer_angles.shape)
-    device = replace(data.array, polarizer_angles=data.array.polarizer_angles + offsets)
+    k = data.array.unit_tilts.shape
+    device = replace(data.array, polarizer_angles=data.array.polarizer_angles + offsets,
+                     unit_tilts=data.array.unit_tilts + np.deg2rad(exp.sim_tilt_sigma_deg) * rng.standard_normal(k),
+                     unit_azimuths=data.array.unit_azimuths + np.deg2rad(exp.sim_azimuth_sigma_deg) * rng.standard_normal(k))
     intensity, q, u = stokes_from_sky(model, device, mount + data.yaw)
     counts = counts_from_stokes(intensity, q, u, device)
     lit = data.counts[data.counts > 0]
     scale = (np.median(lit) if lit.size else 1000.0) / max(float(np.median(counts)), 1e-12)
     gains = np.exp(exp.sim_gain_sigma * rng.standard_normal(counts.shape[1:]))
     counts = counts * scale * gains
+    if exp.sim_view_sigma > 0:  # each photodiode's own smooth departure from the shared sky ring (world frame)
+        counts = counts * np.exp(exp.sim_view_sigma * view_field(rng, mount + data.yaw, data.array.unit_azimuths,
+                                                                   counts.shape[-1]))
     counts = counts * (1.0 + exp.sim_noise * rng.standard_normal(counts.shape))
     counts = np.clip(np.round(counts), 0, None)
     saturation = float(np.max(data.counts)) if data.counts.size else np.inf
@@ -397,6 +420,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     errors = {n: {g: [] for g in GROUPS} for n in names}
     chosen_err, chosen_res = [], []
     res_by_group = {g: [] for g in GROUPS}
+    valid_by_group = {g: [] for g in GROUPS}
     sim_err = {g: [] for g in GROUPS}
     real_err = {g: [] for g in GROUPS}
     per_session_plot = []
@@ -464,6 +488,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                 chosen_err.append(err)
                 chosen_res.append(resolved)
                 res_by_group[data.period].append(resolved)
+                valid_by_group[data.period].append(decoded)
                 real_err[data.period].append(err)
                 per_session_plot.append((session, data, err))
                 if sim_runs:  # every repeat its own simulated device (gains) and cloud draw, errors pooled
@@ -529,6 +554,11 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             metrics[f"{g}_resolved_fraction"] = float(np.mean(np.concatenate(res_by_group[g])))
             # the eq. 4.6 pair chosen right: the error is less than a quarter turn (undecoded samples count as wrong)
             metrics[f"{g}_correct_side_fraction"] = float(np.mean(np.abs(e) < np.pi / 2.0 - 1e-9))
+            # the decoder's per-sample valid flag: a heading was given (enough units above the noise floor);
+            # <group>_mae_deg counts the others as 90 degrees, <group>_mae_valid_deg leaves them out
+            ok = np.concatenate(valid_by_group[g])
+            metrics[f"{g}_valid_fraction"] = float(np.mean(ok))
+            metrics[f"{g}_mae_valid_deg"] = error_stats(e[ok])["mae_deg"]
     for r in pooled_rows:
         if r["decoder"] == chosen and r["group"] in GROUPS:
             metrics[f"{r['group']}_mae_deg"] = r["mae_deg"]
@@ -540,6 +570,9 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         metrics["sim_noise"] = float(exp.sim_noise)
         metrics["sim_canopy_cover"] = float(exp.sim_canopy_cover)
         metrics["sim_max_degree"] = float(exp.sim_max_degree)
+        metrics["sim_view_sigma"] = float(exp.sim_view_sigma)
+        metrics["sim_tilt_sigma_deg"] = float(exp.sim_tilt_sigma_deg)
+        metrics["sim_azimuth_sigma_deg"] = float(exp.sim_azimuth_sigma_deg)
         for g in GROUPS:
             if sim_err[g]:
                 metrics[f"sim_{g}_mae_deg"] = error_stats(np.concatenate(sim_err[g]))["mae_deg"]

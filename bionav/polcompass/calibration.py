@@ -78,13 +78,13 @@ class UnitCalibration:
             ) from None
 
     @classmethod
-    def load(cls, path) -> "UnitCalibration":
-        """Read a calibration written by :meth:`save`."""
+    def load(cls, path, *, setting: str = "experiment.calibration_path") -> "UnitCalibration":
+        """Read a calibration written by :meth:`save`; ``setting`` names the option in error messages."""
         from bionav.files import read_json_file
 
         data = read_json_file(path, what="The compass calibration", fix=(
-            "Point experiment.calibration_path at a calibration.json written by a rotation run, or set it to null "
-            "to calibrate from the scan."), max_bytes=16 * 2**20)
+            f"Point {setting} at a calibration.json written by a rotation run (experiment=pol_compass mode=rotation), "
+            "or drop it to calibrate from the scan."), max_bytes=16 * 2**20)
         if not isinstance(data, dict):
             raise UserError(f"The compass calibration {path} holds a JSON {type(data).__name__}, not an object; "
                             "recalibrate with experiment.mode=rotation.")

@@ -85,6 +85,11 @@ class SunEstimate:
     alternative: np.ndarray
     resolved: np.ndarray
 
+    @property
+    def valid(self) -> np.ndarray:
+        """Per sample: the units gave an azimuth (enough light above the noise floor, enough units), shape ``(N,)``."""
+        return np.isfinite(self.azimuth)
+
 
 def heading_from_sun(sun_sensor_azimuth, sun_world_azimuth):
     """Sensor heading (radians CCW from east) from the solar azimuth in the sensor frame."""
@@ -94,6 +99,38 @@ def heading_from_sun(sun_sensor_azimuth, sun_world_azimuth):
 def _weights(ev: UnitEvectors, valid, power: float):
     ok = np.asarray(valid, bool) & np.isfinite(ev.angle) & np.isfinite(ev.degree)
     return np.where(ok, np.nan_to_num(ev.degree) ** power, 0.0)
+
+
+def angle_noise(ev: UnitEvectors, noise_counts: float, *, min_degree: float = 0.05):
+    """Standard deviation of each unit's e-vector angle caused by count noise, radians, shape ``(N, K)``.
+
+    A POL-OP reads ``x = (s_a - s_b) / (s_a + s_b)`` (eq. 4.3 after delogarithmising); a count noise of
+    ``sigma_c`` counts per photodiode gives ``sigma_x = sqrt(2) sigma_c / S`` with ``S = s_a + s_b`` (to
+    first order), and ``J`` POL-OPs at evenly spread orientations give the angle to
+    ``sigma_a = sigma_x / (2 d sqrt(J / 2))`` (``d``: the unit's measured degree, at least ``min_degree``).
+    ``S`` is twice the unit's mean photodiode reading (:attr:`UnitEvectors.intensity`, counts). In daylight
+    ``sigma_a`` is far below a degree; in twilight, with a few counts per photodiode, it reaches tens of
+    degrees: the noise floor.
+
+    Parameters
+    ----------
+    ev : UnitEvectors
+    noise_counts : float
+        ``sigma_c``: dark noise and quantisation of one photodiode count (counts).
+    min_degree : float
+        Lower bound of the degree used (a noisy degree near 0 would make every angle worthless).
+
+    Returns
+    -------
+    ndarray, shape ``(N, K)``
+        Radians; ``inf`` where the unit reads no light.
+    """
+    s = 2.0 * np.nan_to_num(np.asarray(ev.intensity, float))
+    j = ev.x.shape[-1] if np.ndim(ev.x) == 3 else 1
+    d = np.maximum(np.nan_to_num(np.asarray(ev.degree, float)), float(min_degree))
+    with np.errstate(divide="ignore"):
+        sigma_x = np.where(s > 0, np.sqrt(2.0) * float(noise_counts) / np.where(s > 0, s, 1.0), np.inf)
+    return sigma_x / (2.0 * d * np.sqrt(max(j, 1) / 2.0))
 
 
 def brightness_azimuth(ev: UnitEvectors, valid, array: PolArray):
@@ -193,7 +230,8 @@ def _pick_pair(score, azimuths, total, margin):
 
 def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, sun_elevation: float | None = None,
                      residual: str = "perpendicular", weight_power: float = 1.0, robust_iterations: int = 2,
-                     robust_scale: float = np.deg2rad(10.0), margin: float = 0.01) -> SunEstimate:
+                     robust_scale: float = np.deg2rad(10.0), margin: float = 0.01, noise_counts: float = 0.0,
+                     min_units: int = 1) -> SunEstimate:
     """bionav's least-squares fit of the sky model's pattern (see the module docstring).
 
     Parameters
@@ -223,12 +261,27 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     margin : float
         Minimum difference of the normalised errors of the pair for a
         resolved choice; below it the brighter side decides.
+    noise_counts : float
+        Count noise per photodiode (counts; 0: none). Each unit's angle noise ``sigma_a``
+        (:func:`angle_noise`) lowers its weight to ``d^p s^2 / (s^2 + sigma_a^2)`` with the model-error
+        scale ``s = robust_scale`` (inverse-variance weighting of model error plus noise), and a unit
+        whose ``sigma_a`` exceeds ``s`` takes no part: at dusk, units read by light above the noise
+        floor count, dark ones not.
+    min_units : int
+        Fewest units taking part for a sample to be decoded (two e-vectors fix the sun); fewer: NaN,
+        ``SunEstimate.valid`` False (below the noise floor nothing is claimed).
 
     Returns
     -------
     SunEstimate
     """
     w0 = _weights(ev, valid, weight_power)
+    if noise_counts > 0:
+        sigma = angle_noise(ev, noise_counts)
+        readable = sigma <= robust_scale
+        w0 = np.where(readable, w0 * robust_scale**2 / (robust_scale**2 + np.where(readable, sigma, 0.0) ** 2), 0.0)
+    enough = np.sum(w0 > 0, axis=-1) >= max(int(min_units), 1)
+    w0 = np.where(enough[:, None], w0, 0.0)
     w = w0
     total = w0.sum(axis=-1)
     if residual == "perpendicular":

@@ -22,6 +22,11 @@ class SkyFitConfig:
     robust_iterations, robust_scale_deg : Cauchy re-weighting rounds and their residual scale.
     margin : normalised error gap for a resolved eq. 4.6 pair (else the brighter side decides).
     max_degree, neutral_point_separation_deg : the sky model of ``residual=angle`` (0: Rayleigh).
+    noise_counts : count noise of one photodiode (counts; 0: off). Units are weighted by their signal above
+        it (:func:`bionav.polcompass.decoders.angle_noise`), units whose angle noise exceeds
+        ``robust_scale_deg`` take no part. 0.5 is measured on the recorded sensor: quantisation (0.29) and
+        dark noise (0.0-0.5 counts rms per photodiode after sunset, docs/polcompass.md "Dusk").
+    min_units : fewest units taking part for a sample to be decoded; fewer: no heading (``valid`` false).
     """
 
     residual: str = bounded("perpendicular", choices=("perpendicular", "angle"))
@@ -32,6 +37,8 @@ class SkyFitConfig:
     margin: float = bounded(0.01, ge=0.0, le=1.0)
     max_degree: float = bounded(0.76, gt=0.0, le=1.0)
     neutral_point_separation_deg: float = bounded(0.0, ge=0.0, le=60.0)
+    noise_counts: float = bounded(0.5, ge=0.0, le=1e6)
+    min_units: int = bounded(2, ge=1, le=64)
 
 
 class SkyFit(Decoder):
@@ -68,6 +75,8 @@ class SkyFit(Decoder):
             robust_iterations=self.config.robust_iterations,
             robust_scale=np.deg2rad(self.config.robust_scale_deg),
             margin=self.config.margin,
+            noise_counts=self.config.noise_counts,
+            min_units=self.config.min_units,
         )
 
 

@@ -33,7 +33,14 @@ READING_SCHEMA = {
 
 @dataclass
 class PolCompassSerialConfig:
-    """Parameters of ``sensor=polcompass_serial``."""
+    """Parameters of ``sensor=polcompass_serial``.
+
+    calibration : ``none`` (``experiment.calibration`` decides: a rotation at the zenith, nominal values or
+        ``experiment.calibration_path``) or the path of a ``calibration.json`` written by an earlier rotation run
+        of this compass (per unit: centre volts, volts per decade, polarizer angle in radians; see
+        :class:`bionav.polcompass.UnitCalibration`). A file replaces ``experiment.calibration``, is recorded to
+        ``run.mcap`` (``/pol_compass/calibration``) and is applied again by ``sensor=replay``.
+    """
 
     port: str = "/dev/ttyUSB0"
     baudrate: int = bounded(115200, ge=50, le=4_000_000)
@@ -41,6 +48,7 @@ class PolCompassSerialConfig:
     lines: list[int] = bounded([1, 2, 3], length=(1, 8), item=Range(ge=1, le=8))
     reconnect_attempts: int = bounded(1, ge=0, le=1000)
     reconnect_delay_s: float = bounded(0.5, ge=0.0, le=3600.0)
+    calibration: str = "none"
 
 
 class PolCompassSerial(SerialDeviceMixin, SensorPlugin):
@@ -59,6 +67,19 @@ class PolCompassSerial(SerialDeviceMixin, SensorPlugin):
             raise UserError(f"sensor.lines={lines} must list DLP-IO8-G analog lines between 1 and 8, e.g. sensor.lines=[1,2,3].")
         self.lines = lines
         self._link = None
+        self.calibration = None
+        how = str(config.calibration or "none")
+        if how == "auto":
+            raise UserError("sensor.calibration=auto is not an option of the serial compass: a rotation calibrates it "
+                            "(experiment.calibration=auto or rotation); give sensor.calibration=<calibration.json> or none.")
+        if how != "none":
+            from bionav.polcompass.calibration import UnitCalibration
+
+            self.calibration = UnitCalibration.load(how, setting="sensor.calibration")
+            if len(self.calibration.unit_angles) != len(lines):
+                raise UserError(f"sensor.calibration={how} calibrates {len(self.calibration.unit_angles)} units, but "
+                                f"sensor.lines={lines} reads {len(lines)}; use the calibration.json of a rotation run "
+                                "with the same lines.")
 
     def _init_device(self) -> None:
         self._link.reset_input()

@@ -56,7 +56,7 @@ class RecordingConfig:
     photodiode_angles_deg: list[float] = bounded([-45.0, 45.0, 0.0, 90.0], length=(1, 16), item=Range(ge=-360.0, le=360.0))
     pairs: list[list[int]] = bounded([[2, 3], [1, 0]], length=(1, 8), item=Range(length=2, item=Range(ge=0, le=15)))
     saturation_counts: float = bounded(11000.0, gt=0.0, le=1e12)
-    dark_counts: float = bounded(5.0, ge=0.0, le=1e12)
+    dark_counts: float = bounded(1.0, ge=0.0, le=1e12)
     imbalance_decades: float = bounded(0.15, gt=0.0, le=3.0)
     calibration: str = "none"
 
