@@ -484,7 +484,7 @@ def limit_blas_threads() -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
-    from bionav.errors import guard_closed_pipe
+    from bionav.cli_main import guard_closed_pipe
 
     guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
     argv = list(sys.argv[1:] if argv is None else argv)

@@ -146,3 +146,56 @@ def test_one_definition_per_concept():
     twice = {k: v for k, v in seen.items() if len(v) > 1}
     assert twice == {}, twice
     assert "def sun_position" in seen and "def butterworth_lowpass" in seen  # the pattern does match
+
+
+def console_writes(path: Path) -> list[int]:
+    """Lines of ``print(...)`` calls and ``sys.stdout``/``sys.stderr`` uses in one file."""
+    lines = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "print":
+            lines.append(node.lineno)
+        elif (isinstance(node, ast.Attribute) and node.attr in {"stdout", "stderr"}
+              and isinstance(node.value, ast.Name) and node.value.id == "sys"):
+            lines.append(node.lineno)
+    return sorted(set(lines))
+
+
+def rooms_that_print(package_root: Path, table: dict[str, set[str]]) -> list[str]:
+    """Modules that write to the console although their room has no command line.
+
+    A room has a command line when the table lets it import ``cli_main`` (the
+    wrapper of every ``__main__``); ``cli_main`` itself is where the messages
+    are printed.
+    """
+    found = []
+    for path in sorted(package_root.rglob("*.py")):
+        room = room_of(module_name(path, package_root))
+        if room is None or room == "cli_main" or "cli_main" in table.get(room, set()):
+            continue
+        found += [f"{path}:{line}: room {room} writes to the console" for line in console_writes(path)]
+    return found
+
+
+def test_only_rooms_with_a_command_line_print():
+    """``errors`` and the other rooms without a ``__main__`` never print: the command line does."""
+    table = allowed_imports(DOC.read_text(encoding="utf-8"))
+    assert "cli_main" in table and table["cli_main"] == {"errors", "cli_main"}
+    assert "cli_main" not in table["errors"] and "cli_main" in table["logs"]
+    found = rooms_that_print(ROOT / "bionav", table)
+    assert found == [], "\n".join(found)
+
+
+def test_the_print_check_catches_a_print_in_a_low_room(tmp_path):
+    pkg = tmp_path / "bionav"
+    for rel, text in {
+        "__init__.py": "",
+        "errors.py": "import sys\n\ndef f():\n    print('x', file=sys.stderr)\n",
+        "geometry.py": "def f(x):\n    return x  # print(x) in a comment is fine\n",
+        "cli_main.py": "print('fine here')\n",
+        "logs/__main__.py": "print('fine here too')\n",
+    }.items():
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text(text)
+    table = {"errors": {"errors"}, "geometry": {"geometry"}, "cli_main": {"errors", "cli_main"},
+             "logs": {"errors", "cli_main", "logs"}}
+    assert rooms_that_print(pkg, table) == [f"{pkg / 'errors.py'}:4: room errors writes to the console"]
