@@ -60,11 +60,30 @@ def _per_scan(value, k, n, what):
     return float(v[k])
 
 
+def _scan_devices(cfg, ctx):
+    """The run's sensor and pan-tilt unit (direct pointing when none is configured), the ``pantilt`` node and
+    whether either device is simulated; a real sensor without a real pan-tilt unit is refused."""
+    from bionav.spectral.scan import DirectPanTilt
+
+    sensor_node = _get(cfg, "sensor")
+    if not sensor_node:
+        raise UserError("experiment=contrast_scan needs a sensor: sensor=spectral5_sim (simulation), "
+                        "sensor=spectral5_serial sensor.port=... (hardware) or sensor=replay sensor.path=run.mcap.")
+    sensor = ctx.plugin("sensor", sensor_node)
+    pantilt_node = _get(cfg, "pantilt")
+    pantilt = ctx.plugin("sensor", pantilt_node) if pantilt_node else DirectPanTilt()
+    simulated = bool(getattr(sensor, "simulated", False) or getattr(pantilt, "simulated", False))
+    if not pantilt_node and not simulated and not hasattr(sensor, "recorded"):
+        raise UserError("A real sensor needs a real pan-tilt unit for experiment=contrast_scan: add pantilt=ptu46 "
+                        "pantilt.port=/dev/ttyUSB1 (or use sensor=spectral5_sim for a simulated scan).")
+    return sensor, pantilt, pantilt_node, simulated
+
+
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
-    from bionav.spectral.scan import DirectPanTilt, ScanGrid, run_scan
+    from bionav.spectral.scan import ScanGrid, run_scan
     from bionav.spectral.scene import backyard_scene
 
     exp = experiment_config(cfg, "contrast_scan")
@@ -78,17 +97,7 @@ def run(cfg, ctx) -> dict:
         tilt_start=np.deg2rad(float(exp.tilt_start_deg)),
         pan_centre=np.deg2rad(float(exp.pan_centre_deg)),
     )
-    sensor_node = _get(cfg, "sensor")
-    if not sensor_node:
-        raise UserError("experiment=contrast_scan needs a sensor: sensor=spectral5_sim (simulation), "
-                        "sensor=spectral5_serial sensor.port=... (hardware) or sensor=replay sensor.path=run.mcap.")
-    sensor = ctx.plugin("sensor", sensor_node)
-    pantilt_node = _get(cfg, "pantilt")
-    pantilt = ctx.plugin("sensor", pantilt_node) if pantilt_node else DirectPanTilt()
-    simulated = bool(getattr(sensor, "simulated", False) or getattr(pantilt, "simulated", False))
-    if not pantilt_node and not simulated and not hasattr(sensor, "recorded"):
-        raise UserError("A real sensor needs a real pan-tilt unit for experiment=contrast_scan: add pantilt=ptu46 "
-                        "pantilt.port=/dev/ttyUSB1 (or use sensor=spectral5_sim for a simulated scan).")
+    sensor, pantilt, pantilt_node, simulated = _scan_devices(cfg, ctx)
 
     covers = exp.cloud_cover
     depths = exp.cloud_optical_depth
