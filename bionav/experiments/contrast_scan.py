@@ -32,6 +32,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.experiments.common import _get, load_samples
 from bionav.experiments.configs import experiment_config
+from bionav.files import write_csv_atomic
 from bionav.light.sun import parse_time
 
 SCAN_TOPIC = "/contrast_scan/scan"
@@ -161,7 +162,6 @@ def run(cfg, ctx) -> dict:
 
 def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     """Contrast images, separation, stability series, plots and metrics of a set of scans."""
-    import csv
 
     from bionav.light.bands import CHANNELS, dual_contrasts
     from bionav.spectral.lda_analysis import learn_discriminants
@@ -177,11 +177,9 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     # every scan's separation images, once: for the stability after separation, the plots and the accuracy
     seps = [separation_images(s[..., :5], {n: disc[n] for n in names}, threshold=str(exp.separation)) for s in scans]
     rows = stability_series(scans[..., :5], seps, names=names)
-    with open(ctx.dir / "stability.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=["scan", "time", "feature", "separated", *MEASURES])
-        w.writeheader()
-        for r in rows:
-            w.writerow({**r, "time": times[r["scan"]].isoformat()})
+    header = ["scan", "time", "feature", "separated", *MEASURES]
+    write_csv_atomic(ctx.dir / "stability.csv", header,
+                     ([{**r, "time": times[r["scan"]].isoformat()}.get(c, "") for c in header] for r in rows))
     hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
     if bool(exp.plots):
         _plots(scans, times, hours, rows, disc, seps, ctx.plots, str(exp.separation))

@@ -9,7 +9,6 @@ joins the tasks into the unsplit run's files (``python -m bionav.experiments.mer
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -24,6 +23,7 @@ from bionav.experiments.common import load_configured_database, make_homing, pre
 from bionav.experiments.configs import experiment_config
 from bionav.experiments.runner import LOG_FILE
 from bionav.experiments.tasks import block_of, check_blocks, finish_merge, merge_target, read_task
+from bionav.files import write_csv_atomic
 from bionav.logs.reader import read_attachment, read_messages
 from bionav.logs.writer import McapLog
 
@@ -71,11 +71,10 @@ def _finite_or_none(values) -> list[float | None]:
 
 
 def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["x", "y", "aae_s", "mae_s", "rr_s"])
-        for (x, y), a, m, r in zip(positions, measures.aae_s, measures.mae_s, measures.rr_s):
-            w.writerow([int(x), int(y), f"{a:.6f}", f"{m:.6f}", f"{r:.6f}"])
+    """``per_snapshot.csv``: AAE_s and MAE_s (radians) and RR_s of every snapshot cell ``(x, y)``."""
+    write_csv_atomic(path, ["x", "y", "aae_s", "mae_s", "rr_s"],
+                     ([int(x), int(y), f"{a:.6f}", f"{m:.6f}", f"{r:.6f}"]
+                      for (x, y), a, m, r in zip(positions, measures.aae_s, measures.mae_s, measures.rr_s)))
 
 
 def _row_loggers(ctx, db):

@@ -19,13 +19,12 @@ representation.
 
 from __future__ import annotations
 
-import csv
-
 import numpy as np
 
 from bionav.errors import UserError
 from bionav.experiments.common import _get, load_samples
 from bionav.experiments.configs import experiment_config
+from bionav.files import write_csv_atomic
 from bionav.light.sun import parse_time
 from bionav.report.figures import pyplot, save_figure
 
@@ -322,11 +321,9 @@ def _summary_metrics(cfg, reps, n, n_positions, n_snapshots, results, ms, square
 
 
 def _write_csv(path, rows, fields):
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=fields)
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (f"{v:.6f}" if isinstance(v, float) else v) for k, v in r.items()})
+    """One row per dict of ``rows`` (floats with 6 decimals) under the header ``fields``."""
+    write_csv_atomic(path, fields, ([(f"{v:.6f}" if isinstance(v, float) else v) for v in
+                                     (r.get(c, "") for c in fields)] for r in rows))
 
 
 def _plots(plots, counts, disc, reps, names, metrics, results, geometry, border):
