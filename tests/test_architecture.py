@@ -148,6 +148,15 @@ def test_one_definition_per_concept():
     assert "def sun_position" in seen and "def butterworth_lowpass" in seen  # the pattern does match
 
 
+def _package(tmp_path: Path, files: dict[str, str]) -> Path:
+    """A throw-away ``bionav`` package under ``tmp_path`` with these files (path relative to it -> text)."""
+    pkg = tmp_path / "bionav"
+    for rel, text in files.items():
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text(text)
+    return pkg
+
+
 def console_writes(path: Path) -> list[int]:
     """Lines of ``print(...)`` calls and ``sys.stdout``/``sys.stderr`` uses in one file."""
     lines = []
@@ -186,16 +195,13 @@ def test_only_rooms_with_a_command_line_print():
 
 
 def test_the_print_check_catches_a_print_in_a_low_room(tmp_path):
-    pkg = tmp_path / "bionav"
-    for rel, text in {
+    pkg = _package(tmp_path, {
         "__init__.py": "",
         "errors.py": "import sys\n\ndef f():\n    print('x', file=sys.stderr)\n",
         "geometry.py": "def f(x):\n    return x  # print(x) in a comment is fine\n",
         "cli_main.py": "print('fine here')\n",
         "logs/__main__.py": "print('fine here too')\n",
-    }.items():
-        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
-        (pkg / rel).write_text(text)
+    })
     table = {"errors": {"errors"}, "geometry": {"geometry"}, "cli_main": {"errors", "cli_main"},
              "logs": {"errors", "cli_main", "logs"}}
     assert rooms_that_print(pkg, table) == [f"{pkg / 'errors.py'}:4: room errors writes to the console"]
@@ -262,17 +268,14 @@ def test_the_concept_check_catches_a_second_definition(tmp_path):
            "| sun position | `sun_position`, `SunPosition` | `light/sun.py` | |\n"
            "| materials | `Material` | `light/materials.py`, `world/scene.py` | |\n"
            "| clouds | `CloudLayer` | `light/clouds.py` | |\n")
-    pkg = tmp_path / "bionav"
-    for rel, text in {
+    pkg = _package(tmp_path, {
         "light/sun.py": "class SunPosition:\n    pass\n\n\ndef sun_position(when):\n    return when\n",
         "world/scene.py": "class Material:\n    pass\n",
         "light/materials.py": "class Material:\n    pass\n",
         "spectral/sky.py": "def sun_position(when):  # a second copy\n    return when\n\n\n"
                            "def helper():\n    def CloudLayer():  # nested: not a module-level definition\n"
                            "        pass\n",
-    }.items():
-        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
-        (pkg / rel).write_text(text)
+    })
     rows = concept_table(doc)
     assert [r[0] for r in rows] == ["sun position", "materials", "clouds"]
     found = concept_violations(rows, module_definitions(pkg))
