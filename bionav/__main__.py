@@ -3,6 +3,6 @@
 from bionav.cli import main
 
 if __name__ == "__main__":
-    from bionav.errors import run_main
+    from bionav.cli_main import run_main
 
     run_main(main, "bionav")

@@ -482,20 +482,13 @@ def limit_blas_threads() -> None:
         os.environ.setdefault(var, "1")
 
 
-def main(argv: list[str] | None = None) -> None:
-    """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
-    from bionav.errors import guard_closed_pipe
-
-    guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
-    argv = list(sys.argv[1:] if argv is None else argv)
-    # `python -m bionav homing=sift -m ...`: Hydra's parser takes overrides only after its flags
-    argv = [a for a in argv if a in ("-m", "--multirun")] + [a for a in argv if a not in ("-m", "--multirun")]
-    limit_blas_threads()
+def _answered_without_hydra(argv: list[str]) -> bool:
+    """Answer ``--shell-completion install=bash`` and quick TAB completions without Hydra; True if answered."""
     from bionav.completion import BASH_SCRIPT, rewrite_query_line, wants_bash_install
 
     if wants_bash_install(argv):  # Hydra's script does not know `python -m bionav`
         print(BASH_SCRIPT, end="")
-        return
+        return True
     rewrite_query_line()
     if any(a in ("-sc", "--shell-completion") for a in argv) and "query=bash" in argv:
         from bionav.completion import quick_choices
@@ -503,40 +496,81 @@ def main(argv: list[str] | None = None) -> None:
         choices = quick_choices()
         if choices is not None:
             print(" ".join(choices))
-            return
+            return True
+    return False
+
+
+def _check_before_running(argv: list[str]) -> bool | None:
+    """Every check that can refuse the command line before Hydra runs (raises :class:`UserError`).
+
+    Prints bionav's own ``--help`` and returns None; otherwise returns whether
+    this is a shell-completion query. Output directories are checked only after
+    every value passed, so that a refused run leaves no directory behind.
+    """
+    from bionav.config import register_configs
+
+    names = register_configs()
+    from bionav.clihelp import help_text, wants_help
+
+    if wants_help(argv) and "--hydra-help" not in argv:  # Hydra's own help copies its repository per group
+        try:
+            print(help_text(argv), end="")
+        except UserError:
+            raise
+        except Exception as exc:  # a bad override: Hydra's composition message
+            raise UserError(composition_message(exc, [a for a in argv if not a.startswith("-")])) from None
+        return None
+    output_dirs: list[tuple[Path, bool]] = []
+    completion = any(a in ("-sc", "--shell-completion") for a in argv)  # `query=...` is not an override
+    if not completion and not any(
+        a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
+    ):
+        output_dirs = _precheck(argv, names)
+    if not completion and not any(a in ("--help", "-h", "--hydra-help", "-cp", "-cn", "-cd", "--config-path",
+                                        "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
+        _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
+    # only after every value passed: a refused run leaves no directory behind
+    if any(a in ("-m", "--multirun") for a in argv):
+        _check_sweep_overrides(argv)
+    resume = _resuming(argv)
+    for path, sweep in output_dirs:
+        _check_name_lengths(path, "hydra.sweep.dir" if sweep else "hydra.run.dir")
+        _check_writable(path, sweep=sweep)  # a live writer first: "in use" says more than "finished"
+        _check_not_finished(path, sweep=sweep, resume=resume)
+    return completion
+
+
+def _end_on_termination_signals() -> None:
+    """SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does.
+
+    A signal the caller chose to ignore stays ignored (``nohup python -m bionav ...`` survives the hangup).
+    """
+    for name in ("SIGTERM", "SIGHUP"):
+        try:
+            sig = getattr(signal, name)
+            if signal.getsignal(sig) != signal.SIG_IGN:
+                signal.signal(sig, _terminate)
+        except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
+            pass
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
+    from bionav.cli_main import guard_closed_pipe
+
+    guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # `python -m bionav homing=sift -m ...`: Hydra's parser takes overrides only after its flags
+    argv = [a for a in argv if a in ("-m", "--multirun")] + [a for a in argv if a not in ("-m", "--multirun")]
+    limit_blas_threads()
+    if _answered_without_hydra(argv):
+        return
     try:
-        from bionav.config import register_configs
-
-        names = register_configs()
-        from bionav.clihelp import help_text, wants_help
-
-        if wants_help(argv) and "--hydra-help" not in argv:  # Hydra's own help copies its repository per group
-            try:
-                print(help_text(argv), end="")
-            except UserError:
-                raise
-            except Exception as exc:  # a bad override: Hydra's composition message
-                raise UserError(composition_message(exc, [a for a in argv if not a.startswith("-")])) from None
-            return
-        output_dirs: list[tuple[Path, bool]] = []
-        completion = any(a in ("-sc", "--shell-completion") for a in argv)  # `query=...` is not an override
-        if not completion and not any(
-            a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
-        ):
-            output_dirs = _precheck(argv, names)
-        if not completion and not any(a in ("--help", "-h", "--hydra-help", "-cp", "-cn", "-cd", "--config-path",
-                                            "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
-            _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
-        # only after every value passed: a refused run leaves no directory behind
-        if any(a in ("-m", "--multirun") for a in argv):
-            _check_sweep_overrides(argv)
-        resume = _resuming(argv)
-        for path, sweep in output_dirs:
-            _check_name_lengths(path, "hydra.sweep.dir" if sweep else "hydra.run.dir")
-            _check_writable(path, sweep=sweep)  # a live writer first: "in use" says more than "finished"
-            _check_not_finished(path, sweep=sweep, resume=resume)
+        completion = _check_before_running(argv)
     except UserError as exc:
         _fail(str(exc))
+    if completion is None:  # bionav's --help was printed
+        return
 
     argv = _expand_output_dirs(argv)
     multirun = any(a in ("-m", "--multirun") for a in argv)
@@ -549,15 +583,7 @@ def main(argv: list[str] | None = None) -> None:
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    # SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does;
-    # a signal the caller chose to ignore stays ignored (`nohup python -m bionav ...` survives the hangup)
-    for name in ("SIGTERM", "SIGHUP"):
-        try:
-            sig = getattr(signal, name)
-            if signal.getsignal(sig) != signal.SIG_IGN:
-                signal.signal(sig, _terminate)
-        except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
-            pass
+    _end_on_termination_signals()
     try:
         if completion and any(a.startswith("query=") for a in argv):
             _completion_query(hydra_main)

@@ -6,7 +6,8 @@
   see a half-written file, and a crash leaves the old file intact. The new
   file's mode follows the process umask, like a plain ``open(path, "w")``.
 * :func:`write_json_atomic` is the same for JSON (NumPy scalars and arrays
-  become plain numbers and lists).
+  become plain numbers and lists), :func:`write_csv_atomic` for CSV tables
+  (the one CSV writer).
 * :func:`default_cache_dir` is ``$BIONAV_CACHE`` or ``~/.cache/bionav``, the
   home of rendered stand-in databases and cached per-image work.
 * :func:`cache_key` is the SHA-256 of a JSON payload and of array bytes, so
@@ -19,17 +20,19 @@
 
 from __future__ import annotations
 
+import csv
 import hashlib
+import io
 import json
 import os
 import secrets
 from pathlib import Path
-from typing import IO, Any, Callable
+from typing import IO, Any, Callable, Iterable, Sequence
 
 import numpy as np
 
 __all__ = ["cache_key", "check_cache_dir", "default_cache_dir", "not_a_regular_file", "read_json_file", "user_path",
-           "write_atomic", "write_json_atomic"]
+           "write_atomic", "write_csv_atomic", "write_json_atomic"]
 
 
 def default_cache_dir() -> Path:
@@ -262,3 +265,24 @@ def write_json_atomic(path: str | Path, data: Any, *, indent: int | None = 2) ->
     NumPy scalars and arrays are written as numbers and lists, paths as strings.
     """
     return write_atomic(path, json.dumps(data, indent=indent, default=_json_scalar) + "\n")
+
+
+def write_csv_atomic(path: str | Path, header: Sequence[Any], rows: Iterable[Sequence[Any]]) -> Path:
+    """Write a CSV table (the header row, then ``rows``) with :func:`write_atomic`: the one CSV writer.
+
+    The :mod:`csv` module's default dialect (``excel``): fields separated by
+    commas, quoted only when they hold a comma, a quote or a line break, every
+    line ending in ``\\r\\n``; UTF-8. A value is written as ``str(value)``
+    (format floats before), ``None`` as an empty field. Rows of a mapping:
+    ``([row.get(c, "") for c in header] for row in rows)``.
+
+    Returns
+    -------
+    Path
+        The target path.
+    """
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(header)
+    writer.writerows(rows)
+    return write_atomic(path, text.getvalue())

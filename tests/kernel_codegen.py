@@ -61,8 +61,8 @@ def _examples():
     from bionav.homing import sift_kernels
     from bionav.homing.warping import distance, kernels
     from bionav.robot import coverage
+    from bionav.world import intersect, mesh_kernels
     from bionav.world import kernels as world
-    from bionav.world import mesh_kernels
 
     warping1d = importlib.import_module("bionav.homing.warping.warping1d")  # the package exports a function of that name
 
@@ -116,7 +116,7 @@ def _examples():
                                z(1, dtype=i64), z(1), z(1), 1.0, 0.0, True, z(4, 4), z(4, 4, dtype=i64)))
     ex["mesh_fill_grid"] = (mesh_kernels._fill_grid,
                             (z(2, 3, 3), 0.0, 0.0, 1.0, 1, 1, False, z(2, dtype=i64), z(1, dtype=i64), z(1), z(1)))
-    ex["world_candidates"] = (world._candidates,
+    ex["world_candidates"] = (intersect._candidates,
                               (0.0, 0.0, 0.0, z(4), 0.0, z(1, dtype=i64), z(1, dtype=i64), z(1, 9), z(1, 6),
                                z(1, 6)))
     ex["world_depth_kernel"] = (world.depth_kernel,

@@ -146,3 +146,139 @@ def test_one_definition_per_concept():
     twice = {k: v for k, v in seen.items() if len(v) > 1}
     assert twice == {}, twice
     assert "def sun_position" in seen and "def butterworth_lowpass" in seen  # the pattern does match
+
+
+def _package(tmp_path: Path, files: dict[str, str]) -> Path:
+    """A throw-away ``bionav`` package under ``tmp_path`` with these files (path relative to it -> text)."""
+    pkg = tmp_path / "bionav"
+    for rel, text in files.items():
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text(text)
+    return pkg
+
+
+def console_writes(path: Path) -> list[int]:
+    """Lines of ``print(...)`` calls and ``sys.stdout``/``sys.stderr`` uses in one file."""
+    lines = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "print":
+            lines.append(node.lineno)
+        elif (isinstance(node, ast.Attribute) and node.attr in {"stdout", "stderr"}
+              and isinstance(node.value, ast.Name) and node.value.id == "sys"):
+            lines.append(node.lineno)
+    return sorted(set(lines))
+
+
+def rooms_that_print(package_root: Path, table: dict[str, set[str]]) -> list[str]:
+    """Modules that write to the console although their room has no command line.
+
+    A room has a command line when the table lets it import ``cli_main`` (the
+    wrapper of every ``__main__``); ``cli_main`` itself is where the messages
+    are printed.
+    """
+    found = []
+    for path in sorted(package_root.rglob("*.py")):
+        room = room_of(module_name(path, package_root))
+        if room is None or room == "cli_main" or "cli_main" in table.get(room, set()):
+            continue
+        found += [f"{path}:{line}: room {room} writes to the console" for line in console_writes(path)]
+    return found
+
+
+def test_only_rooms_with_a_command_line_print():
+    """``errors`` and the other rooms without a ``__main__`` never print: the command line does."""
+    table = allowed_imports(DOC.read_text(encoding="utf-8"))
+    assert "cli_main" in table and table["cli_main"] == {"errors", "cli_main"}
+    assert "cli_main" not in table["errors"] and "cli_main" in table["logs"]
+    found = rooms_that_print(ROOT / "bionav", table)
+    assert found == [], "\n".join(found)
+
+
+def test_the_print_check_catches_a_print_in_a_low_room(tmp_path):
+    pkg = _package(tmp_path, {
+        "__init__.py": "",
+        "errors.py": "import sys\n\ndef f():\n    print('x', file=sys.stderr)\n",
+        "geometry.py": "def f(x):\n    return x  # print(x) in a comment is fine\n",
+        "cli_main.py": "print('fine here')\n",
+        "logs/__main__.py": "print('fine here too')\n",
+    })
+    table = {"errors": {"errors"}, "geometry": {"geometry"}, "cli_main": {"errors", "cli_main"},
+             "logs": {"errors", "cli_main", "logs"}}
+    assert rooms_that_print(pkg, table) == [f"{pkg / 'errors.py'}:4: room errors writes to the console"]
+
+
+def concept_table(doc: str) -> list[tuple[str, list[str], list[str], str]]:
+    """``(concept, names, home modules, notes)`` per row of the "concept | names | home | notes" table."""
+    rows, inside = [], False
+    for line in doc.splitlines():
+        if not line.startswith("|"):
+            inside = False
+            continue
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if cells[:4] == ["concept", "names", "home", "notes"]:
+            inside = True
+            continue
+        if not inside or set(line) <= set("|- "):
+            continue
+        rows.append((cells[0], re.findall(r"`([^`]+)`", cells[1]), re.findall(r"`([^`]+)`", cells[2]), cells[3]))
+    return rows
+
+
+def module_definitions(package_root: Path) -> dict[str, list[str]]:
+    """Name -> the modules (paths relative to the package) that define it at module level (def or class)."""
+    found: dict[str, list[str]] = {}
+    for path in sorted(package_root.rglob("*.py")):
+        rel = path.relative_to(package_root).as_posix()
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                found.setdefault(node.name, []).append(rel)
+    return found
+
+
+def concept_violations(rows, definitions: dict[str, list[str]]) -> list[str]:
+    """Names defined outside their row's homes, names their homes do not define, second homes without a note."""
+    problems = []
+    for concept, names, homes, notes in rows:
+        if len(homes) > 1 and not notes:
+            problems.append(f"{concept}: {len(homes)} homes ({', '.join(homes)}) and no note saying why")
+        for name in names:
+            where = definitions.get(name, [])
+            if not set(where) & set(homes):
+                problems.append(f"{concept}: {name} is not defined in {', '.join(homes) or 'any home'}"
+                                f"{' (defined in ' + ', '.join(where) + ')' if where else ''}")
+            for module in where:
+                if module not in homes:
+                    problems.append(f"{concept}: {name} is defined a second time, in {module} "
+                                    f"(its home: {', '.join(homes)})")
+    return problems
+
+
+def test_every_concept_has_its_homes_and_no_other():
+    rows = concept_table(DOC.read_text(encoding="utf-8"))
+    names = [n for _, ns, _, _ in rows for n in ns]
+    assert len(rows) >= 30 and {"sun_position", "sift_features", "evectors_from_counts", "RunLock", "read_json_file",
+                                "bounded", "CloudLayer", "CaptureLight", "Material", "run_main"} <= set(names)
+    assert len(names) == len(set(names)), "a name listed in two rows"
+    found = concept_violations(rows, module_definitions(ROOT / "bionav"))
+    assert found == [], "\n".join(found)
+
+
+def test_the_concept_check_catches_a_second_definition(tmp_path):
+    doc = ("| concept | names | home | notes |\n|---|---|---|---|\n"
+           "| sun position | `sun_position`, `SunPosition` | `light/sun.py` | |\n"
+           "| materials | `Material` | `light/materials.py`, `world/scene.py` | |\n"
+           "| clouds | `CloudLayer` | `light/clouds.py` | |\n")
+    pkg = _package(tmp_path, {
+        "light/sun.py": "class SunPosition:\n    pass\n\n\ndef sun_position(when):\n    return when\n",
+        "world/scene.py": "class Material:\n    pass\n",
+        "light/materials.py": "class Material:\n    pass\n",
+        "spectral/sky.py": "def sun_position(when):  # a second copy\n    return when\n\n\n"
+                           "def helper():\n    def CloudLayer():  # nested: not a module-level definition\n"
+                           "        pass\n",
+    })
+    rows = concept_table(doc)
+    assert [r[0] for r in rows] == ["sun position", "materials", "clouds"]
+    found = concept_violations(rows, module_definitions(pkg))
+    assert found == ["sun position: sun_position is defined a second time, in spectral/sky.py (its home: light/sun.py)",
+                     "materials: 2 homes (light/materials.py, world/scene.py) and no note saying why",
+                     "clouds: CloudLayer is not defined in light/clouds.py"]

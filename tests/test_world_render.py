@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from bionav.geometry import TWO_PI, PanoramaGeometry
-from bionav.world.kernels import trace_depth_reference
+from bionav.world.intersect import trace_depth_reference
 from bionav.world.lights import Ambient, DirectionalLight, PointLight
 from bionav.world.render import ray_grid, render_depth, render_panorama
 from bionav.world.scene import Scene
@@ -178,7 +178,8 @@ def test_result_does_not_depend_on_the_number_of_threads():
 
 @pytest.mark.slow
 def test_binned_shadow_rays_equal_brute_force():
-    from bionav.world import kernels as K
+    from bionav.world.intersect import INF
+    from bionav.world.shadow_bins import _occluded
 
     rng = np.random.default_rng(11)
     s = _random_scene(rng)
@@ -198,8 +199,8 @@ def test_binned_shadow_rays_equal_brute_force():
                 tmax = np.linalg.norm(v) - 1e-3
                 d = v / np.linalg.norm(v)
             else:
-                d, tmax = lp[1:4], K.INF
-            binned = K._occluded(k, *p, *d, tmax, cs.light_params, cs.shadow_grids, cs.shadow_starts,
+                d, tmax = lp[1:4], INF
+            binned = _occluded(k, *p, *d, tmax, cs.light_params, cs.shadow_grids, cs.shadow_starts,
                                  cs.shadow_items, cs.prim_kind, cs.prim_idx, cs.spheres, cs.boxes, cs.frusta,
                                  cs.ellipsoids)
             brute = trace_depth_reference(p, d[None], *casters_only)[0] < tmax

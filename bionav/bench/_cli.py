@@ -15,7 +15,7 @@ import argparse
 import sys
 from typing import Callable, NoReturn
 
-from bionav.errors import run_main
+from bionav.cli_main import run_main
 
 
 class BenchParser(argparse.ArgumentParser):
@@ -38,6 +38,6 @@ def bounded_int(parser: argparse.ArgumentParser, name: str, value: int, lo: int,
 
 
 def run(main: Callable[[], "int | None"], prog: str) -> NoReturn:
-    """Run ``main()`` and exit with its status: :func:`bionav.errors.run_main` (closed pipe: quiet 141;
+    """Run ``main()`` and exit with its status: :func:`bionav.cli_main.run_main` (closed pipe: quiet 141;
     :class:`UserError`: message, 2; Ctrl-C: message, 130)."""
     run_main(main, prog, interrupted="interrupted; nothing more was measured.")

@@ -55,6 +55,26 @@ def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None
         db.horizon_row=... db.rad_per_row=...``.
     """
     out_dir = Path(out_dir)
+    _prepare_folder(out_dir, overwrite=overwrite)
+    if np.any(np.asarray(db.headings) != 0):
+        log.warning("database %s has rotated views; the export writes them as they are and "
+                    "reads back with heading 0", db.name)
+    if bits is None:
+        bits = 8 if exact_in_8bit(db.images) else 16
+    disk = from_canonical(db.images, azimuth="clockwise", x_axis_column=0.0)
+    try:
+        for (x, y), image in zip(db.positions, disk):
+            write_image(out_dir / f"{int(x)}_{int(y)}.png", image, bits=bits)
+    except OSError as exc:
+        raise UserError(f"cannot write the exported images to {out_dir}: {exc}; check the folder's "
+                        "permissions and free space.") from None
+    overrides = _reload_overrides(db, out_dir)
+    _write_sidecar(db, out_dir, overrides, bits=bits)
+    return overrides
+
+
+def _prepare_folder(out_dir: Path, *, overwrite: bool) -> None:
+    """Create ``out_dir``; refuse one that holds ``<x>_<y>.*`` images unless ``overwrite`` (then delete them)."""
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -68,20 +88,12 @@ def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None
         )
     for name in existing:
         (out_dir / name).unlink()
-    if np.any(np.asarray(db.headings) != 0):
-        log.warning("database %s has rotated views; the export writes them as they are and "
-                    "reads back with heading 0", db.name)
-    if bits is None:
-        bits = 8 if exact_in_8bit(db.images) else 16
-    disk = from_canonical(db.images, azimuth="clockwise", x_axis_column=0.0)
-    try:
-        for (x, y), image in zip(db.positions, disk):
-            write_image(out_dir / f"{int(x)}_{int(y)}.png", image, bits=bits)
-    except OSError as exc:
-        raise UserError(f"cannot write the exported images to {out_dir}: {exc}; check the folder's "
-                        "permissions and free space.") from None
+
+
+def _reload_overrides(db: ImageDatabase, out_dir: Path) -> list[str]:
+    """The command-line overrides that load the export in ``out_dir`` back as ``db``."""
     g = db.geometry
-    overrides = [
+    return [
         "db=folder",
         f"db.path={out_dir.resolve()}",
         "db.naming=vardy",
@@ -90,6 +102,11 @@ def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None
         f"db.horizon_row={float(g.horizon_row)!r}",
         f"db.rad_per_row={float(g.rad_per_row)!r}",
     ]
+
+
+def _write_sidecar(db: ImageDatabase, out_dir: Path, overrides: list[str], *, bits: int) -> None:
+    """``bionav-export.yaml``: what the folder loader cannot infer from the files, and how to load them."""
+    g = db.geometry
     sidecar = [
         f"# {len(db)} images of database {db.name!r} exported by python -m bionav.db export",
         "# Vardy naming <x>_<y>.png, Bielefeld convention (azimuth clockwise, column 0 along +x).",
@@ -104,4 +121,3 @@ def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None
         f"rad_per_row: {float(g.rad_per_row)!r}",
     ]
     (out_dir / SIDECAR).write_text("\n".join(sidecar) + "\n")
-    return overrides

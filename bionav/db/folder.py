@@ -113,6 +113,41 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
         log.warning("skipping %s: it %s", entry.path, problem)
         skipped.append(entry.path.name)
 
+    _check_one_file_per_cell(cfg, folder, entries)
+    frames, kept = _read_frames(_inside_grid(entries, nx, ny, bad), bad)
+    if not frames:
+        raise UserError(
+            f"cannot load database {cfg.name!r}: none of the {len(entries)} image file(s) in {folder} "
+            f"could be used (skipped: {', '.join(skipped[:5])}); fix the files or db.grid_shape."
+        )
+
+    unfold = cfg.unfold
+    raw = None
+    if unfold is not None and unfold.enabled:
+        frames = _unfold_all(frames, unfold, kept[0].path)
+        raw = RawFrames(e.path for e in kept)
+    disk = np.stack(frames).astype(np.float32, copy=False)
+    height, width = disk.shape[1:]
+    images = to_canonical(disk, azimuth=cfg.azimuth, x_axis_column=cfg.x_axis_column)
+    geometry = _folder_geometry(cfg, scan, width, height)
+    if scan.meta.get("w") not in (None, width) and not (unfold is not None and unfold.enabled):
+        log.warning("%s: the .db file says w=%s but the images are %d pixels wide",
+                    folder, scan.meta.get("w"), width)
+    meta = _folder_meta(cfg, folder, scan, kept, skipped, nx, ny, geometry, raw)
+    return ImageDatabase(
+        name=cfg.name,
+        images=images,
+        positions=np.array([(e.x, e.y) for e in kept], dtype=np.int64).reshape(-1, 2),
+        grid_shape=(nx, ny),
+        geometry=geometry,
+        spacing_m=float(cfg.spacing_m),
+        raw=raw,
+        meta=meta,
+    )
+
+
+def _check_one_file_per_cell(cfg: DatabaseConfig, folder: Path, entries: list[Entry]) -> None:
+    """Refuse two files for one grid cell (naming both)."""
     seen: dict[tuple[int, int], Entry] = {}
     for entry in entries:
         cell = (entry.x, entry.y)
@@ -122,6 +157,10 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
                 f"{seen[cell].path.name} and {entry.path.name} in {folder}; remove or rename one of them."
             )
         seen[cell] = entry
+
+
+def _inside_grid(entries: list[Entry], nx: int, ny: int, bad) -> list[Entry]:
+    """The entries inside the ``nx`` x ``ny`` grid; ``bad(entry, problem, fix)`` for the others."""
     inside = []
     for entry in entries:
         if 0 <= entry.x < nx and 0 <= entry.y < ny:
@@ -130,10 +169,17 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
             bad(entry, f"is at grid cell ({entry.x}, {entry.y}), outside the declared {nx} x {ny} grid",
                 "fix db.grid_shape=[nx,ny] (or set it to null to use the bounding box of the files) "
                 "or remove the file")
+    return inside
 
-    unfold = cfg.unfold
+
+def _read_frames(entries: list[Entry], bad) -> tuple[list[np.ndarray], list[Entry]]:
+    """The images of ``entries`` that are readable files of the most common size, and their entries.
+
+    ``bad(entry, problem, fix)`` is called for each file that is not a regular file, not a readable image,
+    or of another size than most.
+    """
     frames, kept = [], []
-    for entry in inside:
+    for entry in entries:
         not_file = not_a_file_reason(entry.path)
         if not_file:
             bad(entry, not_file, "replace it by the image file or remove it")
@@ -143,45 +189,38 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
             kept.append(entry)
         except ImageReadError as exc:
             bad(entry, f"is not a readable image ({exc})", "replace or remove the file")
-
-    if frames:
-        sizes = Counter(f.shape for f in frames)
-        common = sizes.most_common(1)[0][0]
-        example = next(e for e, f in zip(kept, frames) if f.shape == common)
-        ok_frames, ok_entries = [], []
-        for entry, frame in zip(kept, frames):
-            if frame.shape == common:
-                ok_frames.append(frame)
-                ok_entries.append(entry)
-            else:
-                bad(entry, f"is {frame.shape[1]} x {frame.shape[0]} pixels while the other images "
-                    f"(e.g. {example.path.name}) are {common[1]} x {common[0]}",
-                    "a database needs one image size: resize or remove the odd file")
-        frames, kept = ok_frames, ok_entries
     if not frames:
-        raise UserError(
-            f"cannot load database {cfg.name!r}: none of the {len(entries)} image file(s) in {folder} "
-            f"could be used (skipped: {', '.join(skipped[:5])}); fix the files or db.grid_shape."
-        )
+        return frames, kept
+    sizes = Counter(f.shape for f in frames)
+    common = sizes.most_common(1)[0][0]
+    example = next(e for e, f in zip(kept, frames) if f.shape == common)
+    ok_frames, ok_entries = [], []
+    for entry, frame in zip(kept, frames):
+        if frame.shape == common:
+            ok_frames.append(frame)
+            ok_entries.append(entry)
+        else:
+            bad(entry, f"is {frame.shape[1]} x {frame.shape[0]} pixels while the other images "
+                f"(e.g. {example.path.name}) are {common[1]} x {common[0]}",
+                "a database needs one image size: resize or remove the odd file")
+    return ok_frames, ok_entries
 
-    raw = None
-    if unfold is not None and unfold.enabled:
-        frames = _unfold_all(frames, unfold, kept[0].path)
-        raw = RawFrames(e.path for e in kept)
-    disk = np.stack(frames).astype(np.float32, copy=False)
-    height, width = disk.shape[1:]
-    images = to_canonical(disk, azimuth=cfg.azimuth, x_axis_column=cfg.x_axis_column)
 
+def _folder_geometry(cfg: DatabaseConfig, scan, width: int, height: int) -> PanoramaGeometry:
+    """Horizon row and vertical angle per row from the config, else the scheme's files, else the defaults
+    (the middle row; square pixels, ``2 pi / width`` radians per row)."""
     horizon_row = cfg.horizon_row if cfg.horizon_row is not None else scan.horizon_row
     rad_per_row = cfg.rad_per_row if cfg.rad_per_row is not None else scan.rad_per_row
-    geometry = PanoramaGeometry(
+    return PanoramaGeometry(
         width, height,
         float(horizon_row) if horizon_row is not None else (height - 1) / 2.0,
         float(rad_per_row) if rad_per_row is not None else TWO_PI / width,
     )
-    if scan.meta.get("w") not in (None, width) and not (unfold is not None and unfold.enabled):
-        log.warning("%s: the .db file says w=%s but the images are %d pixels wide",
-                    folder, scan.meta.get("w"), width)
+
+
+def _folder_meta(cfg: DatabaseConfig, folder: Path, scan, kept: list[Entry], skipped: list[str], nx: int, ny: int,
+                 geometry: PanoramaGeometry, raw) -> dict:
+    """Log how many grid cells have an image (a warning when some are missing or skipped); the ``meta``."""
     n_cells = nx * ny
     n_present = len({(e.x, e.y) for e in kept})
     missing_text = (f", {n_cells - n_present} missing (the agent uses the nearest existing cell)"
@@ -204,16 +243,7 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
         "unfolded": bool(raw is not None),
     }
     meta.update({f"scheme_{k}": v for k, v in scan.meta.items()})
-    return ImageDatabase(
-        name=cfg.name,
-        images=images,
-        positions=np.array([(e.x, e.y) for e in kept], dtype=np.int64).reshape(-1, 2),
-        grid_shape=(nx, ny),
-        geometry=geometry,
-        spacing_m=float(cfg.spacing_m),
-        raw=raw,
-        meta=meta,
-    )
+    return meta
 
 
 #: largest number of grid cells a database may span (arrays of one value per cell are allocated)

@@ -285,18 +285,40 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         Canonical panoramas ``(N, H, W)`` (grey) or ``(N, H, W, C)``, float32
         in [0, 1], positions ``(N, 2)`` of the existing cells.
     """
-    from bionav.world.render import RENDERER_VERSION
-
     spec = get_spec(name)
+    w, h = _checked_request(spec, name, image_size, noise, realism)
+    geometry = spec.geometry(w, h)
+    world = spec.builder(int(seed))
+    positions = np.argwhere(world.cells).astype(np.int64)
+    _check_world(name, spec, world, positions, w, h)
+    params = _cache_params(name, int(seed), noise, geometry, world, positions)
+    if realism == "camera":
+        camera, pose_error = _add_camera_params(params, spec, world, camera, pose_error, geometry)
+    key = cache_key(params)
+    path = (Path(cache_dir) if cache_dir is not None else default_cache_dir()) / \
+        f"{name}-{w}x{h}-seed{int(seed)}{'' if realism == 'ideal' else '-camera'}-{key[:20]}.npz"
+    images_u8, cached = _cached_or_rendered(path, key, params, world, positions, geometry, spec, int(seed), noise,
+                                            realism, camera, pose_error, progress, threads)
+    meta = _meta(spec, world, path, cached, int(seed), noise, realism, rotate_current, rotation_seed, camera,
+                 pose_error)
+    db = ImageDatabase(name=name, images=_float_images(images_u8), positions=positions,
+                       grid_shape=tuple(spec.grid_shape), geometry=geometry, spacing_m=float(spec.spacing_m), meta=meta)
+    return _rotated(db, rotation_seed) if rotate_current else db
+
+
+def _checked_request(spec, name: str, image_size, noise: float, realism: str) -> tuple[int, int]:
+    """``(W, H)`` of the images (the stand-in's native size by default); a bad size, noise or realism refused."""
     w, h = check_image_size(image_size, name="db.image_size", minimum=(8, 2)) or spec.native_size
     if noise < 0:
         raise UserError(f"db.noise must be >= 0, got {noise}.")
     if realism not in ("ideal", "camera"):
         raise UserError(f"db.realism={realism!r} is not a realism level; use db.realism=camera (raw mirror image, "
                         "sensor, pose errors) or db.realism=ideal (the clean original panoramas).")
-    geometry = spec.geometry(w, h)
-    world = spec.builder(int(seed))
-    positions = np.argwhere(world.cells).astype(np.int64)
+    return w, h
+
+
+def _check_world(name: str, spec, world, positions: np.ndarray, w: int, h: int) -> None:
+    """Refuse a render that would not fit in memory; the world's grid must be the table's."""
     from bionav.validation import check_allocation
 
     check_allocation(  # float32 render buffer plus the 8-bit images
@@ -306,12 +328,18 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     )
     if world.grid_shape != spec.grid_shape:
         raise RuntimeError(f"{name}: world grid {world.grid_shape} differs from table {spec.grid_shape}")
+
+
+def _cache_params(name: str, seed: int, noise: float, geometry, world, positions: np.ndarray) -> dict:
+    """Every world and render parameter the cached images depend on (hashed into the cache key)."""
+    from bionav.world.render import RENDERER_VERSION
+
     compiled_digest = world.scene.compile().digest()
-    params = {
+    return {
         "renderer_version": RENDERER_VERSION,
         "database_version": DATABASE_VERSION,
         "name": name,
-        "seed": int(seed),
+        "seed": seed,
         "noise": float(noise),
         "geometry": [geometry.width, geometry.height, geometry.horizon_row, geometry.rad_per_row],
         "grid_origin": list(map(float, world.grid_origin)),
@@ -321,39 +349,44 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         "exposure": float(world.scene.exposure),
         "scene": compiled_digest,
     }
-    if realism == "camera":
-        from bionav.db.camera import resolve_pose_error
 
-        camera, pose_error = _camera_configs(spec, camera, pose_error, geometry)
-        pose_error = resolve_pose_error(pose_error, world)  # tilt_sigma_deg=None: the world's floor
-        del params["noise"]
-        pose_key = dataclasses.asdict(pose_error)
-        if pose_key["heading_drift_deg"] == 0.0:  # no drift: the key (and cache) of the stand-ins before the drift
-            del pose_key["heading_drift_deg"]
-        params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
-                      pose_error=pose_key, native_size=list(spec.native_size))
-        for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
-            if getattr(world, what, None) is not None:
-                params[what] = dataclasses.asdict(getattr(world, what))
-        if getattr(world, "light_level", 1.0) != 1.0:  # a dim scene; 1 keeps the key of the other worlds
-            params["light_level"] = float(world.light_level)
-        if "capture_light" in world.info:  # light changing during the capture (sim_uni)
-            params["capture_light"] = world.info["capture_light"]
-    key = cache_key(params)
-    cdir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    tag = "" if realism == "ideal" else "-camera"
-    path = cdir / f"{name}-{w}x{h}-seed{int(seed)}{tag}-{key[:20]}.npz"
+
+def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
+    """The camera and pose errors of ``realism="camera"`` (resolved), their keys added to ``params``."""
+    from bionav.db.camera import resolve_pose_error
+
+    camera, pose_error = _camera_configs(spec, camera, pose_error, geometry)
+    pose_error = resolve_pose_error(pose_error, world)  # tilt_sigma_deg=None: the world's floor
+    del params["noise"]
+    pose_key = dataclasses.asdict(pose_error)
+    if pose_key["heading_drift_deg"] == 0.0:  # no drift: the key (and cache) of the stand-ins before the drift
+        del pose_key["heading_drift_deg"]
+    params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
+                  pose_error=pose_key, native_size=list(spec.native_size))
+    for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
+        if getattr(world, what, None) is not None:
+            params[what] = dataclasses.asdict(getattr(world, what))
+    if getattr(world, "light_level", 1.0) != 1.0:  # a dim scene; 1 keeps the key of the other worlds
+        params["light_level"] = float(world.light_level)
+    if "capture_light" in world.info:  # light changing during the capture (sim_uni)
+        params["capture_light"] = world.info["capture_light"]
+    return camera, pose_error
+
+
+def _cached_or_rendered(path: Path, key: str, params: dict, world, positions, geometry, spec, seed: int,
+                        noise: float, realism: str, camera, pose_error, progress, threads):
+    """The 8-bit images from the cache file ``path``, or rendered and written there; and whether cached."""
     images_u8 = read_cached_images(path, key)
     cached = images_u8 is not None
     if not cached and realism == "camera":
         from bionav.db.camera import camera_images
 
         images_u8, _, _ = camera_images(world, positions, geometry, camera=camera, pose_error=pose_error,
-                                        seed=int(seed), native_size=spec.native_size, progress=progress,
+                                        seed=seed, native_size=spec.native_size, progress=progress,
                                         threads=threads)
     elif not cached:
         imgs = render_world_images(world, positions, geometry, progress=progress, threads=threads)
-        rng = np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF, 0x6E6F6973]))
+        rng = np.random.default_rng(np.random.SeedSequence([seed & 0xFFFFFFFF, 0x6E6F6973]))
         images_u8 = quantise(imgs, noise=noise, rng=rng)
     if not cached:
         try:
@@ -361,13 +394,24 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
                                                   params=np.array(json.dumps(params))))
         except OSError:
             pass  # a read-only cache is not fatal: the database is still returned
+    return images_u8, cached
+
+
+def _float_images(images_u8: np.ndarray) -> np.ndarray:
+    """8-bit images as float32 in [0, 1]; one channel dropped to ``(N, H, W)``."""
     images = images_u8.astype(np.float32) / np.float32(255.0)
     if images.shape[-1] == 1:
         images = images[..., 0]
+    return images
+
+
+def _meta(spec, world, path: Path, cached: bool, seed: int, noise: float, realism: str, rotate_current: bool,
+          rotation_seed: int, camera, pose_error) -> dict:
+    """The database's ``meta``: where it came from, its camera and the cache file."""
     meta = {
         "source": "synthetic",
         "world": spec.description,
-        "seed": int(seed),
+        "seed": seed,
         "noise": float(noise),
         "mirror": spec.mirror,
         "channels": list(world.scene.channels),
@@ -386,13 +430,14 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         meta.pop("noise")
         meta["camera"] = dataclasses.asdict(camera)
         meta["pose_error"] = dataclasses.asdict(pose_error)
-    db = ImageDatabase(name=name, images=images, positions=positions, grid_shape=tuple(spec.grid_shape),
-                       geometry=geometry, spacing_m=float(spec.spacing_m), meta=meta)
-    if rotate_current:
-        from bionav.db.rotation import rotate_views
+    return meta
 
-        db = rotate_views(db, seed=rotation_seed)
-    return db
+
+def _rotated(db: ImageDatabase, rotation_seed: int) -> ImageDatabase:
+    """Every view rolled by a random whole number of columns (:func:`bionav.db.rotation.rotate_views`)."""
+    from bionav.db.rotation import rotate_views
+
+    return rotate_views(db, seed=rotation_seed)
 
 
 def _camera_version() -> int:

@@ -165,131 +165,173 @@ def home_vector_matrix(
     same = currents is None or currents is snapshots
     currents = snapshots if currents is None else currents
     s_idx = np.arange(len(snapshots)) if snapshot_index is None else np.asarray(snapshot_index, dtype=np.int64)
-
     t0 = time.perf_counter()
-    if prepared is None:
-        cur_prep = prepare_images(method, list(currents.images), workers=workers, progress=progress, cache=cache)
-        snap_prep = cur_prep if same else prepare_images(
-            method, list(snapshots.images), workers=workers, progress=progress, cache=cache,
-            desc="per-image work (snapshots)",
-        )
-    else:
-        snap_prep, cur_prep = prepared
-    t1 = time.perf_counter()
-
-    n_pairs = int(np.sum(~np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)))
-    all_pairs = None
+    snap_prep, cur_prep = prepared if prepared is not None else _prepare_both(method, snapshots, currents, same,
+                                                                              workers, progress, cache)
+    timing = _Timing(t0, time.perf_counter(), _n_pairs(snapshots, currents, s_idx), _prepared_stats(method, cur_prep))
     if batch and same:
-        options = _batch_options(method, snapshot_index=s_idx, workers=workers, progress=progress, on_row=on_row)
-        all_pairs = method.all_pairs_angles(
-            cur_prep, headings=currents.headings, neighbours=neighbour_table(currents), **options,
-        )
-    if all_pairs is not None:
-        angles = np.array(all_pairs, dtype=np.float64)[s_idx]
-        angles[np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)] = np.nan
-        t2 = time.perf_counter()
-        if on_row is not None and "on_row" not in options:  # a method that streams rows has called it already
-            no_compass = np.full(len(currents), np.nan)
-            for row_angles, si in zip(angles, s_idx):
-                on_row(int(si), row_angles, no_compass)
-        return HomeVectorMatrix(snapshot_index=s_idx, angles=angles, compass_error=None, prepare_s=t1 - t0,
-                                pairs_s=t2 - t1, n_pairs=n_pairs, prepared_stats=_prepared_stats(method, cur_prep))
+        matrix = _batch_matrix(method, snapshots, currents, s_idx, cur_prep, timing, workers, progress, on_row)
+        if matrix is not None:
+            return matrix
+    rows = _PairRows(method, snapshots, currents, s_idx, snap_prep, cur_prep, on_partial, partial_period_s)
+    return rows.matrix(timing, workers=workers, progress=progress, on_row=on_row)
 
-    lut = currents.cell_index_map()
-    nx, ny = currents.grid_shape
 
-    def neighbours_of(ci: int) -> dict[tuple[float, float], Any]:
+@dataclass
+class _Timing:
+    """Start and end (``time.perf_counter``, s) of the per-image work, pairs counted, per-image statistics."""
+
+    t0: float
+    t1: float
+    n_pairs: int
+    prepared_stats: dict[str, float]
+
+
+def _prepare_both(method, snapshots, currents, same, workers, progress, cache) -> tuple[list[Any], list[Any]]:
+    """Per-image work of the snapshots and the current views (once when they are one database)."""
+    cur_prep = prepare_images(method, list(currents.images), workers=workers, progress=progress, cache=cache)
+    snap_prep = cur_prep if same else prepare_images(
+        method, list(snapshots.images), workers=workers, progress=progress, cache=cache,
+        desc="per-image work (snapshots)",
+    )
+    return snap_prep, cur_prep
+
+
+def _n_pairs(snapshots: ImageDatabase, currents: ImageDatabase, s_idx: np.ndarray) -> int:
+    """Pairs of the selected snapshots and the current views at another position."""
+    return int(np.sum(~np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)))
+
+
+def _batch_matrix(method, snapshots, currents, s_idx, cur_prep, timing: _Timing, workers, progress,
+                  on_row) -> HomeVectorMatrix | None:
+    """The method's batch path (:meth:`HomingMethod.all_pairs_angles`); None when it has none."""
+    options = _batch_options(method, snapshot_index=s_idx, workers=workers, progress=progress, on_row=on_row)
+    all_pairs = method.all_pairs_angles(
+        cur_prep, headings=currents.headings, neighbours=neighbour_table(currents), **options,
+    )
+    if all_pairs is None:
+        return None
+    angles = np.array(all_pairs, dtype=np.float64)[s_idx]
+    angles[np.all(snapshots.positions[s_idx][:, None, :] == currents.positions[None, :, :], axis=2)] = np.nan
+    t2 = time.perf_counter()
+    if on_row is not None and "on_row" not in options:  # a method that streams rows has called it already
+        no_compass = np.full(len(currents), np.nan)
+        for row_angles, si in zip(angles, s_idx):
+            on_row(int(si), row_angles, no_compass)
+    return HomeVectorMatrix(snapshot_index=s_idx, angles=angles, compass_error=None, prepare_s=timing.t1 - timing.t0,
+                            pairs_s=t2 - timing.t1, n_pairs=timing.n_pairs, prepared_stats=timing.prepared_stats)
+
+
+class _PairRows:
+    """The per-pair path of :func:`home_vector_matrix`: one row of home vectors per snapshot, rows on worker
+    threads, finished rows handed to ``on_row`` in order and pairs of unfinished rows to ``on_partial``.
+
+    Angles and compass errors in radians, grid frame (the current view's heading added).
+    """
+
+    def __init__(self, method, snapshots, currents, s_idx, snap_prep, cur_prep, on_partial, partial_period_s):
+        self.method, self.snapshots, self.currents, self.s_idx = method, snapshots, currents, s_idx
+        self.snap_prep, self.cur_prep = snap_prep, cur_prep
+        self.on_partial, self.partial_period_s = on_partial, partial_period_s
+        self.lut = currents.cell_index_map()
+        self.nx, self.ny = currents.grid_shape
+        #: rows being computed: position in s_idx -> (angles, compass, computed mask, reported mask); the worker
+        #: writes a pair's values before setting its computed flag, the caller's thread only reads flagged pairs
+        self.live: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+        #: set when the caller stops early (Ctrl-C, SIGTERM, an error): rows in progress end after their current pair
+        self.stop = threading.Event()
+
+    def neighbours_of(self, ci: int) -> dict[tuple[float, float], Any]:
         """Prepared grid neighbours keyed by their offset in the current view's frame."""
+        currents, lut, nx, ny = self.currents, self.lut, self.nx, self.ny
         x, y = currents.positions[ci]
         c, s = np.cos(currents.headings[ci]), np.sin(currents.headings[ci])
         out = {}
         for dx, dy in NEIGHBOUR_OFFSETS:
             if 0 <= x + dx < nx and 0 <= y + dy < ny and lut[x + dx, y + dy] >= 0:
                 key = (dx, dy) if s == 0 and c == 1 else (round(c * dx + s * dy, 12), round(-s * dx + c * dy, 12))
-                out[key] = cur_prep[lut[x + dx, y + dy]]
+                out[key] = self.cur_prep[lut[x + dx, y + dy]]
         return out
 
-    #: rows being computed: position in s_idx -> (angles, compass, computed mask, reported mask); the worker
-    #: writes a pair's values before setting its computed flag, the caller's thread only reads flagged pairs
-    live: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
-    #: set when the caller stops early (Ctrl-C, SIGTERM, an error): rows in progress end after their current pair
-    stop = threading.Event()
-
-    def row(k: int) -> tuple[np.ndarray, np.ndarray]:
-        si = s_idx[k]
+    def row(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Home vectors of every current view to snapshot ``s_idx[k]`` (a worker thread)."""
+        method, snapshots, currents = self.method, self.snapshots, self.currents
+        si = self.s_idx[k]
         angles = np.full(len(currents), np.nan)
         compass = np.full(len(currents), np.nan)
         computed = np.zeros(len(currents), dtype=bool)
-        live[k] = (angles, compass, computed, np.zeros(len(currents), dtype=bool))
+        self.live[k] = (angles, compass, computed, np.zeros(len(currents), dtype=bool))
         s_pos = snapshots.positions[si]
         for ci in range(len(currents)):
-            if stop.is_set():
+            if self.stop.is_set():
                 break
             if np.array_equal(currents.positions[ci], s_pos):
                 continue
-            kwargs = {"neighbours": neighbours_of(ci)} if method.uses_test_steps else {}
-            hv = method.home_vector(snap_prep[si], cur_prep[ci], **kwargs)
+            kwargs = {"neighbours": self.neighbours_of(ci)} if method.uses_test_steps else {}
+            hv = method.home_vector(self.snap_prep[si], self.cur_prep[ci], **kwargs)
             angles[ci] = hv.angle + currents.headings[ci]
             if hv.compass is not None:
                 compass[ci] = hv.compass - (currents.headings[ci] - snapshots.headings[si])
             computed[ci] = True
         return wrap_angle(angles), wrap_angle(compass)
 
-    def report_partial(first_open: int) -> None:
+    def report_partial(self, first_open: int) -> None:
         """Hand the pairs computed since the last report, of rows not reported whole, to ``on_partial``."""
-        for k in sorted(live.copy()):  # a worker may add a row meanwhile
+        for k in sorted(self.live.copy()):  # a worker may add a row meanwhile
             if k < first_open:
                 continue
-            angles, compass, computed, reported = live[k]
+            angles, compass, computed, reported = self.live[k]
             new = np.flatnonzero(computed & ~reported)
             if new.size:
-                on_partial(int(s_idx[k]), new, wrap_angle(angles[new]), wrap_angle(compass[new]))
+                self.on_partial(int(self.s_idx[k]), new, wrap_angle(angles[new]), wrap_angle(compass[new]))
                 reported[new] = True
 
-    def finished_rows(pool: ThreadPoolExecutor):
+    def finished_rows(self, pool: ThreadPoolExecutor):
         """Rows in order; while waiting for one, report partial rows every ``partial_period_s``."""
-        futures = [pool.submit(row, k) for k in range(len(s_idx))]
+        futures = [pool.submit(self.row, k) for k in range(len(self.s_idx))]
         last = time.monotonic()
         try:
             for k, future in enumerate(futures):
                 while True:
-                    wait = max(0.0, last + partial_period_s - time.monotonic())
+                    wait = max(0.0, last + self.partial_period_s - time.monotonic())
                     try:
-                        result = future.result(timeout=wait if on_partial is not None else None)
+                        result = future.result(timeout=wait if self.on_partial is not None else None)
                         break
                     except FuturesTimeout:
-                        report_partial(k)
+                        self.report_partial(k)
                         last = time.monotonic()
-                live.pop(k, None)
+                self.live.pop(k, None)
                 yield result
         finally:  # normal end, or the caller stopped early: nothing more to compute
-            stop.set()
+            self.stop.set()
             for future in futures:
                 future.cancel()
 
-    with ThreadPoolExecutor(max(1, workers)) as pool:
-        rows = []
-        try:
-            for si, r in zip(s_idx, progress(finished_rows(pool), desc="home vectors", total=len(s_idx))):
-                rows.append(r)
-                if on_row is not None:
-                    on_row(int(si), r[0], r[1])
-        finally:  # also when on_row or the progress bar raised: the pool must not wait for whole rows
-            stop.set()
-    t2 = time.perf_counter()
-
-    angles = np.array([r[0] for r in rows]).reshape(len(s_idx), len(currents))
-    compass = np.array([r[1] for r in rows]).reshape(len(s_idx), len(currents))
-    has_compass = bool(np.any(np.isfinite(compass)))
-    return HomeVectorMatrix(
-        snapshot_index=s_idx,
-        angles=angles,
-        compass_error=compass if has_compass else None,
-        prepare_s=t1 - t0,
-        pairs_s=t2 - t1,
-        n_pairs=n_pairs,
-        prepared_stats=_prepared_stats(method, cur_prep),
-    )
+    def matrix(self, timing: _Timing, *, workers: int, progress: Progress, on_row) -> HomeVectorMatrix:
+        """Compute every row on ``workers`` threads; ``on_row`` gets each finished row in order."""
+        s_idx, n_cur = self.s_idx, len(self.currents)
+        with ThreadPoolExecutor(max(1, workers)) as pool:
+            rows = []
+            try:
+                for si, r in zip(s_idx, progress(self.finished_rows(pool), desc="home vectors", total=len(s_idx))):
+                    rows.append(r)
+                    if on_row is not None:
+                        on_row(int(si), r[0], r[1])
+            finally:  # also when on_row or the progress bar raised: the pool must not wait for whole rows
+                self.stop.set()
+        t2 = time.perf_counter()
+        angles = np.array([r[0] for r in rows]).reshape(len(s_idx), n_cur)
+        compass = np.array([r[1] for r in rows]).reshape(len(s_idx), n_cur)
+        has_compass = bool(np.any(np.isfinite(compass)))
+        return HomeVectorMatrix(
+            snapshot_index=s_idx,
+            angles=angles,
+            compass_error=compass if has_compass else None,
+            prepare_s=timing.t1 - timing.t0,
+            pairs_s=t2 - timing.t1,
+            n_pairs=timing.n_pairs,
+            prepared_stats=timing.prepared_stats,
+        )
 
 
 def _batch_options(method: HomingMethod, **options: Any) -> dict[str, Any]:

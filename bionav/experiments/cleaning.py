@@ -29,7 +29,6 @@ runs and overlap maps, thesis figs. 7.3-7.4).
 
 from __future__ import annotations
 
-import csv
 import time
 from dataclasses import asdict, dataclass
 from typing import Any, Callable
@@ -39,6 +38,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
 from bionav.experiments.configs import experiment_config
+from bionav.files import write_csv_atomic
 from bionav.robot.controller import LanePlan
 from bionav.robot.kinematics import Pose
 
@@ -364,16 +364,15 @@ def summarise(results: list[RunResult], plan: LanePlan, ideal: dict) -> dict[str
 
 def write_runs_csv(path, results: list[RunResult]) -> None:
     """``cleaning_runs.csv``: one row per run."""
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["run", "wheel_error_left", "wheel_error_right", "coverage", "overlap", "uncovered", "finished",
-                    "ticks", "fixes", "accepted_fixes", "h_error_rms"])
-        for r in results:
-            acc = [f for _, f in r.fixes if f.get("accepted")]
-            herr = (float(np.sqrt(np.mean((np.array([f["h"] for f in acc]) - r.truth_h) ** 2))) if acc else "")
-            w.writerow([r.run, r.wheel_error[0], r.wheel_error[1], f"{r.fractions['coverage']:.6f}",
-                        f"{r.fractions['overlap']:.6f}", f"{r.fractions['uncovered']:.6f}", int(r.episode.finished),
-                        len(r.episode.time), len(r.fixes), len(acc), herr if herr == "" else f"{herr:.6f}"])
+    rows = []
+    for r in results:
+        acc = [f for _, f in r.fixes if f.get("accepted")]
+        herr = (float(np.sqrt(np.mean((np.array([f["h"] for f in acc]) - r.truth_h) ** 2))) if acc else "")
+        rows.append([r.run, r.wheel_error[0], r.wheel_error[1], f"{r.fractions['coverage']:.6f}",
+                     f"{r.fractions['overlap']:.6f}", f"{r.fractions['uncovered']:.6f}", int(r.episode.finished),
+                     len(r.episode.time), len(r.fixes), len(acc), herr if herr == "" else f"{herr:.6f}"])
+    write_csv_atomic(path, ["run", "wheel_error_left", "wheel_error_right", "coverage", "overlap", "uncovered",
+                            "finished", "ticks", "fixes", "accepted_fixes", "h_error_rms"], rows)
 
 
 def make_oracle_homing(cfg: DictConfig):

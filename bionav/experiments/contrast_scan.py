@@ -32,6 +32,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.experiments.common import _get, load_samples
 from bionav.experiments.configs import experiment_config
+from bionav.files import write_csv_atomic
 from bionav.light.sun import parse_time
 
 SCAN_TOPIC = "/contrast_scan/scan"
@@ -60,11 +61,30 @@ def _per_scan(value, k, n, what):
     return float(v[k])
 
 
+def _scan_devices(cfg, ctx):
+    """The run's sensor and pan-tilt unit (direct pointing when none is configured), the ``pantilt`` node and
+    whether either device is simulated; a real sensor without a real pan-tilt unit is refused."""
+    from bionav.spectral.scan import DirectPanTilt
+
+    sensor_node = _get(cfg, "sensor")
+    if not sensor_node:
+        raise UserError("experiment=contrast_scan needs a sensor: sensor=spectral5_sim (simulation), "
+                        "sensor=spectral5_serial sensor.port=... (hardware) or sensor=replay sensor.path=run.mcap.")
+    sensor = ctx.plugin("sensor", sensor_node)
+    pantilt_node = _get(cfg, "pantilt")
+    pantilt = ctx.plugin("sensor", pantilt_node) if pantilt_node else DirectPanTilt()
+    simulated = bool(getattr(sensor, "simulated", False) or getattr(pantilt, "simulated", False))
+    if not pantilt_node and not simulated and not hasattr(sensor, "recorded"):
+        raise UserError("A real sensor needs a real pan-tilt unit for experiment=contrast_scan: add pantilt=ptu46 "
+                        "pantilt.port=/dev/ttyUSB1 (or use sensor=spectral5_sim for a simulated scan).")
+    return sensor, pantilt, pantilt_node, simulated
+
+
 def run(cfg, ctx) -> dict:
     """Entry point called by bionav's experiment runner."""
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
-    from bionav.spectral.scan import DirectPanTilt, ScanGrid, run_scan
+    from bionav.spectral.scan import ScanGrid, run_scan
     from bionav.spectral.scene import backyard_scene
 
     exp = experiment_config(cfg, "contrast_scan")
@@ -78,17 +98,7 @@ def run(cfg, ctx) -> dict:
         tilt_start=np.deg2rad(float(exp.tilt_start_deg)),
         pan_centre=np.deg2rad(float(exp.pan_centre_deg)),
     )
-    sensor_node = _get(cfg, "sensor")
-    if not sensor_node:
-        raise UserError("experiment=contrast_scan needs a sensor: sensor=spectral5_sim (simulation), "
-                        "sensor=spectral5_serial sensor.port=... (hardware) or sensor=replay sensor.path=run.mcap.")
-    sensor = ctx.plugin("sensor", sensor_node)
-    pantilt_node = _get(cfg, "pantilt")
-    pantilt = ctx.plugin("sensor", pantilt_node) if pantilt_node else DirectPanTilt()
-    simulated = bool(getattr(sensor, "simulated", False) or getattr(pantilt, "simulated", False))
-    if not pantilt_node and not simulated and not hasattr(sensor, "recorded"):
-        raise UserError("A real sensor needs a real pan-tilt unit for experiment=contrast_scan: add pantilt=ptu46 "
-                        "pantilt.port=/dev/ttyUSB1 (or use sensor=spectral5_sim for a simulated scan).")
+    sensor, pantilt, pantilt_node, simulated = _scan_devices(cfg, ctx)
 
     covers = exp.cloud_cover
     depths = exp.cloud_optical_depth
@@ -152,7 +162,6 @@ def run(cfg, ctx) -> dict:
 
 def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     """Contrast images, separation, stability series, plots and metrics of a set of scans."""
-    import csv
 
     from bionav.light.bands import CHANNELS, dual_contrasts
     from bionav.spectral.lda_analysis import learn_discriminants
@@ -168,11 +177,9 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     # every scan's separation images, once: for the stability after separation, the plots and the accuracy
     seps = [separation_images(s[..., :5], {n: disc[n] for n in names}, threshold=str(exp.separation)) for s in scans]
     rows = stability_series(scans[..., :5], seps, names=names)
-    with open(ctx.dir / "stability.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=["scan", "time", "feature", "separated", *MEASURES])
-        w.writeheader()
-        for r in rows:
-            w.writerow({**r, "time": times[r["scan"]].isoformat()})
+    header = ["scan", "time", "feature", "separated", *MEASURES]
+    write_csv_atomic(ctx.dir / "stability.csv", header,
+                     ([{**r, "time": times[r["scan"]].isoformat()}.get(c, "") for c in header] for r in rows))
     hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
     if bool(exp.plots):
         _plots(scans, times, hours, rows, disc, seps, ctx.plots, str(exp.separation))

@@ -10,7 +10,6 @@ more tasks than snapshots, every n-th (snapshot, pair) unit: :func:`task_units`)
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -26,6 +25,7 @@ from bionav.experiments.common import load_configured_database, make_homing, pre
 from bionav.experiments.configs import experiment_config
 from bionav.experiments.runner import LOG_FILE
 from bionav.experiments.tasks import block_of, check_blocks, finish_merge, merge_target, read_task
+from bionav.files import write_csv_atomic
 from bionav.logs.reader import read_attachment, read_messages
 from bionav.logs.writer import McapLog
 from bionav.report.figures import pyplot, save_figure
@@ -168,12 +168,8 @@ def _write_results(run_dir: Path, matrices: dict[str, np.ndarray], names: list[s
     """cross_db.csv, plots/cross_db.png and the metrics of the measure matrices (rows: snapshot database)."""
     n = len(names)
     (run_dir / "plots").mkdir(parents=True, exist_ok=True)
-    with open(run_dir / "cross_db.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["measure", "snapshot_db", *names])
-        for key in MEASURES:
-            for i in range(n):
-                w.writerow([key, names[i], *[f"{v:.6f}" for v in matrices[key][i]]])
+    write_csv_atomic(run_dir / "cross_db.csv", ["measure", "snapshot_db", *names],
+                     ([key, names[i], *[f"{v:.6f}" for v in matrices[key][i]]] for key in MEASURES for i in range(n)))
     _plot(run_dir / "plots" / "cross_db.png", matrices, names, f"cross-database test, homing={homing}")
     off = ~np.eye(n, dtype=bool)
 

@@ -9,7 +9,6 @@ joins the tasks into the unsplit run's files (``python -m bionav.experiments.mer
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -24,6 +23,7 @@ from bionav.experiments.common import load_configured_database, make_homing, pre
 from bionav.experiments.configs import experiment_config
 from bionav.experiments.runner import LOG_FILE
 from bionav.experiments.tasks import block_of, check_blocks, finish_merge, merge_target, read_task
+from bionav.files import write_csv_atomic
 from bionav.logs.reader import read_attachment, read_messages
 from bionav.logs.writer import McapLog
 
@@ -71,28 +71,14 @@ def _finite_or_none(values) -> list[float | None]:
 
 
 def write_per_snapshot_csv(path: Path, positions: np.ndarray, measures) -> None:
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["x", "y", "aae_s", "mae_s", "rr_s"])
-        for (x, y), a, m, r in zip(positions, measures.aae_s, measures.mae_s, measures.rr_s):
-            w.writerow([int(x), int(y), f"{a:.6f}", f"{m:.6f}", f"{r:.6f}"])
+    """``per_snapshot.csv``: AAE_s and MAE_s (radians) and RR_s of every snapshot cell ``(x, y)``."""
+    write_csv_atomic(path, ["x", "y", "aae_s", "mae_s", "rr_s"],
+                     ([int(x), int(y), f"{a:.6f}", f"{m:.6f}", f"{r:.6f}"]
+                      for (x, y), a, m, r in zip(positions, measures.aae_s, measures.mae_s, measures.rr_s)))
 
 
-def run(cfg: DictConfig, ctx) -> dict[str, Any]:
-    from bionav.experiments.homing_plots import plot_home_vector_field, plot_per_snapshot_maps
-
-    exp = experiment_config(cfg, "grid_homing")
-    db = load_configured_database(cfg)
-    method = make_homing(cfg, ctx, db.geometry, raw_horizon_radius_px=db.meta.get("raw_horizon_radius_px"))
-    snapshots = None if exp.snapshots is None else list(exp.snapshots)
-    if snapshots is not None and max(snapshots) >= len(db):
-        raise UserError(
-            f"bad value experiment.snapshots={snapshots}: database {db.name!r} has {len(db)} images, so the "
-            f"snapshot indices must be 0..{len(db) - 1}; drop the larger ones (null = every image)."
-        )
-
-    if exp.block is not None:
-        snapshots = block_of(exp.block, range(len(db)) if snapshots is None else snapshots)
+def _row_loggers(ctx, db):
+    """``on_row`` and ``on_partial`` of :func:`home_vector_matrix`: rows and partial rows into ``run.mcap``."""
 
     def log_row(si: int, angles: np.ndarray, compass: np.ndarray) -> None:
         """Each snapshot's home vectors as soon as they are computed (a crash loses no finished row)."""
@@ -117,19 +103,11 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         )
         ctx.log.flush()  # to the file now: the ~2 s of this period are all a crash can lose
 
-    hv = home_vector_matrix(
-        method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
-        cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial,
-    )
-    s_pos = db.positions[hv.snapshot_index]
-    ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
-    n_plots = min(int(exp.n_quiver_plots), len(hv.snapshot_index))
-    plotted = set(np.linspace(0, len(hv.snapshot_index) - 1, n_plots).round().astype(int).tolist()) if n_plots else set()
-    success, paths = evaluate_agents(
-        db, hv, step_length=float(exp.step_length), success_radius=float(exp.success_radius), record=plotted
-    )
-    q = quality_measures(ae, success)
+    return log_row, log_partial
 
+
+def _log_fields(ctx, db, hv, ae, success, paths) -> None:
+    """Every snapshot's home-vector field (angles and AE in radians, grid frame) and the agents' paths."""
     for row, si in enumerate(hv.snapshot_index):
         ctx.log.write(
             "/grid_homing/home_vectors",
@@ -151,7 +129,11 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             schema_name="bionav.AgentPaths",
         )
 
-    write_per_snapshot_csv(ctx.dir / "per_snapshot.csv", s_pos, q)
+
+def _plot_fields(ctx, cfg, db, hv, q, s_pos, success, paths, plotted) -> None:
+    """Home-vector fields of the ``plotted`` snapshot rows and the per-snapshot maps of AAE_s and RR_s."""
+    from bionav.experiments.homing_plots import plot_home_vector_field, plot_per_snapshot_maps
+
     label = f"{cfg.homing.name} on {db.name}"
     for row in sorted(plotted):
         si = hv.snapshot_index[row]
@@ -165,6 +147,39 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         ctx.plots / "per_snapshot.png", positions=s_pos, grid_shape=db.grid_shape, aae_s=q.aae_s, rr_s=q.rr_s,
         title=f"{label}: AAE*={q.aae:.3f} rad, MAE*={q.mae:.3f} rad, RR*={q.rr:.3f}",
     )
+
+
+def run(cfg: DictConfig, ctx) -> dict[str, Any]:
+    exp = experiment_config(cfg, "grid_homing")
+    db = load_configured_database(cfg)
+    method = make_homing(cfg, ctx, db.geometry, raw_horizon_radius_px=db.meta.get("raw_horizon_radius_px"))
+    snapshots = None if exp.snapshots is None else list(exp.snapshots)
+    if snapshots is not None and max(snapshots) >= len(db):
+        raise UserError(
+            f"bad value experiment.snapshots={snapshots}: database {db.name!r} has {len(db)} images, so the "
+            f"snapshot indices must be 0..{len(db) - 1}; drop the larger ones (null = every image)."
+        )
+
+    if exp.block is not None:
+        snapshots = block_of(exp.block, range(len(db)) if snapshots is None else snapshots)
+
+    log_row, log_partial = _row_loggers(ctx, db)
+    hv = home_vector_matrix(
+        method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
+        cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial,
+    )
+    s_pos = db.positions[hv.snapshot_index]
+    ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
+    n_plots = min(int(exp.n_quiver_plots), len(hv.snapshot_index))
+    plotted = set(np.linspace(0, len(hv.snapshot_index) - 1, n_plots).round().astype(int).tolist()) if n_plots else set()
+    success, paths = evaluate_agents(
+        db, hv, step_length=float(exp.step_length), success_radius=float(exp.success_radius), record=plotted
+    )
+    q = quality_measures(ae, success)
+
+    _log_fields(ctx, db, hv, ae, success, paths)
+    write_per_snapshot_csv(ctx.dir / "per_snapshot.csv", s_pos, q)
+    _plot_fields(ctx, cfg, db, hv, q, s_pos, success, paths, plotted)
     metrics: dict[str, Any] = {
         "homing": str(cfg.homing.name),
         "db": db.name,

@@ -315,6 +315,21 @@ def sift_home_vector_reference(
     return _home_vector_from_matches(snapshot, current, ci, si, geometry=geometry, combine=combine, window=window)
 
 
+def _joined_index(index: Sequence) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """Every image's sorted keypoints in one set of arrays: one compiled call per row, no GIL per pair.
+
+    Returns the keypoint offsets (N + 1,), the descriptor offsets (N + 1,) and
+    the concatenated ``x, y, descriptors, sq_norms, rank, where`` of the
+    column indices ``index`` (:func:`column_index`).
+    """
+    n = len(index)
+    kp_off = np.concatenate([[0], np.cumsum([len(ix.x) for ix in index])]).astype(np.int64)
+    desc_off = np.concatenate([[0], np.cumsum([len(ix.descriptors) for ix in index])]).astype(np.int64)
+    joined = [np.concatenate([getattr(ix, name) for ix in index]) if n else np.zeros(0)
+              for name in ("x", "y", "descriptors", "sq_norms", "rank", "where")]
+    return kp_off, desc_off, joined
+
+
 def sift_home_angles_all_pairs(
     features: Sequence[SiftFeatures],
     *,
@@ -377,11 +392,7 @@ def sift_home_angles_all_pairs(
     wanted[np.arange(n) if snapshot_index is None else np.asarray(snapshot_index, dtype=np.int64)] = True
     angles = np.full((n, n), np.nan)
     used = np.zeros((n, n), np.int64)
-    # every image's sorted keypoints in one set of arrays: one compiled call per row, no GIL per pair
-    kp_off = np.concatenate([[0], np.cumsum([len(ix.x) for ix in index])]).astype(np.int64)
-    desc_off = np.concatenate([[0], np.cumsum([len(ix.descriptors) for ix in index])]).astype(np.int64)
-    joined = [np.concatenate([getattr(ix, name) for ix in index]) if n else np.zeros(0)
-              for name in ("x", "y", "descriptors", "sq_norms", "rank", "where")]
+    kp_off, desc_off, joined = _joined_index(index)
     options = (float(search_radius), float(geometry.width), geometry.rad_per_column, float(geometry.horizon_row),
                float(geometry.rad_per_row), MIN_ELEVATION, combine == "max", N_BINS, int(window))
 

@@ -19,6 +19,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Iterable, Mapping, Sequence
 
+from bionav.files import write_csv_atomic
 from bionav.report.figures import pyplot
 from bionav.report.table import markdown_table
 
@@ -229,7 +230,6 @@ def write_parameter_report(root: Path, *, top: int = 8) -> list[str]:
     list of str
         One Markdown section per database (empty when ``root`` holds no parameter sweep).
     """
-    import csv
 
     root = Path(root)
     rows = load_sweep_rows(root)
@@ -238,10 +238,8 @@ def write_parameter_report(root: Path, *, top: int = 8) -> list[str]:
     sections = []
     for db, ranked in best_configurations(rows).items():
         table = ranking_table(rows, db=db)
-        with open(root / f"ranking_{db}.csv", "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=list(table[0]) if table else list(RANKING_COLUMNS))
-            writer.writeheader()
-            writer.writerows(table)
+        header = list(table[0]) if table else list(RANKING_COLUMNS)
+        write_csv_atomic(root / f"ranking_{db}.csv", header, ([row.get(c, "") for c in header] for row in table))
         text = ranking_markdown(table, db=db)
         (root / f"ranking_{db}.md").write_text(text + "\n")
         (root / "plots").mkdir(exist_ok=True)

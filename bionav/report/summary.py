@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import csv
 import json
 from pathlib import Path
 from typing import Any
 
+from bionav.files import write_csv_atomic
 from bionav.report.table import flatten, markdown_table, ordered_columns
 
 
@@ -91,11 +91,7 @@ def write_summary(root: Path) -> tuple[Path, Path, list[dict[str, Any]]]:
     rows, override_keys = collect_rows(root)
     columns = ordered_columns(rows, first=["job", *override_keys, "status"])
     csv_path, md_path = root / "summary.csv", root / "summary.md"
-    with open(csv_path, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({c: row.get(c, "") for c in columns})
+    write_csv_atomic(csv_path, columns, ([row.get(c, "") for c in columns] for row in rows))
     n_failed = sum(1 for r in rows if r.get("status") != "completed")
     text = [f"# Summary of {root}", "", f"{len(rows)} runs, {n_failed} failed.", "", markdown_table(rows, columns), ""]
     md_path.write_text("\n".join(text))

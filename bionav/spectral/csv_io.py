@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from bionav.errors import UserError
+from bionav.files import write_csv_atomic
 from bionav.light.bands import CHANNELS
 from bionav.spectral.samples import SampleSet
 
@@ -114,9 +115,7 @@ def read_samples_csv(path) -> SampleSet:
 def write_samples_csv(samples: SampleSet, path) -> Path:
     """Write a sample set in the format :func:`read_samples_csv` reads; returns the path."""
     path = Path(path)
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(["class", *CHANNELS, "kind", "time"])
-        for c, sky, k, t in zip(samples.counts, samples.is_sky, samples.kind, samples.time):
-            w.writerow(["sky" if sky else "object", *(f"{v:.1f}" for v in c), k, t])
+    write_csv_atomic(path, ["class", *CHANNELS, "kind", "time"],
+                     (["sky" if sky else "object", *(f"{v:.1f}" for v in c), k, t]
+                      for c, sky, k, t in zip(samples.counts, samples.is_sky, samples.kind, samples.time)))
     return path

@@ -12,13 +12,13 @@ significantly (5 %, 1 %, 0.1 %).
 
 from __future__ import annotations
 
-import csv
 import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from bionav.files import write_csv_atomic
 from bionav.light.bands import CHANNELS, feature_subsets
 from bionav.spectral.samples import SampleSet
 from bionav.stats import (
@@ -189,16 +189,16 @@ def write_lda_table_csv(results: dict[str, FeatureResult], path) -> Path:
         est = np.array([getattr(results[n], crit) for n in names])
         order = np.argsort(-est if larger else est, kind="stable")
         ranks[crit] = {names[i]: r + 1 for r, i in enumerate(order)}
-    with path.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["feature", "channels", "J", "J_sigma", "n_f", "n_f_sigma", "rank_J", "rank_J_sigma", "rank_n_f",
-                    "direction", "threshold", "direction_sigma", "threshold_sigma"])
-        for n in names:
-            r = results[n]
-            w.writerow([n, " ".join(CHANNELS[i] for i in r.channels), f"{r.J:.6g}", f"{r.J_sigma:.6g}",
-                        f"{r.n_f:.6g}", f"{r.lda_sigma.error_fraction:.6g}", ranks["J"][n], ranks["J_sigma"][n],
-                        ranks["n_f"][n], " ".join(f"{v:.6g}" for v in r.lda.direction), f"{r.lda.threshold:.6g}",
-                        " ".join(f"{v:.6g}" for v in r.lda_sigma.direction), f"{r.lda_sigma.threshold:.6g}"])
+    header = ["feature", "channels", "J", "J_sigma", "n_f", "n_f_sigma", "rank_J", "rank_J_sigma", "rank_n_f",
+              "direction", "threshold", "direction_sigma", "threshold_sigma"]
+    rows = []
+    for n in names:
+        r = results[n]
+        rows.append([n, " ".join(CHANNELS[i] for i in r.channels), f"{r.J:.6g}", f"{r.J_sigma:.6g}",
+                     f"{r.n_f:.6g}", f"{r.lda_sigma.error_fraction:.6g}", ranks["J"][n], ranks["J_sigma"][n],
+                     ranks["n_f"][n], " ".join(f"{v:.6g}" for v in r.lda.direction), f"{r.lda.threshold:.6g}",
+                     " ".join(f"{v:.6g}" for v in r.lda_sigma.direction), f"{r.lda_sigma.threshold:.6g}"])
+    write_csv_atomic(path, header, rows)
     return path
 
 
@@ -263,9 +263,6 @@ def significance_markdown(sig: dict[str, Significance], *, title: str = "", n_re
 def write_significance_csv(s: Significance, path) -> Path:
     """Matrix of smallest significant levels (blank: not significant) for one criterion."""
     path = Path(path)
-    with path.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow([s.criterion] + s.names)
-        for i, a in enumerate(s.names):
-            w.writerow([a] + ["" if not np.isfinite(v) else f"{v:g}" for v in s.levels[i]])
+    write_csv_atomic(path, [s.criterion] + s.names,
+                     ([a] + ["" if not np.isfinite(v) else f"{v:g}" for v in s.levels[i]] for i, a in enumerate(s.names)))
     return path

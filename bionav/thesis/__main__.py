@@ -242,6 +242,6 @@ def argv_for_display(args) -> list[str]:
 
 
 if __name__ == "__main__":
-    from bionav.errors import run_main
+    from bionav.cli_main import run_main
 
     run_main(main, "bionav.thesis")

@@ -97,7 +97,7 @@ class CompiledScene:
     shadow_items: np.ndarray = None  # (L, total) caster indices
 
     def __post_init__(self) -> None:
-        from bionav.world.kernels import build_shadow_bins
+        from bionav.world.shadow_bins import build_shadow_bins
 
         if self.prim_kind is None:
             self.prim_kind, self.prim_idx, self.spheres, self.casters = bounding_spheres(

@@ -32,6 +32,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from bionav.errors import run_main
+    from bionav.cli_main import run_main
 
     run_main(main, "bionav.experiments.merge")

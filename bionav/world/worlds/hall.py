@@ -81,7 +81,23 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
     gal_d = 3.5
     pitch = 6.0 + g.uniform(-0.5, 0.5)
     scene = Scene(name="hall")
+    concrete = _shell(scene, seed, lx, ly, lz, gal_z, gal_d, pitch)
+    _shops(scene, seed, lx, ly, gal_z)
+    _stairs(scene, seed, ly, gal_z, gal_d)
+    gx0, gy0, cells, planter_mat, bench = _capture_area(scene, seed, part, lx, ly, lz, concrete)
+    _props(scene, seed, lx, ly, gal_d, gx0, gy0, concrete, planter_mat, bench)
+    _lights(scene, seed, lx, ly, gal_z, gal_d)
+    scene.ambient = Ambient(up=AMBIENT[0], down=AMBIENT[1])
+    scene.exposure = EXPOSURE
+    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
+                 camera_height=CAMERA_HEIGHT, cells=cells, info={"room": (lx, ly, lz), "part": part},
+                 floor_tilt_deg=FLOOR_TILT_DEG, light_level=LIGHT_LEVEL)
 
+
+def _shell(scene: Scene, seed: int, lx: float, ly: float, lz: float, gal_z: float, gal_d: float, pitch: float) -> int:
+    """The hall's walls, floor and ceiling, the galleries along both long walls, railings and pillar rows;
+    returns the concrete material (also of the kiosk's roof and the notice boards' legs).
+    """
     r = stream(seed, "hall/shell")
     floor = scene.material(texture=tx.tiles(r, n=4, lo=0.25, hi=0.65, grout_level=0.2), albedo=0.6, scale=2.4)
     wall = scene.material(texture=tx.value_noise(r, lo=0.45, hi=0.7, base_cells=2), albedo=0.6, scale=4.0)
@@ -102,7 +118,11 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
         while y < ly - 1.0:
             scene.box((px - 0.35, y - 0.35, 0.0), (px + 0.35, y + 0.35, gal_z - 0.5), concrete)
             y += pitch
+    return concrete
 
+
+def _shops(scene: Scene, seed: int, lx: float, ly: float, gal_z: float) -> None:
+    """Shop fronts and notice boards under the galleries, pictures, doors at the ends, upper-level openings."""
     # shop fronts and notice boards under the galleries, doors at the ends
     r = stream(seed, "hall/shops")
     glass = scene.material(texture=tx.facade(r, floors=1, windows=3), albedo=0.4, scale=(6.0, 3.5))
@@ -127,6 +147,9 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
     scene.box((0.0, 0.0, gal_z + 1.2), (0.1, ly, gal_z + 4.2), upper, shadow=False)
     scene.box((lx - 0.1, 0.0, gal_z + 1.2), (lx, ly, gal_z + 4.2), upper, shadow=False)
 
+
+def _stairs(scene: Scene, seed: int, ly: float, gal_z: float, gal_d: float) -> None:
+    """Stairs to the west gallery."""
     # stairs to the west gallery
     r = stream(seed, "hall/stairs")
     step = scene.material(texture=tx.stripes(r, n=2, lo=0.35, hi=0.6), albedo=0.6, scale=(1.0, 0.3))
@@ -135,6 +158,13 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
     for k in range(n_steps):
         scene.box((gal_d, sy + k * 0.3, 0.0), (gal_d + 1.8, sy + (k + 1) * 0.3, (k + 1) * gal_z / n_steps), step)
 
+
+def _capture_area(scene: Scene, seed: int, part: int, lx: float, ly: float, lz: float, concrete: int) -> tuple:
+    """The capture grid of part ``part`` with the kiosk over one corner and a pillar beside it.
+
+    Returns the grid origin ``gx0, gy0`` (m), the existing cells, and the planter and bench materials
+    (drawn from this part's random stream, used by :func:`_props`).
+    """
     # the capture grid: open floor of the deserted hall (thesis 3.1), except for the information kiosk
     # standing over one corner of the grid area (the 30 cells the robot could not reach: table 3.1's
     # 170 of 10 x 20 images) and a round pillar of the hall just outside the opposite corner
@@ -153,7 +183,12 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
         raise RuntimeError(f"hall: the kiosk takes {int((~cells).sum())} cells, table 3.1 has {N_MISSING} missing")
     planter_mat = scene.material(texture=tx.value_noise(r, lo=0.3, hi=0.5), albedo=0.5, scale=0.8)
     bench = scene.material(texture=tx.wood(r), albedo=0.45, scale=1.0)
+    return gx0, gy0, cells, planter_mat, bench
 
+
+def _props(scene: Scene, seed: int, lx: float, ly: float, gal_d: float, gx0: float, gy0: float, concrete: int,
+           planter_mat: int, bench: int) -> None:
+    """Benches, notice boards and planters elsewhere in the hall (none near the capture grid)."""
     # more benches, bins and planters elsewhere in the hall
     r = stream(seed, "hall/props")
     for k in range(10):
@@ -175,6 +210,9 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
             scene.box((x - 0.55, y - 0.02, 0.0), (x - 0.5, y + 0.02, 0.5), concrete)
             scene.box((x + 0.5, y - 0.02, 0.0), (x + 0.55, y + 0.02, 0.5), concrete)
 
+
+def _lights(scene: Scene, seed: int, lx: float, ly: float, gal_z: float, gal_d: float) -> None:
+    """The few fluorescent lamps under the galleries that are on at night."""
     # night: no daylight through the upper windows, only a few fluorescent lamps under the galleries
     # are on (thesis 3.1: "the illumination is sparse because there are only few fluorescent lamps").
     # Most of the hall is lit only by light bounced off the lit floor patches, so the bounce
@@ -190,8 +228,3 @@ def build_hall(seed: int = 0, *, part: int = 1) -> World:
                       shadow=False)
             if on:
                 scene.add_light(PointLight((x, y, gal_z - 0.6), LAMP_INTENSITY, downward=True))
-    scene.ambient = Ambient(up=AMBIENT[0], down=AMBIENT[1])
-    scene.exposure = EXPOSURE
-    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT, cells=cells, info={"room": (lx, ly, lz), "part": part},
-                 floor_tilt_deg=FLOOR_TILT_DEG, light_level=LIGHT_LEVEL)

@@ -80,8 +80,22 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
     gy0 = 1.45 + g.uniform(-0.1, 0.1)
     gx1, gy1 = gx0 + 2.7, gy0 + 4.8
     scene = Scene(name="lab", exposure=1.0)
+    _shell(scene, seed, lx, ly, lz)
+    win_centres = _windows(scene, seed, lx, ly, lz, daylight=daylight, curtains_open=curtains_open)
+    _door(scene, seed, ly)
+    _furniture(scene, seed, lx, ly, lz, gx0, gy0, gx1)
+    _desks(scene, seed, gx0, gx1, gy1)
+    _posters(scene, seed, lx, ly)
+    _lights(scene, seed, lx, ly, lz, win_centres, door_band=door_band, window_band=window_band, daylight=daylight,
+            curtains_open=curtains_open)
+    _variants(scene, seed, gx0, gy0, gx1, plant=plant, chairs=chairs, screen=screen)
+    scene.exposure = 2.4
+    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG)
 
-    # ---------------------------------------------------------------- shell
+
+def _shell(scene: Scene, seed: int, lx: float, ly: float, lz: float) -> None:
+    """The room's walls, floor, ceiling, skirting and cable ducts (room ``lx x ly x lz`` metres)."""
     r = stream(seed, "lab/shell")
     wall = scene.material(texture=tx.plaster(r), albedo=0.85, scale=1.7)
     floor = scene.material(texture=tx.tiles(r, n=4, lo=0.25, hi=0.55, grout_level=0.3), albedo=0.55, scale=2.0)
@@ -95,7 +109,9 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
     scene.box((0, 0.3, 0.95), (0.05, ly - 0.3, 1.05), duct, shadow=False)  # cable duct on the west wall
     scene.box((0.3, ly - 0.05, 0.95), (lx - 0.3, ly, 1.05), duct, shadow=False)
 
-    # ---------------------------------------------------------------- windows (east wall)
+
+def _windows(scene: Scene, seed: int, lx: float, ly: float, lz: float, *, daylight: float, curtains_open: bool) -> list[float]:
+    """Windows, curtains and radiators along the east wall (``x = lx``); returns the windows' centres ``y`` (m)."""
     r = stream(seed, "lab/windows")
     n_win = 3
     win_w = 1.5
@@ -118,8 +134,11 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
                       curtain_mat)
     rail = scene.material(albedo=0.7)
     scene.box((lx - 0.18, 0.1, lz - 0.12), (lx - 0.04, ly - 0.1, lz - 0.06), rail, shadow=False)
+    return win_centres
 
-    # ---------------------------------------------------------------- door and west wall
+
+def _door(scene: Scene, seed: int, ly: float) -> None:
+    """The door and the whiteboard in the west wall (``x = 0``)."""
     r = stream(seed, "lab/door")
     door_y = 0.6 + r.uniform(0.0, 0.5)
     door = scene.material(texture=tx.panel(r, nx=1, ny=2), fit=True, albedo=0.7)
@@ -130,7 +149,9 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
     wy = ly * 0.55
     scene.box((0.0, wy - 1.0, 0.9), (0.04, wy + 1.0, 2.0), board, shadow=False)  # whiteboard with scribbles
 
-    # ---------------------------------------------------------------- furniture along the walls
+
+def _furniture(scene: Scene, seed: int, lx: float, ly: float, lz: float, gx0: float, gy0: float, gx1: float) -> None:
+    """Cabinets, shelves, crates, a bin, a stool, the robot-arm support and a pipe (grid from ``(gx0, gy0)``)."""
     r = stream(seed, "lab/furniture")
     cabinet(scene, r, x0=0.0, y0=2.2, x1=0.6, y1=3.4, height=2.0, facing="+x", doors=(2, 3))
     cabinet(scene, r, x0=0.0, y0=ly - 1.7, x1=0.5, y1=ly - 0.9, height=1.1, facing="+x", doors=(2, 2))
@@ -163,7 +184,9 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
     pipe = scene.material(albedo=0.8)
     scene.cylinder((lx - 0.12, ly - 0.12), 0.0, lz, 0.07, material=pipe)
 
-    # ---------------------------------------------------------------- desks covering the last grid row
+
+def _desks(scene: Scene, seed: int, gx0: float, gx1: float, gy1: float) -> None:
+    """Two desks with screens, keyboards and a PC covering the last grid row (``y = gy1``)."""
     r = stream(seed, "lab/desks")
     ty0, ty1 = gy1 - 0.25, gy1 + 0.6
     tx0, tx1 = gx0 - 0.35, gx1 + 0.35
@@ -179,7 +202,9 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
         scene.box((mx - 0.2, ty0 + 0.15, 0.74), (mx + 0.2, ty0 + 0.3, 0.76), case)  # keyboard
     scene.box((tx1 - 0.3, ty1 - 0.45, 0.0), (tx1 - 0.08, ty1 - 0.05, 0.45), case)  # PC tower under the desk
 
-    # ---------------------------------------------------------------- posters
+
+def _posters(scene: Scene, seed: int, lx: float, ly: float) -> None:
+    """Posters on the walls."""
     r = stream(seed, "lab/posters")
     for wall_name, positions, length in (("south", [0.6, 5.2], lx), ("north", [3.6, 5.6], lx),
                                           ("west", [4.2, 6.9], ly), ("east", [], ly)):
@@ -189,7 +214,10 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
             wall_picture(scene, r, wall=wall_name, position=min(p, length - 0.5), z0=z0, z1=z0 + w * 1.3,
                          width=w, room=(lx, ly))
 
-    # ---------------------------------------------------------------- lights
+
+def _lights(scene: Scene, seed: int, lx: float, ly: float, lz: float, win_centres: list[float], *, door_band: bool,
+            window_band: bool, daylight: float, curtains_open: bool) -> None:
+    """The two ceiling light bands (on or off), the ambient bounce light and daylight through open windows."""
     r = stream(seed, "lab/lights")
     band_intensity = BAND_INTENSITY
     fixture_off = scene.material(texture=tx.stripes(r, n=4, lo=0.6, hi=0.9), albedo=0.8, scale=(1.2, 0.15))
@@ -213,7 +241,10 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
         for c in win_centres:  # diffuse daylight entering through each window
             scene.add_light(PointLight((lx - 0.3, c, 2.0), 1.0 * daylight, downward=False))
 
-    # ---------------------------------------------------------------- variants
+
+def _variants(scene: Scene, seed: int, gx0: float, gy0: float, gx1: float, *, plant: bool, chairs: bool,
+              screen: bool) -> None:
+    """What the variants add: the plant, the chairs, the projection screen."""
     if plant:
         # centre of the room, between four grid cells so no camera stands inside it
         potted_plant(scene, stream(seed, "lab/plant"), x=gx0 + SPACING * 4.5, y=gy0 + SPACING * 8.5,
@@ -234,10 +265,6 @@ def build_lab(seed: int = 0, *, plant: bool = False, chairs: bool = False, curta
         for yy in (sy0 + 0.1, sy0 + 1.7):
             scene.cylinder((0.86, yy), 0.0, 0.85, 0.02, material=legs)
             scene.box((0.6, yy - 0.02, 0.0), (1.1, yy + 0.02, 0.04), legs)
-
-    scene.exposure = 2.4
-    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG)
 
 
 def build_lab_variant(variant: str, seed: int = 0) -> World:

@@ -215,8 +215,30 @@ def build_living_kitchen(seed: int = 0) -> World:
     gx1, gy1 = gx0 + 1.0, gy0 + 3.5
     scene = Scene(name="living room and kitchen")
     _shell(scene, seed, lx, ly, lz, "kitchen")
+    _kitchen_units(scene, seed)
+    _dining_corner(scene, seed, gx1)
+    panes, windows = _kitchen_living_room(scene, seed, lx, ly, gy0, gx1, gy1)
 
-    # kitchen: counters along the west and south walls, upper cabinets, fridge, stove
+    lamp = scene.material(albedo=0.9, emission=1.5)
+    for cy in (1.6, ly - 2.0):
+        scene.ellipsoid((lx / 2, cy, lz - 0.2), (0.2, 0.2, 0.1), material=lamp, shadow=False)
+        scene.add_light(PointLight((lx / 2, cy, lz - 0.35), 2.2, downward=False))
+    scene.ambient = Ambient(up=0.3, down=0.2)
+    scene.exposure = 1.5
+    # a morning: the sun rises in front of the east windows (azimuth -50 -> +16 deg)
+    daylight = Daylight(room=(lx, ly, lz), windows=windows, sun_azimuth_deg=(-50.0, 16.0),
+                        sun_elevation_deg=(15.0, 40.0), sun_irradiance=SUN_IRRADIANCE,
+                        duration_h=11 * 36 * SECONDS_PER_IMAGE / 3600.0, cloud_sigma=CLOUD_SIGMA,
+                        cloud_images=CLOUD_IMAGES, sky_lights=(), panes=panes, lane_axis=1)
+    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
+                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"],
+                 heading_drift_deg=HEADING_DRIFT_DEG["kitchen"],
+                 daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
+                                                          jitter_m=SUPERVISOR_JITTER, lane_axis=1))
+
+
+def _kitchen_units(scene: Scene, seed: int) -> None:
+    """*roeben1*'s kitchen: counters along the west and south walls, upper cabinets, fridge, stove, sink."""
     r = stream(seed, "kitchen/kitchen")
     counter_top = scene.material(texture=tx.value_noise(r, lo=0.2, hi=0.5, base_cells=8), albedo=0.7, scale=0.8)
     front = scene.material(texture=tx.panel(r, nx=4, ny=2), fit=True, albedo=0.8)
@@ -238,7 +260,10 @@ def build_living_kitchen(seed: int = 0) -> World:
     sink = scene.material(albedo=0.55)
     scene.box((1.0, 0.05, 0.88), (1.6, 0.5, 0.91), sink)
     scene.cylinder((1.3, 0.08), 0.9, 1.2, 0.015, material=sink)
-    # dining table with chairs between kitchen and living room, east of the grid
+
+
+def _dining_corner(scene: Scene, seed: int, gx1: float) -> None:
+    """*roeben1*'s dining table with chairs between kitchen and living room, east of the grid (``x > gx1``)."""
     rt = stream(seed, "kitchen/dining")
     dx0 = gx1 + CLUTTER_GAP
     table(scene, rt, x0=dx0, y0=1.6, x1=dx0 + 0.9, y1=3.0, height=0.74, apron=True)
@@ -246,7 +271,13 @@ def build_living_kitchen(seed: int = 0) -> World:
         chair(scene, rt, x=dx0 + 1.1, y=cy, yaw=np.pi)
     chair(scene, rt, x=dx0 + 0.45, y=1.25, yaw=np.pi / 2)
     chair(scene, rt, x=dx0 + 0.45, y=3.35, yaw=-np.pi / 2)
-    # living room: sofa close along the west wall, shelf, TV, armchair
+
+
+def _kitchen_living_room(scene: Scene, seed: int, lx: float, ly: float, gy0: float, gx1: float, gy1: float):
+    """*roeben1*'s living room: sofa, shelf, TV, armchair, plant, lamp, east windows, door and pictures.
+
+    Returns the windows' panes and openings (as :class:`~bionav.world.worlds.common.Daylight` takes them).
+    """
     r = stream(seed, "kitchen/living")
     _sofa(scene, r, x=0.4, y=gy0 + 3.5 + 0.2, yaw=0.0, width=2.0)
     shelf(scene, r, x0=0.6, y0=ly - 0.35, x1=2.6, y1=ly, height=2.0, facing="-y", shelves=5)
@@ -268,20 +299,4 @@ def build_living_kitchen(seed: int = 0) -> World:
         w = r.uniform(0.4, 0.8)
         wall_picture(scene, r, wall=wall, position=min(pos, length - 0.5), z0=1.4, z1=1.4 + w * 0.8, width=w,
                      room=(lx, ly))
-
-    lamp = scene.material(albedo=0.9, emission=1.5)
-    for cy in (1.6, ly - 2.0):
-        scene.ellipsoid((lx / 2, cy, lz - 0.2), (0.2, 0.2, 0.1), material=lamp, shadow=False)
-        scene.add_light(PointLight((lx / 2, cy, lz - 0.35), 2.2, downward=False))
-    scene.ambient = Ambient(up=0.3, down=0.2)
-    scene.exposure = 1.5
-    # a morning: the sun rises in front of the east windows (azimuth -50 -> +16 deg)
-    daylight = Daylight(room=(lx, ly, lz), windows=windows, sun_azimuth_deg=(-50.0, 16.0),
-                        sun_elevation_deg=(15.0, 40.0), sun_irradiance=SUN_IRRADIANCE,
-                        duration_h=11 * 36 * SECONDS_PER_IMAGE / 3600.0, cloud_sigma=CLOUD_SIGMA,
-                        cloud_images=CLOUD_IMAGES, sky_lights=(), panes=panes, lane_axis=1)
-    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
-                 camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"],
-                 heading_drift_deg=HEADING_DRIFT_DEG["kitchen"],
-                 daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
-                                                          jitter_m=SUPERVISOR_JITTER, lane_axis=1))
+    return panes, windows

@@ -13,7 +13,7 @@ callable to render multi-band (e.g. UV, B, G, R, IR) images; the defaults of
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -275,7 +275,24 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
 
     g = stream(seed, "campus/layout")
     gx0, gy0 = 0.0, 0.0
-    # ground: paving slab with grass areas and an asphalt road
+    _campus_ground(seed, scene, mat)
+    glass = _campus_main_building(seed, scene, mat, g)
+    _campus_buildings(seed, scene, mat)
+    _campus_greenery(seed, scene, mat, gx0, gy0)
+    _campus_props(seed, scene, mat, glass)
+
+    scene.add_light(DirectionalLight(sun, tuple(np.broadcast_to(np.asarray(sun_irradiance, float), (c,)))))
+    up = np.broadcast_to(np.asarray(sky_irradiance, float), (c,))
+    scene.ambient = Ambient(up=tuple(up), down=tuple(0.4 * up))
+    scene.exposure = exposure
+    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
+                 camera_height=CAMERA_HEIGHT,
+                 info={"sun_elevation": float(sun_elevation), "sun_azimuth": float(sun_azimuth),
+                       "channels": channels}, floor_tilt_deg=FLOOR_TILT_DEG)
+
+
+def _campus_ground(seed: int, scene: Scene, mat: Callable[..., int]) -> None:
+    """The campus ground: paving slabs with grass areas and an asphalt road (``mat(kind, texture, ...)``: a material)."""
     r = stream(seed, "campus/ground")
     paving = mat("paving", tx.tiles(r, n=4, lo=PAVING_TEXTURE[0], hi=PAVING_TEXTURE[1], grout_level=0.4), scale=2.0)
     grass = mat("grass", tx.foliage(r), scale=1.5)
@@ -285,7 +302,12 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
         scene.box((x0, y0, 0.0), (x1, y1, 0.02), grass, shadow=False)
     scene.box((-300, 60, 0.0), (300, 68, 0.01), asphalt, shadow=False)
 
-    # the main building south of the grid with its north entrance
+
+def _campus_main_building(seed: int, scene: Scene, mat: Callable[..., int], g: np.random.Generator) -> int:
+    """The main building south of the grid with its north entrance; its height from the layout stream ``g``.
+
+    Returns the glass material (also of the parked cars' windows).
+    """
     r = stream(seed, "campus/main")
     main_h = 20.0 + g.uniform(-2, 2)
     facade = mat("concrete", tx.facade(r, floors=4, windows=4), scale=(10.4, 15.2))
@@ -298,8 +320,11 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
         scene.cylinder((px, -5.0), 0.0, 3.6, 0.25, material=pillar)
     glass = mat("glass", tx.facade(r, floors=1, windows=6), scale=(15.0, 3.5))
     scene.box((-3, -9.1, 0.0), (12, -8.9, 3.5), glass, shadow=False)
+    return glass
 
-    # other buildings around
+
+def _campus_buildings(seed: int, scene: Scene, mat: Callable[..., int]) -> None:
+    """The other buildings around the campus."""
     r = stream(seed, "campus/buildings")
     for x0, y0, x1, y1, h, kind in ((38, 4, 58, 34, 12.0, "brick"), (-62, -4, -36, 22, 15.0, "concrete"),
                                     (-40, 75, 10, 95, 22.0, "concrete"), (20, 72, 60, 90, 9.0, "brick"),
@@ -311,7 +336,9 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
         top = mat(kind)
         scene.box((x0 + jx, y0 + jy, 0.0), (x1 + jx, y1 + jy, hh), [fac, fac, fac, fac, top, top])
 
-    # trees, hedges, lamps, racks, benches, bollards -- none within 1.5 m of the grid
+
+def _campus_greenery(seed: int, scene: Scene, mat: Callable[..., int], gx0: float, gy0: float) -> None:
+    """Trees and hedges, none within ``TREE_CLEARANCE`` metres of the grid (origin ``gx0, gy0``)."""
     r = stream(seed, "campus/trees")
     bark_mat = mat("bark", tx.bark(r), scale=0.8)
     leaf_mats = [mat("foliage", tx.foliage(r), scale=1.5) for _ in range(3)]
@@ -332,6 +359,10 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     hedge = mat("foliage", tx.foliage(r), scale=1.0)
     scene.box((-6, 18.5, 0.0), (16, 19.5, 1.1), hedge)
     scene.box((13.5, -3, 0.0), (14.3, 12, 0.9), hedge)
+
+
+def _campus_props(seed: int, scene: Scene, mat: Callable[..., int], glass: int) -> None:
+    """Lamp posts, a bike rack, benches, bollards, a notice board and parked cars."""
     r = stream(seed, "campus/props")
     metal = mat("metal", tx.value_noise(r, lo=0.4, hi=0.7), scale=0.5)
     paint = mat("paint", tx.poster(r, n_shapes=10), fit=True)
@@ -358,15 +389,6 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
         cx = -12 + 6.5 * k + r.uniform(-0.5, 0.5)
         scene.box((cx, 58.5, 0.3), (cx + 4.3, 60.3, 1.0), car)
         scene.box((cx + 1.0, 58.6, 1.0), (cx + 3.2, 60.2, 1.45), glass)
-
-    scene.add_light(DirectionalLight(sun, tuple(np.broadcast_to(np.asarray(sun_irradiance, float), (c,)))))
-    up = np.broadcast_to(np.asarray(sky_irradiance, float), (c,))
-    scene.ambient = Ambient(up=tuple(up), down=tuple(0.4 * up))
-    scene.exposure = exposure
-    return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT,
-                 info={"sun_elevation": float(sun_elevation), "sun_azimuth": float(sun_azimuth),
-                       "channels": channels}, floor_tilt_deg=FLOOR_TILT_DEG)
 
 
 def build_uni(seed: int = 0) -> World:

@@ -1,0 +1,92 @@
+"""Configs of the cleaning robot: ``experiment=cleaning`` and its ``layout=`` group.
+
+Units: metres and grid units as named; angles in degrees only in keys ending ``_deg``; times ISO 8601
+with zone. Checked by :func:`bionav.experiments.configs.experiment_config`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+from omegaconf import II
+
+from bionav.validation import Range, bounded
+
+
+@dataclass
+class CleaningCameraConfig:
+    """The robot's panoramic camera (thesis 7.2: unfolded images of 335 x 40).
+
+    height_m : camera height above the floor. horizon_row : None = the middle row (square pixels).
+    noise : pixel noise std before 8-bit quantisation (seeded per run and capture).
+    """
+
+    width: int = bounded(335, ge=8, le=8192)
+    height: int = bounded(40, ge=2, le=8192)
+    height_m: float = bounded(0.30, gt=0.0, le=100.0)
+    horizon_row: Optional[float] = bounded(None, ge=-100_000.0, le=100_000.0)
+    noise: float = bounded(0.01, ge=0.0, le=1.0)
+
+
+@dataclass
+class CleaningOracleConfig:
+    """``vision=oracle``: home vectors from the true geometry plus Gaussian noise."""
+
+    angle_noise_deg: float = bounded(5.0, ge=0.0, le=180.0)
+    compass_noise_deg: float = bounded(3.0, ge=0.0, le=180.0)
+
+
+@dataclass
+class CleaningConfig:
+    """``experiment=cleaning`` (thesis chapter 7; Gerstmayr et al. 2009): the lane controller.
+
+    runs : runs per configuration (the top-level ``runs`` is a shortcut).
+    vision : ``render`` (panoramas rendered at the true pose, homing with ``cfg.homing``) or ``oracle``.
+    wheel_error : static wheel-speed error, +e left / -e right for the first half of the runs, swapped after.
+    track_width, robot_radius, robot_height : wheel distance, footprint radius, height (m).
+    start_position_std, start_heading_std_deg : manual placement at the start.
+    dt : control period (s). time_limit_factor : a run ends after this multiple of the ideal meander's time.
+    raster_cell, raster_margin : coverage raster (m) and how far it extends beyond the target area.
+    log_images : also log every grabbed image (lossless) to run.mcap.
+    """
+
+    name: str = "cleaning"
+    runs: int = bounded(II("runs"), ge=1, le=100_000)
+    vision: str = bounded("render", choices=("render", "oracle"))
+    world: str = "apartment"
+    world_seed: int = bounded(0, ge=0, le=2**32 - 1)
+    camera: CleaningCameraConfig = field(default_factory=CleaningCameraConfig)
+    oracle: CleaningOracleConfig = field(default_factory=CleaningOracleConfig)
+    wheel_error: float = bounded(0.05, ge=-0.5, le=0.5)
+    track_width: float = bounded(0.30, gt=0.0, le=5.0)
+    robot_radius: float = bounded(0.17, gt=0.0, le=5.0)
+    robot_height: float = bounded(0.35, gt=0.0, le=10.0)
+    start_position_std: float = bounded(0.01, ge=0.0, le=10.0)
+    start_heading_std_deg: float = bounded(1.0, ge=0.0, le=180.0)
+    dt: float = bounded(0.1, gt=0.0, le=10.0)
+    time_limit_factor: float = bounded(3.0, gt=0.0, le=1000.0)
+    raster_cell: float = bounded(0.01, ge=0.001, le=1.0)
+    raster_margin: float = bounded(0.5, ge=0.0, le=100.0)
+    log_images: bool = False
+
+
+@dataclass
+class LayoutConfig:
+    """``layout=<name>`` of ``experiment=cleaning`` (``bionav/conf/layout/*.yaml``: thesis fig. 7.2).
+
+    n_lanes, lane_length, spacing : the meander's lanes (m); unit_width : cleaning width (m).
+    turn : side of the next lane seen from the first lane. wall_offset : first lane's distance from the
+    wall on its right (m). start, start_heading_deg : ``[x, y]`` in the world (m) and heading; None:
+    placed along a wall automatically.
+    """
+
+    name: str = "long_lanes"
+    n_lanes: int = bounded(7, ge=1, le=1000)
+    lane_length: float = bounded(4.0, gt=0.0, le=1000.0)
+    spacing: float = bounded(0.30, gt=0.0, le=100.0)
+    unit_width: float = bounded(0.30, gt=0.0, le=100.0)
+    turn: str = bounded("left", choices=("left", "right"))
+    wall_offset: float = bounded(0.25, ge=0.0, le=100.0)
+    start: Optional[list[float]] = bounded(None, length=2, item=Range(ge=-1e4, le=1e4))
+    start_heading_deg: Optional[float] = bounded(None, ge=-360.0, le=360.0)
