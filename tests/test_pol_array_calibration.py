@@ -60,6 +60,7 @@ def test_known_gains_and_polarizer_offsets_are_recovered_from_simulated_rotation
     assert est.symmetry > 0.95 and est.residual_rms < 0.02
 
 
+@pytest.mark.slow  # over 5 s on two cores
 def test_combined_calibration_decodes_like_the_true_device_and_round_trips_through_json(tmp_path):
     arr, real, log_gain, offset = _device(2)
     ests = []
@@ -146,6 +147,7 @@ def test_the_command_self_calibrates_leaving_one_day_out(tmp_path):
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow  # over 5 s on two cores
 @needs_data
 def test_a_real_daylight_session_self_calibrates():
     from bionav.experiments.configs import RecordingsConfig
@@ -240,6 +242,7 @@ def test_the_replay_of_a_recording_run_applies_its_calibration(tmp_path):
     assert metrics["auto"]["heading_mae_deg"] < 0.5 * metrics["none"]["heading_mae_deg"]
 
 
+@pytest.mark.slow  # over 5 s on two cores
 def test_the_simulated_view_field_gives_the_ring_residual_it_was_fitted_with():
     """``sim_view_sigma`` of experiment=pol_recordings is fitted on the real counts' departure from one shared sky ring
     (median ``residual_rms`` 0.087 over the daylight sessions, docs/polcompass.md): the self-calibration's residual

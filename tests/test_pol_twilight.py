@@ -105,6 +105,7 @@ def test_noise_weighting_leaves_daylight_alone():
     assert np.median(_errors(with_noise, sun, yaw)) < 1.0
 
 
+@pytest.mark.slow  # over 5 s on two cores
 def test_readable_counts_inverts_the_angle_noise_and_the_limit_sits_where_the_counts_run_out():
     from bionav.light.twilight import twilight_zenith_radiance
     from bionav.polcompass.array import UnitEvectors
