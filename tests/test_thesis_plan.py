@@ -70,3 +70,15 @@ def test_run_costs_scale_with_the_size_the_overrides_give():
     assert sky[0].cpu_s - c["skyline_homing_start"] == pytest.approx(4 * (sky[1].cpu_s - c["skyline_homing_start"]))
     cleaning = RunSpec(("experiment=cleaning", "layout=long_lanes", "runs=4"))
     assert plan_mod.task_cpu_s(cleaning).cpu_s == pytest.approx(c["cleaning_start"] + 4 * c["cleaning_run"])
+
+
+def test_a_database_without_a_preset_grid_gets_an_assumed_one_not_an_error():
+    """A folder database knows its grid only once read: the estimate assumes one and says so (the pool
+    sorts every task by its estimate, so an estimate must never stop a run)."""
+    ms = plan_mod.HOME_VECTOR_MS["mfdid"][0] * 64 * 16 / (288 * 50)  # mfdid scales with the pixels
+    nx, ny = plan_mod.ASSUMED_GRID
+    for db in ("folder", "no_such_database"):
+        est = plan_mod.task_cpu_s(RunSpec(("experiment=grid_homing", f"db={db}", "homing=mfdid",
+                                           "db.image_size=[64,16]", "experiment.snapshots=[0,1]")))
+        assert est.cpu_s == pytest.approx(2 * nx * ny * ms / 1e3)
+        assert f"grid of {db} assumed {nx} x {ny}" in est.basis

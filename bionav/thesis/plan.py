@@ -100,11 +100,14 @@ def _ints(text: str) -> list[int]:
     return [int(v) for v in text.strip("[] ").split(",") if v.strip()]
 
 
-def _grid_images(db: str) -> int:
-    from bionav.thesis.items import db_meta
+#: grid assumed for a database whose preset gives no grid shape (a folder: known only once read)
+ASSUMED_GRID = (10, 17)
 
-    nx, ny = db_meta(db)["grid_shape"]
-    return int(nx) * int(ny)
+
+def _grid_images(db: str) -> tuple[int, str]:
+    """Images of ``db``'s grid, and a note when the grid is assumed (:data:`ASSUMED_GRID`)."""
+    nx, ny, note = _grid_shape(db)
+    return nx * ny, note
 
 
 def _size(ov: dict[str, str]) -> tuple[int, int]:
@@ -131,20 +134,20 @@ def task_cpu_s(spec: RunSpec) -> TaskEstimate:
     command = "python -m bionav " + (" -m " if spec.multirun else "") + " ".join(spec.overrides)
     if experiment == "grid_homing":
         db = ov.get("db", "sim_original")
-        n = _grid_images(db)
+        n, assumed = _grid_images(db)
         snaps = len(_ints(ov["experiment.snapshots"])) if "experiment.snapshots" in ov else n
         if block:
             snaps = math.ceil(snaps / block[1])
         ms, basis = _hv_ms(homing, size)
         render = n * size[0] * size[1] / 1e6 * RENDER_S_PER_MPX
-        return TaskEstimate(command, experiment, snaps * n * ms / 1e3, f"{snaps} x {n} home vectors; {basis}",
-                            (db, f"{size[0]}x{size[1]}"), render)
+        return TaskEstimate(command, experiment, snaps * n * ms / 1e3,
+                            f"{snaps} x {n} home vectors{assumed}; {basis}", (db, f"{size[0]}x{size[1]}"), render)
     if experiment == "cross_db":
         family = ov.get("experiment.family", "[sim_original]").strip("[]").split(",")
         stride = int(ov.get("experiment.snapshot_stride", 2))
-        n = _grid_images(family[0].strip())
-        nx, ny = (math.ceil(v / stride) for v in _grid_shape(family[0].strip()))
-        snaps, n_pairs = nx * ny, len(family) ** 2
+        gx, gy, assumed = _grid_shape(family[0].strip())
+        n = gx * gy
+        snaps, n_pairs = math.ceil(gx / stride) * math.ceil(gy / stride), len(family) ** 2
         if block and block[1] <= snaps:  # every n-th snapshot, all pairs (bionav.experiments.cross_db.task_units)
             snaps = math.ceil(snaps / block[1])
         elif block:  # every n-th (snapshot, pair) unit
@@ -153,7 +156,7 @@ def task_cpu_s(spec: RunSpec) -> TaskEstimate:
         pairs = n_pairs * snaps * n
         render = len(family) * n * size[0] * size[1] / 1e6 * RENDER_S_PER_MPX
         return TaskEstimate(command, experiment, pairs * ms / 1e3,
-                            f"{n_pairs} database pairs x {snaps} x {n} home vectors; {basis}",
+                            f"{n_pairs} database pairs x {snaps} x {n} home vectors{assumed}; {basis}",
                             tuple(sorted(family)) + (f"{size[0]}x{size[1]}",), render)
     if experiment == "param_sweep":
         grid = ov.get("experiment.grid", "full")
@@ -205,11 +208,23 @@ def _experiment_defaults(experiment: str) -> dict:
     return OmegaConf.to_container(compose([f"experiment={experiment}"]).experiment, resolve=True)
 
 
-def _grid_shape(db: str) -> tuple[int, int]:
+@functools.lru_cache(maxsize=None)
+def _grid_shape(db: str) -> tuple[int, int, str]:
+    """``db``'s grid shape from its preset, or :data:`ASSUMED_GRID` with a note where the preset
+    gives none (an estimate must never stop a run)."""
+    from bionav.errors import UserError
     from bionav.thesis.items import db_meta
 
-    nx, ny = db_meta(db)["grid_shape"]
-    return int(nx), int(ny)
+    try:
+        shape = db_meta(db)["grid_shape"]
+    except (UserError, LookupError, ValueError, OSError, ImportError) as exc:  # e.g. no such preset
+        shape, why = None, f"{type(exc).__name__}"
+    else:
+        why = "no grid_shape in its preset"
+    if not shape:
+        nx, ny = ASSUMED_GRID
+        return nx, ny, f" (grid of {db} assumed {nx} x {ny}: {why})"
+    return int(shape[0]), int(shape[1]), ""
 
 
 def make_plan(specs: Iterable[RunSpec], *, nodes: int, cores: int) -> dict[str, Any]:
