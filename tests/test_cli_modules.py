@@ -26,6 +26,25 @@ def test_fake_server_prints_one_override_per_device_and_stops_on_ctrl_c(scene, o
     assert proc.returncode == 0 and "Traceback" not in err
 
 
+def test_fake_server_stops_on_ctrl_c_even_when_started_with_sigint_ignored():
+    """A shell running a script's background job hands it SIGINT ignored (and Python keeps that):
+    the server takes Ctrl-C back, so that it still stops."""
+    proc = subprocess.Popen([sys.executable, "-m", "bionav.plugins.sensors.fakes", "--scene", "polcompass"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+    try:
+        assert "serving" in proc.stderr.readline()
+    finally:
+        proc.send_signal(signal.SIGINT)
+        try:
+            _, err = proc.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+            raise AssertionError("the fake server ignored Ctrl-C") from None
+    assert proc.returncode == 0 and "Traceback" not in err
+
+
 def test_replay_of_a_missing_log_is_one_clear_error(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "bionav.experiments.cleaning_replay", str(tmp_path / "nowhere")],
                           capture_output=True, text=True)

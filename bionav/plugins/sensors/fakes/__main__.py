@@ -11,6 +11,7 @@ printed as the override that selects it (``sensor.port=...``,
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 
@@ -79,6 +80,9 @@ def main(argv: list[str] | None = None) -> int:
     spectral.add_argument("--cloud-optical-depth", type=float, default=30.0)
     args = parser.parse_args(argv)
 
+    # Ctrl-C (SIGINT) is how this server stops: started from a script in the background, a shell
+    # may hand it SIGINT ignored, and Python keeps it so; take it back
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     fakes = (_spectral_fakes if args.scene == "spectral" else _polcompass_fakes)(args)
     try:
         for label, fake in fakes.items():
