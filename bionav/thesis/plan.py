@@ -96,18 +96,17 @@ def _overrides(spec: RunSpec) -> dict[str, str]:
     return dict(o.lstrip("+~").partition("=")[::2] for o in spec.overrides)
 
 
+def _items(text: str) -> list[str]:
+    """The items of a list override value such as ``[a,b]`` or ``'[a, b]'``."""
+    return [v.strip() for v in text.strip("[] '").split(",") if v.strip()]
+
+
 def _ints(text: str) -> list[int]:
-    return [int(v) for v in text.strip("[] ").split(",") if v.strip()]
+    return [int(v) for v in _items(text)]
 
 
 #: grid assumed for a database whose preset gives no grid shape (a folder: known only once read)
 ASSUMED_GRID = (10, 17)
-
-
-def _grid_images(db: str) -> tuple[int, str]:
-    """Images of ``db``'s grid, and a note when the grid is assumed (:data:`ASSUMED_GRID`)."""
-    nx, ny, note = _grid_shape(db)
-    return nx * ny, note
 
 
 def _size(ov: dict[str, str]) -> tuple[int, int]:
@@ -134,7 +133,8 @@ def task_cpu_s(spec: RunSpec) -> TaskEstimate:
     command = "python -m bionav " + (" -m " if spec.multirun else "") + " ".join(spec.overrides)
     if experiment == "grid_homing":
         db = ov.get("db", "sim_original")
-        n, assumed = _grid_images(db)
+        gx, gy, assumed = _grid_shape(db)
+        n = gx * gy
         snaps = len(_ints(ov["experiment.snapshots"])) if "experiment.snapshots" in ov else n
         if block:
             snaps = math.ceil(snaps / block[1])
@@ -143,9 +143,9 @@ def task_cpu_s(spec: RunSpec) -> TaskEstimate:
         return TaskEstimate(command, experiment, snaps * n * ms / 1e3,
                             f"{snaps} x {n} home vectors{assumed}; {basis}", (db, f"{size[0]}x{size[1]}"), render)
     if experiment == "cross_db":
-        family = ov.get("experiment.family", "[sim_original]").strip("[]").split(",")
+        family = _items(ov.get("experiment.family", "[sim_original]"))
         stride = int(ov.get("experiment.snapshot_stride", 2))
-        gx, gy, assumed = _grid_shape(family[0].strip())
+        gx, gy, assumed = _grid_shape(family[0])
         n = gx * gy
         snaps, n_pairs = math.ceil(gx / stride) * math.ceil(gy / stride), len(family) ** 2
         if block and block[1] <= snaps:  # every n-th snapshot, all pairs (bionav.experiments.cross_db.task_units)
@@ -186,16 +186,13 @@ def _scaled_run_cpu_s(experiment: str, ov: dict[str, str]) -> tuple[float, str] 
         (s0, b0), (s1, b1) = RUN_CPU_S["contrast_lda_start"], RUN_CPU_S["contrast_lda_resample"]
         return s0 + n * s1, f"{n} resamples; {b0}, {b1}"
     if experiment == "contrast_scan":
-        given = ov.get("experiment.times")
-        n_times = len([t for t in given.strip("[] '").split(",") if t.strip()]) if given else len(d["times"])
+        n_times = len(_items(ov["experiment.times"])) if "experiment.times" in ov else len(d["times"])
         n_dir = int(ov.get("experiment.n_pan", d["n_pan"])) * int(ov.get("experiment.n_tilt", d["n_tilt"]))
         (s0, b0), (s1, b1) = RUN_CPU_S["contrast_scan_start"], RUN_CPU_S["contrast_scan_direction"]
         return s0 + n_times * n_dir * s1, f"{n_times} scans x {n_dir} directions; {b0}, {b1}"
-    if experiment == "skyline_homing":
-        stride = int(ov.get("experiment.snapshot_stride", d["snapshot_stride"]))
-        (s0, b0), (s1, b1) = RUN_CPU_S["skyline_homing_start"], RUN_CPU_S["skyline_homing_stride4"]
-        return s0 + s1 * (4 / stride) ** 2, f"snapshot_stride={stride}; {b0}, {b1}"
-    return None
+    stride = int(ov.get("experiment.snapshot_stride", d["snapshot_stride"]))  # skyline_homing
+    (s0, b0), (s1, b1) = RUN_CPU_S["skyline_homing_start"], RUN_CPU_S["skyline_homing_stride4"]
+    return s0 + s1 * (4 / stride) ** 2, f"snapshot_stride={stride}; {b0}, {b1}"
 
 
 @functools.lru_cache(maxsize=None)
