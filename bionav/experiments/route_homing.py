@@ -49,7 +49,6 @@ along each route, heading-error maps).
 
 from __future__ import annotations
 
-import csv
 import math
 import zlib
 from dataclasses import dataclass
@@ -60,6 +59,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
 from bionav.experiments.configs import RouteHomingConfig, experiment_config
+from bionav.files import write_csv_atomic
 from bionav.geometry import angular_difference, wrap_angle
 
 #: the agent's step of each protocol when ``experiment.agent_step_m`` is null, metres
@@ -355,11 +355,11 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
 
 def write_rows(path, rows: list[dict], keys: list[str]) -> None:
     """One CSV row per dict (floats with 6 decimals; keys not in ``keys`` left out)."""
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (f"{v:.6f}" if isinstance(v, float) else v) for k, v in r.items()})
+    write_csv_atomic(path, keys, ([_cell(r.get(k, "")) for k in keys] for r in rows))
+
+
+def _cell(value: Any) -> Any:
+    return f"{value:.6f}" if isinstance(value, float) else value
 
 
 def _write_csv(path, rows):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import base64
-import csv
 import html
 import re
 from collections import Counter
@@ -11,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
+from bionav.files import write_csv_atomic
 from bionav.thesis.outcome import MISSING, VERDICT_RULE, Outcome, fmt
 from bionav.thesis.presets import Preset
 
@@ -55,10 +55,8 @@ def csv_rows(sections: Sequence[Section]) -> list[dict[str, str]]:
 
 
 def write_csv(path: Path, sections: Sequence[Section]) -> None:
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(CSV_COLUMNS))
-        w.writeheader()
-        w.writerows(csv_rows(sections))
+    """Write ``items.csv``: one row per item, check and value (:data:`CSV_COLUMNS`), atomically."""
+    write_csv_atomic(path, CSV_COLUMNS, ([row.get(c, "") for c in CSV_COLUMNS] for row in csv_rows(sections)))
 
 
 def verdict_counts(sections: Sequence[Section]) -> Counter:
