@@ -123,7 +123,7 @@ def test_bench_sweep_with_more_workers_than_cpus(tmp_path):
 
     from helpers import write_tiny_folder
 
-    from bionav.experiments.common import usable_cpus
+    from bionav.machine import usable_cpus
 
     folder = write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
     cpus = usable_cpus()

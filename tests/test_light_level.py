@@ -12,7 +12,7 @@ from bionav.db.camera import (
     camera_setup,
     noise_rng,
     pose_error_config_for,
-    sensor_frame,
+    raw_frame_from_radiance,
     unfold_frame,
 )
 from bionav.db.config import CameraConfig
@@ -38,7 +38,7 @@ def test_the_camera_gets_the_radiance_times_the_light_level():
     setup = camera_setup(cam, geometry)
     for k, (i, j) in enumerate(positions):  # re-rendered by hand: radiance x exposure x light level
         rad = render_raw_frame(world.scene, position=world.cell_position(i, j), heading=0.0, layout=setup.layout)
-        raw = sensor_frame(rad * 0.3, setup, rng=noise_rng(0, (i, j)))
+        raw = raw_frame_from_radiance(rad * 0.3, setup, rng=noise_rng(0, (i, j)))
         assert np.array_equal(unfold_frame(raw, setup, geometry), imgs[k])
     bright, _, _ = camera_images(dataclasses.replace(world, light_level=1.0), positions, geometry, camera=cam,
                                  pose_error=STILL, seed=0)

@@ -5,9 +5,9 @@ import pytest
 
 from bionav.db.synthetic import (
     SYNTHETIC_DATABASES,
-    available_databases,
     get_spec,
     synthetic_database,
+    synthetic_database_names,
 )
 from bionav.errors import UserError
 from bionav.files import cache_key
@@ -131,7 +131,7 @@ def test_same_seed_same_world_other_seed_other_world():
 def test_unknown_name_lists_the_valid_ones(tmp_path):
     with pytest.raises(UserError) as e:
         synthetic_database("sim_nowhere", cache_dir=tmp_path)
-    for n in available_databases():
+    for n in synthetic_database_names():
         assert n in str(e.value)
 
 

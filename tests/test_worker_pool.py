@@ -1,6 +1,7 @@
 """experiments.common.worker_pool: processes capped at the CPUs, numba threads shared out (issue 29)."""
 
-from bionav.experiments.common import usable_cpus, worker_pool
+from bionav.experiments.common import worker_pool
+from bionav.machine import usable_cpus
 
 
 def _numba_threads(_):

@@ -12,7 +12,6 @@ and wall time, in ms per home vector unless the key says ``_s``.
 from __future__ import annotations
 
 import os
-import platform
 import time
 
 import numpy as np
@@ -20,6 +19,7 @@ import numpy as np
 from bionav.bench.background_load import start_load, stop_load
 from bionav.bench.pairs import MINWARPING_VARIANTS, plugin
 from bionav.errors import UserError
+from bionav.machine import machine_label
 
 #: timed over a whole grid (``--method sift``), not per pair of the pillar room; not part of ``all``
 GRID_METHODS = ("sift",)
@@ -92,7 +92,7 @@ def grid_rows(args, load_procs_n: int) -> list[dict]:
                 "rounds": args.grid_rounds,
                 "background_load": load_procs_n,
                 "loadavg_1min": [round(load_before, 2), round(load_after, 2)],
-                "machine": f"{platform.machine()} {os.cpu_count()} cpus",
+                "machine": machine_label(),
                 **numba_target(),
             })
     return rows
@@ -189,7 +189,7 @@ def _sift_variant_rows(args, variant: str) -> list[dict]:
             "rounds": args.repeat,
             "background_load": args.background_load,
             "loadavg_1min": [round(v, 2) for v in loadavg],
-            "machine": f"{platform.machine()} {os.cpu_count()} cpus",
+            "machine": machine_label(),
             **numba_target(),
         })
     return rows

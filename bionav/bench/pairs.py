@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import os
-import platform
 import subprocess
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -23,6 +22,7 @@ import numpy as np
 
 from bionav.bench.background_load import start_load, stop_load
 from bionav.errors import UserError
+from bionav.machine import machine_label
 
 METHODS = ("minwarping", "warping2d", "warping1d", "hiss")
 
@@ -145,7 +145,7 @@ def pair_rows(args, batch: int) -> list[dict]:
     target = numba_target()
     common = {"threads": args.threads, "rounds": args.repeat, "home_vectors_per_round": batch, "pairs": args.pairs,
               "background_load": args.background_load, "loadavg_1min": [round(load_before, 2), round(load_after, 2)],
-              "machine": f"{platform.machine()} {os.cpu_count()} cpus", **target}
+              "machine": machine_label(), **target}
     return [_pair_row(run, args, common, reference) for run in runs]
 
 

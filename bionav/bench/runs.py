@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import json
 import os
-import platform
 import resource
 import subprocess
 import sys
@@ -28,6 +27,7 @@ import time
 from pathlib import Path
 
 from bionav.errors import UserError
+from bionav.machine import machine_label
 
 RUN_METHODS = ("sweep", "cleaning")
 #: at most this many worker processes (each a Python process with its own numba and images)
@@ -123,7 +123,7 @@ def run_benchmark(args) -> list[dict]:
     """Rows (one dict) of the whole-run benchmark ``args.method``."""
     from bionav.bench.cpu import numba_target
 
-    machine = f"{platform.machine()} {os.cpu_count()} cpus"
+    machine = machine_label()
     with tempfile.TemporaryDirectory(prefix="bionav-bench-") as tmp:
         tmp = Path(tmp)
         env = dict(os.environ)

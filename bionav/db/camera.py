@@ -288,7 +288,7 @@ def camera_setup(camera: CameraConfig, geometry: PanoramaGeometry, *, native_siz
                        psf, float(camera.full_well_e) / scale ** 2, float(camera.read_noise_e) / scale)
 
 
-def sensor_frame(radiance: np.ndarray, setup: CameraSetup, *, rng: np.random.Generator) -> np.ndarray:
+def raw_frame_from_radiance(radiance: np.ndarray, setup: CameraSetup, *, rng: np.random.Generator) -> np.ndarray:
     """The 8-bit raw frame a sensor makes of a raw radiance frame (steps 1-4 of the module docstring).
 
     Parameters
@@ -501,7 +501,7 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
             radiance *= float(world.scene.exposure)
         if light_level != 1.0:  # a dim scene (the night hall): the automatic exposure has to make up for it
             radiance *= light_level
-        raw = sensor_frame(radiance, setup, rng=noise_rng(seed, (i, j)))
+        raw = raw_frame_from_radiance(radiance, setup, rng=noise_rng(seed, (i, j)))
         out[k] = unfold_frame(raw, setup, geometry, tilt=tilts[k])
         if raws is not None:
             raws[k] = raw

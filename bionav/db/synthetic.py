@@ -162,7 +162,7 @@ SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
 }
 
 
-def available_databases() -> list[str]:
+def synthetic_database_names() -> list[str]:
     """Names of the synthetic stand-ins."""
     return sorted(SYNTHETIC_DATABASES)
 
@@ -172,7 +172,7 @@ def get_spec(name: str) -> SyntheticSpec:
     if name not in SYNTHETIC_DATABASES:
         raise UserError(
             f"Unknown synthetic database {name!r}. Available synthetic databases: "
-            f"{', '.join(available_databases())}. Choose one of them with db=<name>."
+            f"{', '.join(synthetic_database_names())}. Choose one of them with db=<name>."
         )
     return SYNTHETIC_DATABASES[name]
 
@@ -242,7 +242,7 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     Parameters
     ----------
     name : str
-        One of :func:`available_databases` (``sim_original`` ...).
+        One of :func:`synthetic_database_names` (``sim_original`` ...).
     image_size : (int, int), optional
         ``(W, H)``; the images are rendered directly at this size with the
         mirror's field of view (:meth:`PanoramaGeometry.resized`). Default

@@ -135,7 +135,7 @@ def rendered_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
 
 # ---------------------------------------------------------------------------- runs
 @dataclass
-class RunResult:
+class CleaningRun:
     """One simulated run and its analysis."""
 
     run: int
@@ -177,7 +177,7 @@ def true_lane_distances(episode, fixes: list, captures_true: dict[int, tuple]) -
 
 
 def _simulate_run(cfg: DictConfig, world: CleaningWorld, plan: LanePlan, make_controller, homing, k: int,
-                  seeds, error: tuple[float, float], log, offset_ns: int) -> tuple[RunResult, int]:
+                  seeds, error: tuple[float, float], log, offset_ns: int) -> tuple[CleaningRun, int]:
     """Run ``k`` of :func:`simulate`, its ticks written to ``log`` from ``offset_ns`` on.
 
     Returns the result and the log time of its last tick.
@@ -235,7 +235,7 @@ def _simulate_run(cfg: DictConfig, world: CleaningWorld, plan: LanePlan, make_co
     fixes = [(t, i["fix"]) for t, i in episode.info if "fix" in i]
     accepted = [(t, f) for t, f in fixes if f.get("accepted")]
     truth = true_lane_distances(episode, accepted, captures_true) if accepted else np.zeros(0)
-    return RunResult(k, error, episode, counts, fractions, fixes, truth, seconds), recorder.last_time_ns
+    return CleaningRun(k, error, episode, counts, fractions, fixes, truth, seconds), recorder.last_time_ns
 
 
 class _BufferLog:
@@ -275,7 +275,7 @@ def _init_worker(cfg_container: dict) -> None:
     _WORKER.update(cfg=cfg, plan=plan, world=world, make_controller=lambda: cls(config), homing=homing)
 
 
-def _worker_run(job: tuple[int, tuple, tuple]) -> tuple[RunResult, list, int]:
+def _worker_run(job: tuple[int, tuple, tuple]) -> tuple[CleaningRun, list, int]:
     k, seeds, error = job
     w = _WORKER
     log = _BufferLog()
@@ -285,7 +285,7 @@ def _worker_run(job: tuple[int, tuple, tuple]) -> tuple[RunResult, list, int]:
 
 
 def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_controller, homing,
-             *, workers: int = 1) -> list[RunResult]:
+             *, workers: int = 1) -> list[CleaningRun]:
     """Run ``cfg.experiment.runs`` simulated cleaning runs, logging each to ``ctx.log``.
 
     With ``workers > 1`` the runs are simulated in that many processes (each
@@ -306,7 +306,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
     offset_ns = int(getattr(ctx.log, "start_ns", None) or time.time_ns())
     workers = max(1, min(int(workers), runs))
 
-    def finish(result: RunResult, last_ns: int) -> None:
+    def finish(result: CleaningRun, last_ns: int) -> None:
         nonlocal offset_ns
         fixes = result.fixes
         accepted = [f for _, f in fixes if f.get("accepted")]
@@ -337,7 +337,7 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
     return results
 
 
-def summarise(results: list[RunResult], plan: LanePlan, ideal: dict) -> dict[str, Any]:
+def summarise(results: list[CleaningRun], plan: LanePlan, ideal: dict) -> dict[str, Any]:
     """Flat metrics: means (and stds) over runs plus triangulation statistics."""
     out: dict[str, Any] = {}
     for key in ("coverage", "overlap", "uncovered"):
@@ -362,7 +362,7 @@ def summarise(results: list[RunResult], plan: LanePlan, ideal: dict) -> dict[str
     return out
 
 
-def write_runs_csv(path, results: list[RunResult]) -> None:
+def write_runs_csv(path, results: list[CleaningRun]) -> None:
     """``cleaning_runs.csv``: one row per run."""
     rows = []
     for r in results:

@@ -11,6 +11,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.files import user_path
+from bionav.machine import usable_cpus
 
 
 def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageDatabase:
@@ -37,16 +38,6 @@ def load_configured_database(cfg: DictConfig, node: Any | None = None) -> ImageD
             "(and check db.grid_shape and the warnings about skipped files)."
         )
     return db
-
-
-def usable_cpus() -> int:
-    """CPUs this process may run on (its affinity mask; ``os.cpu_count()`` where there is none)."""
-    import os
-
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):  # pragma: no cover - platforms without affinity
-        return max(1, os.cpu_count() or 1)
 
 
 def _init_pool_worker(numba_threads: int, initializer, initargs: tuple) -> None:

@@ -378,7 +378,8 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
     Stand-ins not yet in the cache are rendered first, one size per task.
     """
     from bionav.config import plugin_config
-    from bionav.experiments.common import usable_cpus, worker_pool
+    from bionav.experiments.common import worker_pool
+    from bionav.machine import usable_cpus
     from bionav.plugins.signatures import signature_class
     from bionav.report.ranking import write_parameter_report
 

@@ -9,7 +9,7 @@ from typing import Any, Iterable, Mapping, Sequence
 PREFERRED = ("status", "aae", "mae", "rr", "compass_aae", "n_images", "n_pairs", "ms_per_home_vector")
 
 
-def fmt(value: Any) -> str:
+def format_cell(value: Any) -> str:
     """Format one cell: floats with 4 significant decimals, None as empty."""
     if value is None:
         return ""
@@ -43,7 +43,7 @@ def markdown_table(rows: Sequence[Mapping[str, Any]], columns: Sequence[str]) ->
     """A GitHub-flavoured Markdown table (cells with ``|`` or line breaks escaped)."""
     head = "| " + " | ".join(_cell(str(c)) for c in columns) + " |"
     sep = "|" + "|".join("---" for _ in columns) + "|"
-    body = ["| " + " | ".join(_cell(fmt(r.get(c))) for c in columns) + " |" for r in rows]
+    body = ["| " + " | ".join(_cell(format_cell(r.get(c))) for c in columns) + " |" for r in rows]
     return "\n".join([head, sep, *body])
 
 

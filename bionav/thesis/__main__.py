@@ -108,7 +108,7 @@ def run(args) -> int:
         raise UserError(f"unknown --preset {args.preset!r}; choose one of {', '.join(PUBLIC_PRESETS)}.")
     preset = PRESETS[args.preset]
     if args.jobs is not None and not 1 <= args.jobs <= 4096:
-        from bionav.thesis.runs import usable_cpus
+        from bionav.machine import usable_cpus
 
         raise UserError(f"--jobs {args.jobs} is out of range; give 1 (one run after the other) up to the number "
                         f"of runs to execute at once, e.g. --jobs {usable_cpus()}.")
@@ -137,11 +137,12 @@ def run(args) -> int:
 
 
 def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> int:
+    from bionav.machine import usable_cpus
     from bionav.thesis.items import Context
     from bionav.thesis.outcome import Outcome
     from bionav.thesis.reference import load_reference
     from bionav.thesis.report import Section, markdown_to_html, report_markdown, verdict_counts, write_csv
-    from bionav.thesis.runs import Runner, tool_env, usable_cpus
+    from bionav.thesis.runs import Runner, tool_env
 
     ref_all = load_reference()
     specs = {it.id: it.runs(preset) for it in items}
@@ -207,8 +208,8 @@ def _plan(args, items, preset) -> int:
     """``--plan``: the preset's tasks, their CPU, the critical path and the wall time; runs nothing."""
     import json
 
+    from bionav.machine import usable_cpus
     from bionav.thesis.plan import format_plan, plan_for
-    from bionav.thesis.runs import usable_cpus
 
     specs = [s for it in items for s in it.runs(preset)]
     plan = plan_for(specs, nodes=args.nodes, cores=args.cores or usable_cpus())

@@ -27,6 +27,8 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import yaml
 
+from bionav.machine import usable_cpus
+
 log = logging.getLogger(__name__)
 
 #: override keys that do not change a run's results (ignored when matching runs)
@@ -527,14 +529,6 @@ class Runner:
                 metrics = _sweep_metrics(d) if spec.multirun else read_json(d / "metrics.json")
                 results[spec.key] = RunResult(spec, d, metrics)
         return results
-
-
-def usable_cpus() -> int:
-    """CPUs this process may run on (its affinity mask, e.g. a SLURM allocation), at least 1."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):  # not Linux
-        return max(1, os.cpu_count() or 1)
 
 
 def render_key(spec: RunSpec) -> tuple[str, ...]:

@@ -1,0 +1,23 @@
+"""What this process may use of the machine it runs on."""
+
+from __future__ import annotations
+
+import os
+import platform
+
+
+def usable_cpus() -> int:
+    """CPUs this process may run on: its affinity mask (e.g. a SLURM allocation or ``taskset``),
+    ``os.cpu_count()`` on platforms without one; at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # pragma: no cover - platforms without affinity
+        return max(1, os.cpu_count() or 1)
+
+
+def machine_label() -> str:
+    """The machine as benchmark records name it: architecture and CPU count, e.g. ``"x86_64 16 cpus"``."""
+    return f"{platform.machine()} {os.cpu_count()} cpus"
+
+
+__all__ = ["machine_label", "usable_cpus"]
