@@ -6,7 +6,6 @@ composes its configs through Hydra's own application machinery instead.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,11 +18,6 @@ def available_databases() -> list[str]:
     from bionav.config import config_options
 
     return config_options("db")
-
-
-def default_data_dir() -> Path:
-    """``$BIONAV_DATA`` if set, else ``./data``."""
-    return Path(os.environ.get("BIONAV_DATA") or "./data")
 
 
 @dataclass

@@ -165,21 +165,6 @@ def read_image(path: Path) -> np.ndarray:
     return to_grey_float(image, maxval=maxval)
 
 
-def image_size_of(path: Path) -> tuple[int, int] | None:
-    """``(W, H)`` of an image from its header without decoding the pixels (PNG, PNM, BMP), else None."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(64)
-    except OSError:
-        return None
-    if head.startswith(b"\x89PNG\r\n\x1a\n") and len(head) >= 24:
-        return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
-    match = _PNM_HEADER.match(head)
-    if match is not None:
-        return int(match.group(2)), int(match.group(3))
-    return None
-
-
 def write_image(path: Path, image: np.ndarray, *, bits: int = 8) -> None:
     """Write a float grey image in ``[0, 1]`` as an 8- or 16-bit file (format from the suffix).
 
