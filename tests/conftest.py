@@ -39,3 +39,19 @@ def fake_distributions(tmp_path, monkeypatch):
     for name in list(sys.modules):
         if name.startswith("fakeplug"):
             del sys.modules[name]
+
+
+CONTROLLERS = {
+    "triangulation": "bionav.plugins.controllers.triangulation:TriangulationController",
+    "odometry": "bionav.plugins.controllers.odometry:OdometryController",
+    "random": "bionav.plugins.controllers.random_bounce:RandomController",
+}
+
+
+@pytest.fixture
+def controllers(fake_distributions):
+    """The built-in controllers, registered by a stand-in distribution when bionav is not installed."""
+    from bionav import registry
+
+    if not set(CONTROLLERS) <= set(registry.entry_points_of("controller")):
+        fake_distributions("bionav-controllers-dev", {"bionav.controllers": CONTROLLERS})

@@ -9,6 +9,9 @@ import sys
 import time
 from pathlib import Path
 
+#: the checkout this test suite belongs to
+REPO = Path(__file__).resolve().parents[1]
+
 
 def run_bionav(*args: str, cwd: Path, env: dict | None = None, module: str = "bionav", timeout: float = 600):
     """Run ``python -m <module> args`` and return the CompletedProcess (text mode), with ``.seconds`` (wall time)."""
@@ -124,4 +127,45 @@ def source_copy(src: Path, dst: Path) -> Path:
 def external_data() -> Path:
     """Real data written by others: ``$BIONAV_EXTERNAL_DATA``, else ``../shared/data`` beside the checkout."""
     env = os.environ.get("BIONAV_EXTERNAL_DATA")
-    return Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "data"
+    return Path(env) if env else REPO.parent / "shared" / "data"
+
+
+def cleaning_config(controller: str, **experiment):
+    """experiment=cleaning on 3 lanes of 1.2 m, oracle vision, 2 runs, seed 0, as a plain config."""
+    from omegaconf import OmegaConf
+
+    conf = REPO / "bionav" / "conf"
+    exp = OmegaConf.load(conf / "experiment" / "cleaning.yaml")
+    del exp["defaults"]
+    layout = OmegaConf.load(conf / "layout" / "long_lanes.yaml")
+    layout.n_lanes, layout.lane_length = 3, 1.2
+    cfg = OmegaConf.merge(exp, {"layout": layout, "controller": {"name": controller}, "seed": 0, "runs": 2,
+                                "experiment": {"vision": "oracle", **experiment}})
+    return cfg
+
+
+def round_room(grid_shape=(5, 4), missing=((2, 1),), width=72, height=12):
+    """Panoramas in a round room (radius 6 cells) with a textured wall, floor and ceiling: real parallax."""
+    import numpy as np
+
+    from bionav.db.database import ImageDatabase
+    from bionav.geometry import PanoramaGeometry
+
+    geometry = PanoramaGeometry.square_pixels(width, height)
+    theta = geometry.column_azimuths()
+    elev = geometry.row_elevations()
+    centre = np.array([(grid_shape[0] - 1) / 2, (grid_shape[1] - 1) / 2])
+    cells = [(x, y) for x in range(grid_shape[0]) for y in range(grid_shape[1]) if (x, y) not in missing]
+    images = []
+    for cell in cells:
+        p = np.asarray(cell, float) - centre
+        d = np.stack([np.cos(theta), np.sin(theta)], 1)
+        b = d @ p
+        t = -b + np.sqrt(b * b - (p @ p - 36.0))  # distance to the wall along each column
+        hit = p + t[:, None] * d
+        phi = np.arctan2(hit[:, 1], hit[:, 0])
+        wall = 0.5 + 0.25 * np.sin(5 * phi) + 0.12 * np.sin(13 * phi + 1.0)
+        z = np.tan(elev)[:, None] * t[None, :]  # height of the hit point relative to the camera
+        img = np.where(z > 1.5, 0.9, np.where(z < -0.8, 0.15, wall[None, :]))
+        images.append(np.rint(img * 255) / 255)
+    return ImageDatabase("round_room", np.asarray(images, np.float32), cells, grid_shape, geometry, spacing_m=0.3)

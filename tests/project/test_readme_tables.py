@@ -9,7 +9,7 @@ from helpers import run_bionav
 
 from bionav.registry import CONFIG_GROUP, GROUPS, SCHEMA_GROUP
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+README = Path(__file__).resolve().parents[2] / "README.md"
 
 
 def _help_groups(tmp_path) -> dict[str, list[str]]:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import round_room
 
 from bionav.db.compose import compose_database
 from bionav.db.database import ImageDatabase
@@ -12,29 +13,6 @@ from bionav.db.loading import load_database
 from bionav.evaluation.agent import evaluate_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix
-from bionav.geometry import PanoramaGeometry
-
-
-def round_room(grid_shape=(5, 4), missing=((2, 1),), width=72, height=12) -> ImageDatabase:
-    """Panoramas in a round room (radius 6 cells) with a textured wall, floor and ceiling: real parallax."""
-    geometry = PanoramaGeometry.square_pixels(width, height)
-    theta = geometry.column_azimuths()
-    elev = geometry.row_elevations()
-    centre = np.array([(grid_shape[0] - 1) / 2, (grid_shape[1] - 1) / 2])
-    cells = [(x, y) for x in range(grid_shape[0]) for y in range(grid_shape[1]) if (x, y) not in missing]
-    images = []
-    for cell in cells:
-        p = np.asarray(cell, float) - centre
-        d = np.stack([np.cos(theta), np.sin(theta)], 1)
-        b = d @ p
-        t = -b + np.sqrt(b * b - (p @ p - 36.0))  # distance to the wall along each column
-        hit = p + t[:, None] * d
-        phi = np.arctan2(hit[:, 1], hit[:, 0])
-        wall = 0.5 + 0.25 * np.sin(5 * phi) + 0.12 * np.sin(13 * phi + 1.0)
-        z = np.tan(elev)[:, None] * t[None, :]  # height of the hit point relative to the camera
-        img = np.where(z > 1.5, 0.9, np.where(z < -0.8, 0.15, wall[None, :]))
-        images.append(np.rint(img * 255) / 255)
-    return ImageDatabase("round_room", np.asarray(images, np.float32), cells, grid_shape, geometry, spacing_m=0.3)
 
 
 def measures_of(db: ImageDatabase, snapshot_index=None):

@@ -18,7 +18,7 @@ from bionav.db.export import export_database
 from bionav.db.loading import load_database
 from bionav.geometry import PanoramaGeometry
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def make_db(*, quantised: bool = True, seed: int = 0) -> ImageDatabase:

@@ -22,7 +22,7 @@ from bionav.light.measured_spectra import (
 )
 from bionav.spectral.sensor_model import LogSensorModel
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 EXTERNAL = Path(os.environ.get("BIONAV_EXTERNAL_DATA", REPO.parent / "shared" / "data"))
 BUMBLEVIEW = EXTERNAL / "bumbleview"
 needs_bumbleview = pytest.mark.skipif(not (BUMBLEVIEW / "xmpl_data.csv").is_file(),

@@ -12,8 +12,8 @@ from bionav.db.camera import (
     camera_setup,
     noise_rng,
     pose_error_config_for,
+    raw_frame_from_radiance,
     resolve_pose_error,
-    sensor_frame,
     tilt_offsets,
     unfold_frame,
 )
@@ -53,7 +53,7 @@ def _edge_panorama(tilt) -> tuple[np.ndarray, PanoramaGeometry]:
     geometry = PanoramaGeometry.square_pixels(561, 81)
     setup = camera_setup(CameraConfig(**CLEAN), geometry, tilt_margin=float(np.abs(tilt).sum()))
     radiance = render_raw_frame(_edge_scene(), position=(0.0, 0.0, 0.0), heading=0.0, layout=setup.layout)
-    raw = sensor_frame(radiance, setup, rng=np.random.default_rng(0))
+    raw = raw_frame_from_radiance(radiance, setup, rng=np.random.default_rng(0))
     return _edge_elevation(unfold_frame(raw, setup, geometry, tilt=tilt)[:, :, 0] / 255.0, geometry), geometry
 
 
@@ -116,6 +116,6 @@ def test_camera_images_apply_the_drawn_tilt():
     setup = camera_setup(cam, geometry, tilt_margin=float(np.abs(poses["tilts"]).sum(axis=1).max()))
     for k, (i, j) in enumerate(positions):
         rad = render_raw_frame(world.scene, position=world.cell_position(i, j), heading=0.0, layout=setup.layout)
-        raw = sensor_frame(rad, setup, rng=noise_rng(0, (i, j)))
+        raw = raw_frame_from_radiance(rad, setup, rng=noise_rng(0, (i, j)))
         assert np.array_equal(unfold_frame(raw, setup, geometry, tilt=poses["tilts"][k]), imgs[k])
         assert not np.array_equal(unfold_frame(raw, setup, geometry), imgs[k])

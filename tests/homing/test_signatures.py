@@ -196,7 +196,7 @@ def test_rotation_invariance_under_column_roll(name):
 
 def test_all_nineteen_registered_with_config_and_entry_points():
     assert len(SIGNATURE_NAMES) == 19
-    data = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    data = tomllib.loads((Path(__file__).resolve().parents[2] / "pyproject.toml").read_text())
     eps = data["project"]["entry-points"]["bionav.signatures"]
     for name in SIGNATURE_NAMES:
         cls = builtin_signature_class(name)

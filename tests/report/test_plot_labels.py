@@ -6,7 +6,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from test_cleaning_experiment import controllers  # noqa: F401  (fixture)
 
 from bionav.report.figures import pyplot
 
@@ -124,7 +123,7 @@ def test_thesis_bar_charts_have_a_y_label_and_a_legend_beside_the_bars(tmp_path,
 
 @pytest.mark.usefixtures("controllers")
 def test_cleaning_legends_stand_beside_or_below_the_maps(tmp_path, figures):
-    from test_cleaning_experiment import config
+    from helpers import cleaning_config as config
 
     from bionav.experiments.runner import run_experiment
 

@@ -10,8 +10,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from helpers import run_bionav
-from test_db_roundtrip_homing import round_room
+from helpers import round_room, run_bionav
 
 from bionav.db.export import export_database
 from bionav.thesis.runs import Runner, RunSpec, index_runs, tool_env

@@ -4,38 +4,13 @@ import json
 from pathlib import Path
 
 import pytest
+from helpers import cleaning_config as config
 from omegaconf import OmegaConf
 
 from bionav.experiments.runner import run_experiment
 from bionav.logs.reader import read_messages
 
-CONF = Path(__file__).resolve().parents[1] / "bionav" / "conf"
-CONTROLLERS = {
-    "triangulation": "bionav.plugins.controllers.triangulation:TriangulationController",
-    "odometry": "bionav.plugins.controllers.odometry:OdometryController",
-    "random": "bionav.plugins.controllers.random_bounce:RandomController",
-}
-
-
-@pytest.fixture
-def controllers(fake_distributions):
-    """The built-in controllers, registered by a stand-in distribution when bionav is not installed."""
-    from bionav import registry
-
-    if not set(CONTROLLERS) <= set(registry.entry_points_of("controller")):
-        fake_distributions("bionav-controllers-dev", {"bionav.controllers": CONTROLLERS})
-
-
-def config(controller: str, **experiment):
-    exp = OmegaConf.load(CONF / "experiment" / "cleaning.yaml")
-    del exp["defaults"]
-    layout = OmegaConf.load(CONF / "layout" / "long_lanes.yaml")
-    layout.n_lanes, layout.lane_length = 3, 1.2
-    cfg = OmegaConf.merge(exp, {"layout": layout, "controller": {"name": controller}, "seed": 0, "runs": 2,
-                                "experiment": {"vision": "oracle", **experiment}})
-    return cfg
-
-
+CONF = Path(__file__).resolve().parents[2] / "bionav" / "conf"
 def test_layout_files_match_the_thesis():
     long = OmegaConf.load(CONF / "layout" / "long_lanes.yaml")
     short = OmegaConf.load(CONF / "layout" / "short_lanes.yaml")

@@ -119,7 +119,7 @@ def test_bad_parameters_are_user_errors(cls, options):
 
 
 def test_plugins_are_registered_with_typed_configs():
-    pyproject = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
+    pyproject = tomllib.loads((Path(__file__).parents[2] / "pyproject.toml").read_text())
     group = pyproject["project"]["entry-points"]["bionav.homing"]
     want = {
         "minwarping": MinWarping,
@@ -137,7 +137,7 @@ def test_plugins_are_registered_with_typed_configs():
 def test_thesis_presets_fit_the_typed_config(preset, cls):
     from omegaconf import OmegaConf
 
-    raw = OmegaConf.load(Path(__file__).parents[1] / "bionav" / "conf" / "homing" / f"{preset}.yaml")
+    raw = OmegaConf.load(Path(__file__).parents[2] / "bionav" / "conf" / "homing" / f"{preset}.yaml")
     assert list(raw.pop("defaults")) == [cls.name, "_self_"]
     cfg = OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(cls.Config), raw))
     assert cfg.n_alpha == cfg.n_psi == 72 and cfg.image_size == [346, 50]

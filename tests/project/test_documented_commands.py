@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 from helpers import source_copy
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 #: placeholders used in the docs and what a test substitutes (RUN/DIR/<date>/<time> are real dirs)
 PLACEHOLDERS = {
@@ -157,7 +157,7 @@ def _substitute(cmd: Command) -> list[str]:
         text = text.replace(key, value)
     unknown = re.findall(r"<[A-Za-z _-]+>", text)
     assert not unknown, (f"{cmd.where()}\n  unknown placeholder {unknown}: add it to PLACEHOLDERS in "
-                         f"tests/test_documented_commands.py")
+                         f"tests/project/test_documented_commands.py")
     args = shlex.split(text)[3:]  # drop python -m bionav...
     out = []
     for a in args:

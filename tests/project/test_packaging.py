@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from helpers import run_bionav, source_copy
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _pip(*args, cwd):

@@ -17,7 +17,7 @@ from bionav.evaluation.route import best_match, catchment_width, distance_to_rou
 from bionav.geometry import PanoramaGeometry, angular_difference
 from bionav.world.mesh_render import cast_mesh_directions, render_mesh_panorama
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def external_data() -> Path:

@@ -16,8 +16,8 @@ from bionav.db.camera import (
     noise_rng,
     pose_error_config_for,
     pose_offsets,
+    raw_frame_from_radiance,
     resolve_pose_error,
-    sensor_frame,
     unfold_frame,
 )
 from bionav.db.config import CameraConfig
@@ -81,7 +81,7 @@ def test_camera_images_turn_each_capture_by_its_drift():
     for k, (i, j) in enumerate(positions):
         rad = render_raw_frame(world.scene, position=world.cell_position(i, j), heading=float(noise_heads[k] + drift[k]),
                                layout=setup.layout)
-        assert np.array_equal(unfold_frame(sensor_frame(rad, setup, rng=noise_rng(0, (i, j))), setup, geometry),
+        assert np.array_equal(unfold_frame(raw_frame_from_radiance(rad, setup, rng=noise_rng(0, (i, j))), setup, geometry),
                               imgs[k])
 
 

@@ -15,7 +15,7 @@ from bionav.errors import DeviceError, UserError
 from bionav.experiments.runner import run_experiment
 from bionav.logs import read_messages
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def experiment_config(mode: str, **overrides):

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "slurm-localhost.sh"
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "slurm-localhost.sh"
 
 pytestmark = pytest.mark.skipif(os.geteuid() != 0 or sys.platform != "linux",
                                 reason="the script needs root (it runs `sudo` otherwise) and /proc")

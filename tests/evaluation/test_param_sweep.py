@@ -20,7 +20,7 @@ from bionav.plugins.signatures import SIGNATURE_NAMES, builtin_signature_class
 from bionav.report import ranking
 
 GEOM = PanoramaGeometry.square_pixels(72, 18)
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

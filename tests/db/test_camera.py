@@ -18,7 +18,7 @@ from bionav.db.camera import (
     noise_rng,
     pose_error_config_for,
     pose_offsets,
-    sensor_frame,
+    raw_frame_from_radiance,
     unfold_frame,
 )
 from bionav.db.config import CameraConfig
@@ -36,7 +36,7 @@ from bionav.world.lights import Ambient, PointLight
 from bionav.world.render import render_panorama
 from bionav.world.scene import Scene
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 # a camera without sensor effects: no blur, no vignetting, fixed exposure, (almost) no noise
 CLEAN = dict(psf_sigma_px=0.0, vignetting=0.0, auto_exposure=False, full_well_e=1e7, read_noise_e=0.0)
@@ -106,7 +106,7 @@ def test_unfolded_raw_frame_matches_the_directly_rendered_panorama_of_a_smooth_w
     setup = camera_setup(CameraConfig(**CLEAN), geometry)
     position = (0.0, 0.0, 0.6)
     radiance = render_raw_frame(s, position=position, heading=0.0, layout=setup.layout)
-    raw = sensor_frame(radiance, setup, rng=np.random.default_rng(0))
+    raw = raw_frame_from_radiance(radiance, setup, rng=np.random.default_rng(0))
     unfolded = unfold_frame(raw, setup, geometry)[:, :, 0] / 255.0
     direct = np.clip(render_panorama(s, position=position, geometry=geometry)[:, :, 0], 0, 1)
     assert direct.std() > 0.05  # the world is not flat: the comparison has power
@@ -126,7 +126,7 @@ def test_auto_exposure_and_noise_follow_the_closed_forms():
     setup = camera_setup(cam, geometry)
     h, w = setup.layout.radius.shape
     level = 0.05  # dark scene: exposure time 2 (the maximum), then gain 0.4 / (0.05 * 2) = 4
-    raw = sensor_frame(np.full((h, w, 1), level), setup, rng=np.random.default_rng(1))[:, :, 0] / 255.0
+    raw = raw_frame_from_radiance(np.full((h, w, 1), level), setup, rng=np.random.default_rng(1))[:, :, 0] / 255.0
     inside = (setup.layout.radius >= setup.band[0]) & (setup.layout.radius <= setup.band[1])
     t, g = 2.0, 4.0
     assert raw[inside].mean() == pytest.approx(level * t * g, abs=0.003)
@@ -134,7 +134,7 @@ def test_auto_exposure_and_noise_follow_the_closed_forms():
     std = raw[inside].std()
     assert std == pytest.approx(math.sqrt(expected_std ** 2 + 1 / 255 ** 2 / 12), rel=0.05)
     # a bright scene is exposed shorter, without gain, to the target level
-    bright = sensor_frame(np.full((h, w, 1), 1.6), setup, rng=np.random.default_rng(2))[:, :, 0] / 255.0
+    bright = raw_frame_from_radiance(np.full((h, w, 1), 1.6), setup, rng=np.random.default_rng(2))[:, :, 0] / 255.0
     assert bright[inside].mean() == pytest.approx(0.4, abs=0.003)
 
 
@@ -142,7 +142,7 @@ def test_vignetting_darkens_towards_the_rim():
     geometry = PanoramaGeometry.square_pixels(561, 81)
     setup = camera_setup(CameraConfig(**{**CLEAN, "vignetting": 0.5}), geometry)
     h, w = setup.layout.radius.shape
-    raw = sensor_frame(np.full((h, w, 1), 0.8), setup, rng=np.random.default_rng(0))[:, :, 0] / 255.0
+    raw = raw_frame_from_radiance(np.full((h, w, 1), 0.8), setup, rng=np.random.default_rng(0))[:, :, 0] / 255.0
     r = setup.layout.radius
     ring = np.abs(r - 150.0) < 0.5
     assert raw[ring].mean() == pytest.approx(0.8 * (1 - 0.5 * (150.0 / 230.0) ** 2), abs=2 / 255)
@@ -180,7 +180,7 @@ def test_camera_images_are_rendered_at_the_perturbed_poses():
         x, y, z = world.cell_position(i, j)
         pos = (x + poses2["offsets_m"][k, 0], y + poses2["offsets_m"][k, 1], z)
         rad = render_raw_frame(world.scene, position=pos, heading=poses2["heading_errors"][k], layout=setup.layout)
-        raw = sensor_frame(rad, setup, rng=noise_rng(0, (i, j)))
+        raw = raw_frame_from_radiance(rad, setup, rng=noise_rng(0, (i, j)))
         assert np.array_equal(unfold_frame(raw, setup, geometry), moved[k])
 
 

@@ -75,7 +75,7 @@ def test_missing_attribute_and_missing_config(fake_distributions):
 def test_duplicate_name_from_two_distributions_names_both(fake_distributions):
     fake_distributions("fake-one", {"bionav.homing": {"twin": "fakeplug_one:Good"}}, {"fakeplug_one": GOOD})
     fake_distributions("fake-two", {"bionav.homing": {"twin": "fakeplug_two:Good"}}, {"fakeplug_two": GOOD})
-    # issue 13 item 9: the duplicate blocks only its own name (tests/test_hostile_plugins.py covers the CLI)
+    # issue 13 item 9: the duplicate blocks only its own name (tests/cli/test_hostile_plugins.py covers the CLI)
     assert {"twin", "sift", "mfdid"} <= set(registry.entry_points_of("homing"))
     with pytest.raises(PluginError, match="fake-one.*fake-two|fake-two.*fake-one"):
         registry.load_plugin("homing", "twin")
