@@ -139,6 +139,36 @@ def _dot4x4(da, g0, db, j):
 
 
 @nb.njit(nogil=True, cache=True)
+def _inside(x, width):
+    """Whether every column ``x`` lies in ``[0, width)``."""
+    for i in range(x.shape[0]):
+        if not (0.0 <= x[i] < width):
+            return False
+    return True
+
+
+@nb.njit(nogil=True, cache=True)
+def _core_pieces(xi, yi, y_lo, y_hi, r2, xb, width, start, stop):
+    """Bounds ``c0 <= ... <= c5`` of the pieces of ``[start, stop)`` for one a-keypoint.
+
+    The core holds the b-keypoints closer in column than ``h``, where every row of b
+    (``y_lo..y_hi``) is inside the radius for sure: x in ``[xi - h, xi + h]`` and,
+    across the border, ``x <= xi + h - W`` or ``x >= xi - h + W``. Pieces ``[c0, c1)``,
+    ``[c2, c3)``, ``[c4, c5)`` are core, ``[c1, c2)`` and ``[c3, c4)`` edge; no core
+    gives ``c0 = ... = c5 = start``.
+    """
+    dy_max = max(abs(yi - y_lo), abs(yi - y_hi))
+    h = np.sqrt(max(r2 - dy_max * dy_max, 0.0)) - _CORE_MARGIN
+    if h <= 0.0:
+        return start, start, start, start, start, start
+    c1 = max(start, min(stop, np.searchsorted(xb, xi + h - width, side="right")))
+    c2 = max(c1, min(stop, np.searchsorted(xb, xi - h)))
+    c3 = max(c2, min(stop, np.searchsorted(xb, xi + h, side="right")))
+    c4 = max(c3, min(stop, np.searchsorted(xb, xi - h + width)))
+    return start, c1, c2, c3, c4, stop
+
+
+@nb.njit(nogil=True, cache=True)
 def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, key_b, symmetric):
     """Best neighbourhood matches between two column-sorted keypoint sets.
 
@@ -178,13 +208,7 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
         key_b[:] = _NONE
     if n_a == 0 or n_b == 0:
         return
-    inside_image = True
-    for i in range(n_a):
-        if not (0.0 <= xa[i] < width):
-            inside_image = False
-    for j in range(n_b):
-        if not (0.0 <= xb[j] < width):
-            inside_image = False
+    inside_image = _inside(xa, width) and _inside(xb, width)
     y_lo = np.min(yb)
     y_hi = np.max(yb)
     base_b = np.empty(n_b, np.int64)
@@ -229,19 +253,10 @@ def match_sorted(xa, ya, da, na, ra, xb, yb, db, nbs, rb, radius, width, key_a, 
                 i = g0 + t
                 xi = xa[i]
                 yi = ya[i]
-                # core: columns closer than h, where every row of b is inside the radius for sure
-                dy_max = max(abs(yi - y_lo), abs(yi - y_hi))
-                h = np.sqrt(max(r2 - dy_max * dy_max, 0.0)) - _CORE_MARGIN
-                if h <= 0.0 or not inside_image:
-                    c0 = c1 = c2 = c3 = c4 = c5 = start
+                if inside_image:
+                    c0, c1, c2, c3, c4, c5 = _core_pieces(xi, yi, y_lo, y_hi, r2, xb, width, start, stop)
                 else:
-                    # the core is x in [xi - h, xi + h] and, across the border, x <= xi + h - W or x >= xi - h + W
-                    c0 = start
-                    c1 = max(start, min(stop, np.searchsorted(xb, xi + h - width, side="right")))
-                    c2 = max(c1, min(stop, np.searchsorted(xb, xi - h)))
-                    c3 = max(c2, min(stop, np.searchsorted(xb, xi + h, side="right")))
-                    c4 = max(c3, min(stop, np.searchsorted(xb, xi - h + width)))
-                    c5 = stop
+                    c0 = c1 = c2 = c3 = c4 = c5 = start
                 best = key_a[i]
                 base_a = na[i] * _SHIFT + ra[i]
                 row = buf[t]

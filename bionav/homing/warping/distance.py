@@ -95,6 +95,51 @@ def _quantise(planes, scale, out, norms):
                 nk[j] += abs(np.int32(o[j]))
 
 
+@njit(nogil=True, fastmath=True, cache=True, inline="always")
+def _add_row_distances(af, a0, c0, width):
+    """Add one row's ``|a0[i] - c0[i + d]|`` to the diagonal sums ``af[d * W + i]`` (16-bit)."""
+    uw = np.uint64(width)
+    for d in range(width):
+        ud = np.uint64(d)
+        ab = ud * uw
+        for i in range(width):
+            ui = np.uint64(i)
+            af[ab + ui] += np.uint16(abs(np.int16(a0[ui] - c0[ud + ui])))
+
+
+@njit(nogil=True, fastmath=True, cache=True, inline="always")
+def _normalise_plane(acc, na, cn2, qf, t, out_k, step):
+    """One plane's diagonal sums ``acc`` (W, W) to 8-bit NSAD, de-interleaved into
+    ``out_k[d, i % step, i // step]``; ``t`` (W,) is scratch."""
+    width = na.shape[0]
+    n = width // step
+    for d in range(width):
+        nb = cn2[d:d + width]
+        ac = acc[d]
+        for i in range(width):
+            # the norms' sum in 32 bits (AVX2 has no packed 64-bit integer to float
+            # conversion, so an int64 sum kept this loop scalar there); a zero sum
+            # means two zero columns, whose distance sum is 0 as well: dividing it by 1
+            # gives the old 0.5 without a branch
+            den = np.float32(max(np.int32(na[i] + nb[i]), np.int32(1)))
+            t[i] = np.uint8(np.float32(ac[i]) * qf / den + np.float32(0.5))
+        o = out_k[d]
+        if step == 1:
+            o0 = o[0]
+            for m in range(n):
+                o0[m] = t[m]
+        elif step == 3:  # constant stride, one phase at a time: byte shuffles
+            for rr in range(3):
+                orr = o[rr]
+                for m in range(n):
+                    orr[m] = t[3 * m + rr]
+        else:
+            for rr in range(step):
+                orr = o[rr]
+                for m in range(n):
+                    orr[m] = t[m * step + rr]
+
+
 @njit(nogil=True, fastmath=True, cache=True)
 def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     """8-bit NSAD in diagonal layout from 16-bit stacks.
@@ -109,7 +154,6 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     de-interleaved into ``out[k, d, i % step, i // step]``.
     """
     n_planes, n_rows, width = sq.shape
-    n = width // step
     acc = np.empty((width + 1, width), np.uint16)  # row W: scratch for odd W
     af = acc.reshape(-1)
     uw = np.uint64(width)
@@ -167,41 +211,9 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
                     )
             r += 8
         while r < n_rows:
-            a0 = sq[k, r]
-            c0 = cq2[k, r]
-            for d in range(width):
-                ud = np.uint64(d)
-                ab = ud * uw
-                for i in range(width):
-                    ui = np.uint64(i)
-                    af[ab + ui] += np.uint16(abs(np.int16(a0[ui] - c0[ud + ui])))
+            _add_row_distances(af, sq[k, r], cq2[k, r], width)
             r += 1
-        na = sn[k]
-        for d in range(width):
-            nb = cn2[k, d:d + width]
-            ac = acc[d]
-            for i in range(width):
-                # the norms' sum in 32 bits (AVX2 has no packed 64-bit integer to float
-                # conversion, so an int64 sum kept this loop scalar there); a zero sum
-                # means two zero columns, whose distance sum is 0 as well: dividing it by 1
-                # gives the old 0.5 without a branch
-                den = np.float32(max(np.int32(na[i] + nb[i]), np.int32(1)))
-                t[i] = np.uint8(np.float32(ac[i]) * qf / den + np.float32(0.5))
-            o = out[k, d]
-            if step == 1:
-                o0 = o[0]
-                for m in range(n):
-                    o0[m] = t[m]
-            elif step == 3:  # constant stride, one phase at a time: byte shuffles
-                for rr in range(3):
-                    orr = o[rr]
-                    for m in range(n):
-                        orr[m] = t[3 * m + rr]
-            else:
-                for rr in range(step):
-                    orr = o[rr]
-                    for m in range(n):
-                        orr[m] = t[m * step + rr]
+        _normalise_plane(acc, sn[k], cn2[k], qf, t, out[k], step)
 
 
 @njit(nogil=True, fastmath=True, cache=True)
