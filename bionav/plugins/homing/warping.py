@@ -54,7 +54,7 @@ def panorama_cutoff(method: HomingMethod, width: int) -> float | None:
     if cfg.butterworth_cutoff is None:
         return None
     if getattr(cfg, "butterworth_relative_to", "panorama") != "raw":
-        return float(cfg.butterworth_cutoff)
+        return cfg.butterworth_cutoff
     from bionav.homing.imageops import panorama_cutoff_from_raw
 
     radius = getattr(method, "raw_horizon_radius_px", None)

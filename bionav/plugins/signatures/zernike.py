@@ -55,7 +55,7 @@ class Zernike(Signature):
         """Complex moments and their ``(n, m)`` (:func:`bionav.homing.signatures.zernike.zernike_moments`)."""
         from bionav.homing.signatures.zernike import zernike_moments
 
-        return zernike_moments(self._input(image), order=int(self.config.order))
+        return zernike_moments(self._input(image), order=self.config.order)
 
     def compute(self, image, *, raw=None) -> np.ndarray:
         return np.abs(self.moments(image)[0])
