@@ -241,3 +241,15 @@ def test_typed_config_is_the_one_path():
     for node, message in cases:
         with pytest.raises(UserError, match=message):
             typed_config(node, Node, key="node", what="the node")
+
+
+def test_every_db_preset_uses_every_key_it_sets():
+    """The presets' own values pass the unused-key check (a stand-in's grid as its preset records it)."""
+    from bionav.config import compose, config_options
+    from bionav.db.loading import as_database_config
+
+    names = config_options("db")
+    assert {"sim_original", "sim_uni", "original", "mesh", "sim_seville", "seville_route"} <= set(names)
+    for name in names:
+        extra = {"folder": ["db.path=."], "mesh": ["db.world=seville2009"]}.get(name, [])
+        assert as_database_config(compose([f"db={name}", *extra]).db).name == name
