@@ -80,7 +80,7 @@ PATH_SCHEMA = {
 
 def route_homing_config(cfg: DictConfig) -> RouteHomingConfig:
     """The typed, range-checked ``experiment`` node (:class:`~bionav.experiments.configs.RouteHomingConfig`)."""
-    exp = experiment_config(cfg, "route_homing")
+    exp = OmegaConf.to_object(experiment_config(cfg, "route_homing"))
     if exp.agent_step_m is None:
         exp.agent_step_m = PROTOCOL_STEP_M[exp.protocol]
     if not any(float(v) == 0.0 for v in exp.offsets_m):

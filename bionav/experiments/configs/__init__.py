@@ -20,7 +20,6 @@ import path of the experiments and of plugin authors
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
@@ -116,13 +115,15 @@ def register(store=None) -> None:
     store.store(name="recordings_schema", node=RecordingsConfig, provider="bionav")
 
 
-def experiment_config(cfg: DictConfig, name: str | None = None) -> Any:
-    """The run's ``experiment`` node as its typed dataclass, defaults filled, every value checked.
+def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
+    """The run's ``experiment`` node typed by its dataclass, defaults filled, every value checked.
 
     Finds the dataclass by the experiment's name and types the node with
     :func:`bionav.validation.typed_config` (the one config path), in the
     context of the whole config so that defaults such as ``${seed}`` and
-    ``${experiment.grid}`` resolve.
+    ``${experiment.grid}`` resolve; the checked instance is handed back as a
+    structured node, so experiments read it as attributes (``exp.step_length``,
+    already a ``float``) or as a mapping (``exp.sky.get("time")``).
 
     Parameters
     ----------
@@ -136,10 +137,11 @@ def experiment_config(cfg: DictConfig, name: str | None = None) -> Any:
 
     Returns
     -------
-    dataclass instance or DictConfig
-        An instance of :data:`EXPERIMENT_CONFIGS` ``[name]`` (attribute access;
-        values already of their declared types); an experiment without a
-        dataclass gets its node back unchanged.
+    DictConfig
+        A structured node of the checked :data:`EXPERIMENT_CONFIGS` ``[name]``
+        instance (values of their declared types; ``OmegaConf.to_object`` gives
+        the instance); an experiment without a dataclass gets its node back
+        unchanged.
 
     Raises
     ------
@@ -155,4 +157,4 @@ def experiment_config(cfg: DictConfig, name: str | None = None) -> Any:
     if schema is None:
         return node
     root = cfg if "seed" in cfg else OmegaConf.merge(OmegaConf.create({"seed": 0}), cfg)
-    return typed_config(None, schema, key="experiment", what=f"experiment={name}", root=root)
+    return OmegaConf.structured(typed_config(None, schema, key="experiment", what=f"experiment={name}", root=root))
