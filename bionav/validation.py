@@ -339,9 +339,10 @@ def typed_config(node: Any, schema: type, *, key: str, what: str | None = None, 
     :func:`check_config` checks every declared range; a dataclass may add two
     hooks, both called here and nowhere else:
 
-    * ``unused_keys(self) -> (set_but_unused, used)``: keys given a value
-      that this instance does not use (``db.grid_shape`` on a synthetic
-      database, whose grid is its own) and the keys it does use;
+    * ``unused_keys(self) -> (set_but_unused, used)``: keys (dotted for
+      nested ones, ``camera.width``) given a value that this instance does
+      not use (``db.grid_shape`` on a synthetic database, whose grid is its
+      own) and the keys it does use;
     * ``validate(self)``: relations between fields (``min < max``), raising
       :class:`~bionav.errors.UserError`.
 
@@ -402,9 +403,12 @@ def typed_config(node: Any, schema: type, *, key: str, what: str | None = None, 
         if unused:
             bad = unused[0]
             name = _joined(key, bad)
+            value = instance
+            for part in bad.split("."):  # a nested key: camera.width
+                value = getattr(value, part)
             raise UserError(
-                f"{name}={_show(getattr(instance, bad))} is not used by {what}; it uses: {', '.join(used)}. "
-                f"Remove {name} from the command line, or choose a {key or 'config'} that uses it."
+                f"{name}={_show(value)} is not used by {what}; it uses: {', '.join(used)}. "
+                f"Remove {name} from the command line, or choose another {key or 'setting'} that uses it."
             )
     validate = getattr(instance, "validate", None)
     if callable(validate):

@@ -190,6 +190,8 @@ UNUSED = [
     (["db=sim_seville", "db.realism=camera"], ["db.realism=camera is not used by db=sim_seville",
                                                "grid_shape, spacing_m, origin_m"]),
     (["db=folder", "db.path=.", "db.seed=3"], ["db.seed=3 is not used by db=folder", "naming, azimuth"]),
+    (["experiment=cleaning", "experiment.vision=oracle", "experiment.camera.width=100"],
+     ["experiment.camera.width=100 is not used by experiment=cleaning", "oracle"]),
     (["db=seville_route", "db.grid_shape=[3,3]"], ["db.grid_shape=[3,3] is not used by db=seville_route",
                                                    "route, routes_path, step_m"]),
 ]
