@@ -192,6 +192,8 @@ UNUSED = [
     (["db=folder", "db.path=.", "db.seed=3"], ["db.seed=3 is not used by db=folder", "naming, azimuth"]),
     (["experiment=cleaning", "experiment.vision=oracle", "experiment.camera.width=100"],
      ["experiment.camera.width=100 is not used by experiment=cleaning", "oracle"]),
+    (["experiment=skyline_homing", "experiment.world=campus", "experiment.grid=[5,5]"],
+     ["experiment.grid=[5,5] is not used by experiment=skyline_homing", "world_seed, image_width"]),
     (["db=seville_route", "db.grid_shape=[3,3]"], ["db.grid_shape=[3,3] is not used by db=seville_route",
                                                    "route, routes_path, step_m"]),
 ]

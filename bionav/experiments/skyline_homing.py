@@ -190,9 +190,7 @@ def _world_grid(exp):
     from bionav.geometry import PanoramaGeometry
 
     world_name = exp.world
-    if world_name not in ("garden", "campus"):
-        raise UserError(f"experiment.world={world_name!r} is unknown; choose garden or campus.")
-    nx, ny = (int(v) for v in exp.grid)
+    nx, ny = exp.grid
     spacing = exp.spacing_m
     if world_name == "campus":
         from bionav.world.worlds.outdoor import GRID_SHAPE, SPACING
