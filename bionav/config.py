@@ -25,6 +25,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from bionav import registry
 from bionav.registry import config_dirs  # noqa: F401  (its home is the registry; re-exported for the Hydra wiring)
+from bionav.validation import unknown_key_message  # noqa: F401  (its home is validation; re-exported for cli.py)
 
 #: config groups users select plugins in
 PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
@@ -210,10 +211,11 @@ def compose(overrides: Sequence[str] = (), *, config_name: str = "config",
 
 
 def plugin_config(kind: str, node: Any, *, key: str | None = None) -> Any:
-    """Validate a config node against its plugin's ``Config``: ``(plugin class, config instance)``.
+    """A plugin's class and its typed, checked config: ``(plugin class, config instance)``.
 
-    Types come from the dataclass, ranges from its fields' :func:`bionav.validation.bounded`
-    declarations (:func:`bionav.validation.check_config`).
+    The node's ``name`` selects the plugin; the rest becomes an instance of the
+    plugin's ``Config`` through :func:`bionav.validation.typed_config` (types from
+    the dataclass, ranges from its :func:`bionav.validation.bounded` fields).
 
     Parameters
     ----------
@@ -225,49 +227,11 @@ def plugin_config(kind: str, node: Any, *, key: str | None = None) -> Any:
         The config key users type for this node (``pantilt`` for a sensor
         selected in the ``pantilt`` group); default ``kind``.
     """
-    from bionav.errors import UserError
-    from bionav.validation import check_config
+    from bionav.validation import typed_config
 
     key = key or kind
-
     plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
     name = plain.pop("name", None)
     plain.pop("broken", None)
     cls = registry.load_plugin(kind, name)
-    valid = {f.name for f in dataclasses.fields(cls.Config)}
-    unknown = sorted(set(plain) - valid)
-    if unknown:
-        raise UserError(unknown_key_message(key, unknown[0], sorted(valid), what=f"the {kind} plugin {name!r}"))
-    try:
-        merged = OmegaConf.merge(OmegaConf.structured(cls.Config), plain)
-        config = OmegaConf.to_object(merged)
-    except Exception as exc:  # omegaconf validation errors
-        where = getattr(exc, "full_key", None)
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise UserError(
-            f"bad value for {key}.{where or '<parameter>'} (the {kind} plugin {name!r}): {first}. "
-            f"Give {key}.{where or '<parameter>'} a value of the declared type."
-        ) from None
-    return cls, check_config(config, prefix=key)
-
-
-def unknown_key_message(node: str, bad: str, valid: Sequence[str], *, what: str | None = None) -> str:
-    """One paragraph for a misspelt key: the key, the valid keys of its node, the closest one.
-
-    Parameters
-    ----------
-    node : str
-        Dotted key of the node (``homing``, ``db``, ``experiment.camera``).
-    bad : str
-        The unknown key (last component).
-    valid : sequence of str
-        The keys the node has.
-    """
-    import difflib
-
-    full = f"{node}.{bad}" if node else bad
-    close = difflib.get_close_matches(bad, list(valid), n=1, cutoff=0.6)
-    hint = f" Did you mean {node + '.' if node else ''}{close[0]}?" if close else ""
-    owner = f" ({what})" if what else ""
-    keys = ", ".join(valid) or "(none)"
-    return f"unknown key {full}: {node or 'the config'}{owner} has no key {bad!r}; its keys are {keys}.{hint}"
+    return cls, typed_config(plain, cls.Config, key=key, what=f"the {kind} plugin {name!r}")

@@ -18,10 +18,19 @@ length with items in range; nested dataclasses are checked recursively. The
 error is a :class:`~bionav.errors.UserError` naming the key as the user types
 it (``homing.sigma``), the bad value and the allowed range.
 
-bionav checks every plugin config in :func:`bionav.config.plugin_config`, the
-``db`` node in :func:`bionav.db.loading.as_database_config` and the experiment
-node in :func:`bionav.experiments.configs.experiment_config`; the command line
-runs all of them before a run directory is created.
+:func:`typed_config` is the one path from a config node (an OmegaConf node, a
+mapping or an instance) to its typed dataclass: it merges the node onto the
+dataclass (unknown keys and values of the wrong type named), checks every
+declared range (:func:`check_config`), refuses keys the node's dataclass says
+it does not use (its ``unused_keys`` hook, e.g. ``db.grid_shape`` on a
+synthetic database) and checks relations between fields (its ``validate``
+hook, e.g. ``min < max``). Every error is one :class:`~bionav.errors.UserError`
+naming the key as the user types it, the bad value and what is allowed.
+Plugin configs (:func:`bionav.config.plugin_config`), the ``db`` node
+(:func:`bionav.db.loading.as_database_config`), the experiment node
+(:func:`bionav.experiments.configs.experiment_config`) and the other typed
+groups all go through it; the command line runs all of them before a run
+directory is created, and nothing downstream re-checks or re-casts a value.
 
 :func:`check_allocation` bounds an array allocation against the memory of
 the machine before it is made.
@@ -54,6 +63,11 @@ class Range:
         Exact length, or ``(min, max)`` length, of a list value.
     item : Range, optional
         Range of each item of a list value.
+    items : tuple of Range, optional
+        Range of the item at each position of a list of fixed ``length``
+        (e.g. an image size ``[W, H]`` with its own bounds for W and H).
+    names : tuple of str, optional
+        Names of the positions in messages (``("W", "H")``).
     allow_inf : bool
         Whether ``inf``/``-inf`` pass (NaN never does).
     """
@@ -65,6 +79,8 @@ class Range:
     choices: tuple | None = None
     length: int | tuple[int, int] | None = None
     item: "Range | None" = None
+    items: "tuple[Range, ...] | None" = None
+    names: tuple[str, ...] | None = None
     allow_inf: bool = False
 
     def describe(self, *, integer: bool = False) -> str:
@@ -79,6 +95,9 @@ class Range:
                 parts.append(f"a list of {self.length} items")
             if self.item is not None:
                 parts.append("each " + self.item.describe(integer=integer))
+            if self.items is not None:
+                names = self.names or tuple(f"item {i + 1}" for i in range(len(self.items)))
+                parts += [f"{n} {r.describe(integer=integer)}" for n, r in zip(names, self.items)]
             return ", ".join(parts)
         bounds = []
         if self.ge is not None:
@@ -105,6 +124,12 @@ class Range:
                     why = self.item.problem(v)
                     if why:
                         return f"has an item {v!r} that {why}"
+            if self.items is not None:
+                names = self.names or tuple(f"item {i + 1}" for i in range(len(self.items)))
+                for n, r, v in zip(names, self.items, value):
+                    why = r.problem(v)
+                    if why:
+                        return f"has {n}={v!r} that {why}"
             return None
         if self.length is not None:
             return "is not a list"
@@ -147,6 +172,8 @@ def bounded(
     choices: Sequence[str] | None = None,
     length: int | tuple[int, int] | None = None,
     item: Range | None = None,
+    items: Sequence[Range] | None = None,
+    names: Sequence[str] | None = None,
     allow_inf: bool = False,
 ) -> Any:
     """A dataclass field with a declared range (see the module docstring).
@@ -155,7 +182,8 @@ def bounded(
     turned into a ``default_factory``).
     """
     rng = Range(ge=ge, gt=gt, le=le, lt=lt, choices=tuple(choices) if choices is not None else None,
-                length=length, item=item, allow_inf=allow_inf)
+                length=length, item=item, items=tuple(items) if items is not None else None,
+                names=tuple(names) if names is not None else None, allow_inf=allow_inf)
     if isinstance(default, (list, dict)):
         value = default
         default, default_factory = MISSING, (lambda: type(value)(value))
@@ -237,6 +265,155 @@ def check_config(config: Any, *, prefix: str) -> Any:
                 f"Set {key} to an allowed value (default: {_default_text(field)})."
             )
     return config
+
+
+def unknown_key_message(node: str, bad: str, valid: Sequence[str], *, what: str | None = None) -> str:
+    """One paragraph for a misspelt key: the key, the valid keys of its node, the closest one.
+
+    Parameters
+    ----------
+    node : str
+        Dotted key of the node (``homing``, ``db``, ``experiment.camera``).
+    bad : str
+        The unknown key (last component).
+    valid : sequence of str
+        The keys the node has.
+    what : str, optional
+        What the node configures, said in parentheses (``experiment=cleaning``).
+    """
+    import difflib
+
+    full = f"{node}.{bad}" if node else bad
+    close = difflib.get_close_matches(bad, list(valid), n=1, cutoff=0.6)
+    hint = f" Did you mean {node + '.' if node else ''}{close[0]}?" if close else ""
+    owner = f" ({what})" if what else ""
+    keys = ", ".join(valid) or "(none)"
+    return f"unknown key {full}: {node or 'the config'}{owner} has no key {bad!r}; its keys are {keys}.{hint}"
+
+
+def _schema_file(schema: type) -> str:
+    """The source file of a config dataclass as users find it (``bionav/experiments/configs/grid.py``)."""
+    import sys
+
+    module = schema.__module__
+    file = getattr(sys.modules.get(module), "__file__", None) or ""
+    return module.replace(".", "/") + ("/__init__.py" if file.endswith("__init__.py") else ".py")
+
+
+def _joined(prefix: str, key: str) -> str:
+    return f"{prefix}.{key}" if prefix and key else (prefix or key)
+
+
+def _omegaconf_message(exc: Exception, schema: type, *, key: str, what: str, rooted: bool) -> str:
+    """The one message for an OmegaConf merge error: unknown key, missing value or wrong type."""
+    from omegaconf import DictConfig, OmegaConf
+
+    full = str(getattr(exc, "full_key", "") or "")
+    if rooted and full.startswith(key + "."):
+        full = full[len(key) + 1:]  # relative to the node
+    elif rooted and full == key:
+        full = ""
+    kind = type(exc).__name__
+    if kind in ("ConfigKeyError", "ConfigAttributeError") and full:
+        parent, _, bad = full.rpartition(".")
+        where = OmegaConf.structured(schema)
+        if parent:
+            where = OmegaConf.select(where, parent)
+        valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
+        return unknown_key_message(_joined(key, parent), bad, valid, what=what)
+    name = _joined(key, full)
+    if kind == "MissingMandatoryValue" and full:
+        return f"{name} has no value ({what} needs it); add {name}=<value> on the command line."
+    value = getattr(exc, "value", None)
+    shown = f"={_show(value)}" if value is not None else ""
+    first = str(exc).splitlines()[0] if str(exc) else kind
+    return (f"bad value {name}{shown} ({what}): {first}. Give {name} a value of the declared type "
+            f"(see {schema.__name__} in {_schema_file(schema)}).")
+
+
+def typed_config(node: Any, schema: type, *, key: str, what: str | None = None, root: Any = None) -> Any:
+    """A config node as an instance of its dataclass, every value checked: the one config path.
+
+    The node is merged onto ``schema`` (OmegaConf types each value: an integer
+    field holds an ``int``, a float field a ``float``), then
+    :func:`check_config` checks every declared range; a dataclass may add two
+    hooks, both called here and nowhere else:
+
+    * ``unused_keys(self) -> (set_but_unused, used)``: keys (dotted for
+      nested ones, ``camera.width``) given a value that this instance does
+      not use (``db.grid_shape`` on a synthetic database, whose grid is its
+      own) and the keys it does use;
+    * ``validate(self)``: relations between fields (``min < max``), raising
+      :class:`~bionav.errors.UserError`.
+
+    Callers use the returned values as they are: nothing re-checks a declared
+    range or re-casts a typed value afterwards.
+
+    Parameters
+    ----------
+    node : DictConfig, Mapping, schema instance or None
+        The config node (interpolations such as ``${data_dir}`` are resolved
+        against the config it belongs to). ``None`` gives the defaults.
+    schema : type
+        Its dataclass.
+    key : str
+        The key users type for the node (``db``, ``homing``, ``layout``;
+        ``""`` for top-level keys); messages name ``<key>.<field>``.
+    what : str, optional
+        What the node configures, said in messages (``db=sim_original``,
+        ``the homing plugin 'sift'``); default ``key``.
+    root : DictConfig, optional
+        The whole config, when the dataclass' defaults interpolate other keys
+        (``${seed}``, ``${experiment.grid}``): the node is then ``root[key]``
+        typed in place, and ``node`` is ignored.
+
+    Returns
+    -------
+    An instance of ``schema``.
+
+    Raises
+    ------
+    UserError
+        One paragraph: an unknown key (the node's keys listed, the closest
+        named), a missing or ill-typed value, a value outside its declared
+        range (:func:`check_config`), a key this instance does not use (the
+        keys it uses listed), or a relation between fields broken.
+    """
+    from omegaconf import OmegaConf
+    from omegaconf.errors import OmegaConfBaseException
+
+    what = what or key or "the config"
+    if isinstance(node, schema) and root is None:
+        instance = node
+    else:
+        try:
+            if root is not None:
+                tree = OmegaConf.merge(OmegaConf.create({key: OmegaConf.structured(schema)}), root)
+                typed = tree[key]
+            else:
+                plain = OmegaConf.to_container(node, resolve=True) if OmegaConf.is_config(node) else dict(node or {})
+                typed = OmegaConf.merge(OmegaConf.structured(schema), plain)
+            instance = OmegaConf.to_object(typed)
+        except OmegaConfBaseException as exc:
+            raise UserError(_omegaconf_message(exc, schema, key=key, what=what, rooted=root is not None)) from None
+    check_config(instance, prefix=key)
+    unused_keys = getattr(instance, "unused_keys", None)
+    if callable(unused_keys):
+        unused, used = unused_keys()
+        if unused:
+            bad = unused[0]
+            name = _joined(key, bad)
+            value = instance
+            for part in bad.split("."):  # a nested key: camera.width
+                value = getattr(value, part)
+            raise UserError(
+                f"{name}={_show(value)} is not used by {what}; it uses: {', '.join(used)}. "
+                f"Remove {name} from the command line, or choose another {key or 'setting'} that uses it."
+            )
+    validate = getattr(instance, "validate", None)
+    if callable(validate):
+        validate()
+    return instance
 
 
 def available_memory_bytes() -> int:

@@ -112,20 +112,19 @@ def _camera(args, composed) -> int:
     from bionav.db.loading import as_database_config
     from bionav.db.sheets import write_camera_sheet
     from bionav.db.synthetic import _camera_configs, get_spec
-    from bionav.homing.imageops import check_image_size
 
     cfg = as_database_config(composed.db)
-    if str(cfg.source) != "synthetic":
+    if cfg.source != "synthetic":
         raise UserError(f"db={args.db} is not a synthetic stand-in; the camera sheet exists for the sim_* "
                         "stand-ins (python -m bionav.db camera sim_original).")
     if not 1 <= args.cells <= 12:
         raise UserError(f"--cells {args.cells}: choose 1 to 12 cells.")
     spec = get_spec(cfg.name)
-    size = check_image_size(cfg.image_size, name="db.image_size", minimum=(8, 2)) or spec.native_size
+    size = cfg.image_size or spec.native_size
     camera, pose_error = _camera_configs(spec, cfg.camera, cfg.pose_error, spec.geometry(*size))
     out = args.out if args.out is not None else Path("outputs") / "db" / args.db
     try:
-        path = write_camera_sheet(cfg.name, out, camera=camera, pose_error=pose_error, seed=int(cfg.seed),
+        path = write_camera_sheet(cfg.name, out, camera=camera, pose_error=pose_error, seed=cfg.seed,
                                   image_size=size, n_cells=args.cells)
     except OSError as exc:
         raise UserError(f"cannot write to {out}: {exc}; choose a writable folder with --out DIR.") from None

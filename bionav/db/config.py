@@ -9,6 +9,9 @@ from bionav.validation import Range, bounded
 
 #: largest image side (pixels) a database or unfolded image may have
 MAX_IMAGE_SIDE = 16384
+#: ``db.image_size = [W, H]``: the one limit of a database's image size (W spans 360 degrees; the
+#: homing methods and the renderers need W >= 8 columns and H >= 2 rows)
+IMAGE_SIZE = dict(length=2, items=(Range(ge=8, le=MAX_IMAGE_SIDE), Range(ge=2, le=MAX_IMAGE_SIDE)), names=("W", "H"))
 #: largest grid side (cells) of a database
 MAX_GRID_SIDE = 10_000
 
@@ -93,7 +96,7 @@ class DatabaseConfig:
     name: str = "sim_original"
     source: str = bounded("synthetic", choices=("synthetic", "folder", "mesh", "route"))
     path: Optional[str] = None  # folder databases: the directory
-    image_size: Optional[list[int]] = bounded(None, length=2, item=Range(ge=2, le=MAX_IMAGE_SIDE))  # [W, H]; None: native
+    image_size: Optional[list[int]] = bounded(None, **IMAGE_SIZE)  # [W, H]; None: native
     seed: int = bounded(0, ge=0, le=2**32 - 1)  # synthetic worlds: which world of this kind
     noise: float = bounded(0.01, ge=0.0, le=1.0)  # synthetic, realism=ideal: noise std before 8-bit quantisation
     # synthetic: 'camera' renders the raw mirror image and unfolds it (docs/databases.md), 'ideal' the old
@@ -127,3 +130,75 @@ class DatabaseConfig:
     route: Optional[str] = None  # route databases: Ant<a>_Route<r>
     routes_path: Optional[str] = None  # .mat of routes; None = the packaged Seville routes
     step_m: float = bounded(0.1, gt=0.0, le=10.0)  # route databases: path length between views, metres
+
+    def unused_keys(self) -> tuple[list[str], tuple[str, ...]]:
+        """Keys given a value this database does not use, and the keys its source uses.
+
+        Called by :func:`bionav.validation.typed_config`. A key outside
+        :data:`USED_KEYS` ``[source]`` must keep its default, or the value the
+        database has anyway (:meth:`own_values`: a synthetic stand-in's own
+        grid, spacing and horizon, the canonical azimuth of rendered images),
+        which the presets record for the reader.
+        """
+        import dataclasses
+
+        used = USED_KEYS.get(self.source, ())
+        own: dict[str, Any] | None = None
+        unused = []
+        for f in dataclasses.fields(self):
+            if f.name in used:
+                continue
+            value = getattr(self, f.name)
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            if value == default:
+                continue
+            own = self.own_values() if own is None else own
+            if f.name in own and _same(value, own[f.name]):
+                continue
+            unused.append(f.name)
+        return unused, used
+
+    def validate(self) -> None:
+        """Relations between keys (called by :func:`bionav.validation.typed_config`)."""
+        from bionav.errors import UserError
+
+        if self.source in ("mesh", "route") and self.path is None and self.world is None:
+            raise UserError(f"db={self.name} needs the mesh file: pass db.path=FILE (.mat with X/Y/Z[/colp], .obj "
+                            "or .ply), or db.world=seville2009 for the packaged Seville ant world.")
+        if self.source == "mesh" and self.grid_shape is None:
+            raise UserError(f"db={self.name} needs its grid: pass db.grid_shape=[nx,ny], e.g. db.grid_shape=[10,10].")
+
+    def own_values(self) -> dict[str, Any]:
+        """Values this database has whatever the config says (keys outside :data:`USED_KEYS`)."""
+        if self.source == "synthetic":
+            from bionav.db.synthetic import get_spec
+
+            spec = get_spec(self.name)
+            geometry = spec.geometry(*spec.native_size)
+            return {"grid_shape": list(spec.grid_shape), "spacing_m": spec.spacing_m,
+                    "horizon_row": geometry.horizon_row, "azimuth": "counterclockwise"}
+        if self.source in ("mesh", "route"):
+            return {"azimuth": "counterclockwise"}
+        return {}
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    return a == b
+
+
+_ALL_SOURCES = ("name", "source", "image_size")
+#: the ``db.*`` keys each ``db.source`` uses (any other key must keep its default: a key a database does
+#: not use is an error naming these)
+USED_KEYS: dict[str, tuple[str, ...]] = {
+    "synthetic": _ALL_SOURCES + ("seed", "noise", "realism", "camera", "pose_error", "rotate_current",
+                                 "rotation_seed"),
+    "folder": _ALL_SOURCES + ("path", "naming", "azimuth", "x_axis_column", "horizon_row", "rad_per_row",
+                              "spacing_m", "grid_shape", "on_bad_image", "rotate_current", "rotation_seed",
+                              "unfold", "extra"),
+    "mesh": _ALL_SOURCES + ("path", "world", "grid_shape", "spacing_m", "origin_m", "camera_height_m", "ground",
+                            "channels", "clearance_m", "noise", "seed", "rotate_current", "rotation_seed"),
+    "route": _ALL_SOURCES + ("path", "world", "route", "routes_path", "step_m", "camera_height_m", "ground",
+                             "channels", "clearance_m", "noise", "seed"),
+}

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from bionav.db.config import DatabaseConfig
-from bionav.db.conventions import azimuth_sign, to_canonical
+from bionav.db.conventions import to_canonical
 from bionav.db.database import ImageDatabase
 from bionav.db.imageio import ImageReadError, read_image
 from bionav.db.naming import Entry, not_a_file_reason, scan_folder
@@ -58,10 +58,7 @@ class RawFrames:
 
 def _grid_shape(cfg: DatabaseConfig, scan, entries: list[Entry]) -> tuple[int, int]:
     if cfg.grid_shape is not None:
-        shape = tuple(int(v) for v in cfg.grid_shape)
-        if len(shape) != 2 or min(shape) < 1:
-            raise UserError(f"db.grid_shape={list(cfg.grid_shape)} must be two positive integers [nx, ny].")
-        return shape
+        return tuple(cfg.grid_shape)
     if scan.grid_shape is not None:
         return tuple(int(v) for v in scan.grid_shape)
     return (max(e.x for e in entries) + 1, max(e.y for e in entries) + 1)
@@ -90,11 +87,7 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
         are not changed by the conversion); ``raw`` set when unfolding.
     """
     folder = Path(folder)
-    policy = str(cfg.on_bad_image).strip().lower()
-    if policy not in ("error", "skip"):
-        raise UserError(f"db.on_bad_image={cfg.on_bad_image!r} must be 'error' or 'skip'.")
-    skip = policy == "skip"
-    azimuth_sign(cfg.azimuth)  # validate early
+    skip = cfg.on_bad_image == "skip"
     extra = dict(cfg.extra or {})
     scan = scan_folder(folder, naming=cfg.naming, grid_shape=cfg.grid_shape, bw_cutoff=extra.get("bw_cutoff"))
     if scan.ignored:
@@ -140,7 +133,7 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
         positions=np.array([(e.x, e.y) for e in kept], dtype=np.int64).reshape(-1, 2),
         grid_shape=(nx, ny),
         geometry=geometry,
-        spacing_m=float(cfg.spacing_m),
+        spacing_m=cfg.spacing_m,
         raw=raw,
         meta=meta,
     )
@@ -238,7 +231,7 @@ def _folder_meta(cfg: DatabaseConfig, folder: Path, scan, kept: list[Entry], ski
         "naming": scan.scheme,
         "files": [e.path.name for e in kept],
         "skipped": skipped,
-        "conventions": {"azimuth": cfg.azimuth, "x_axis_column": float(cfg.x_axis_column),
+        "conventions": {"azimuth": cfg.azimuth, "x_axis_column": cfg.x_axis_column,
                         "horizon_row": geometry.horizon_row, "rad_per_row": geometry.rad_per_row},
         "unfolded": bool(raw is not None),
     }

@@ -10,7 +10,6 @@ from bionav.db.database import ImageDatabase
 from bionav.db.preprocess import preprocess_database, resize_database
 from bionav.db.rotation import rotate_views
 from bionav.errors import UserError
-from bionav.homing.imageops import check_image_size
 
 log = logging.getLogger(__name__)
 
@@ -21,31 +20,28 @@ REAL_DATABASES = ("original", "arboreal", "chairs", "day", "doorlit", "screen", 
 
 
 def as_database_config(cfg) -> DatabaseConfig:
-    """A :class:`DatabaseConfig` from a dataclass, an OmegaConf node or a plain mapping.
+    """The ``db`` node as a checked :class:`DatabaseConfig` (:func:`bionav.validation.typed_config`).
+
+    Parameters
+    ----------
+    cfg : DatabaseConfig, DictConfig or Mapping
+        The ``db`` node (``${data_dir}`` resolved against the whole config).
 
     Raises
     ------
     UserError
-        Unknown keys or values of the wrong type (message names the key).
+        Unknown keys, values of the wrong type or out of range, keys this
+        database does not use (the keys it uses listed), a mesh database
+        without its mesh or grid (message names the key).
     """
-    from bionav.validation import check_config
+    from bionav.validation import typed_config
 
-    if isinstance(cfg, DatabaseConfig):
-        return check_config(cfg, prefix="db")
-    from omegaconf import OmegaConf
-    from omegaconf.errors import OmegaConfBaseException
+    return typed_config(cfg, DatabaseConfig, key="db", what=f"db={_name_of(cfg)}")
 
-    try:
-        if OmegaConf.is_config(cfg):  # resolve ${data_dir} etc. against the full config first
-            cfg = OmegaConf.to_container(cfg, resolve=True)
-        merged = OmegaConf.merge(OmegaConf.structured(DatabaseConfig), cfg)
-        config = OmegaConf.to_object(merged)
-    except OmegaConfBaseException as exc:
-        key = getattr(exc, "full_key", None)
-        where = f"db.{key}" if key else "a db.* value"
-        raise UserError(f"invalid db configuration, {where}: {str(exc).splitlines()[0]}; "
-                        f"fix {where} (see the DatabaseConfig fields in bionav/db/config.py).") from None
-    return check_config(config, prefix="db")
+
+def _name_of(cfg) -> str:
+    name = cfg.get("name") if hasattr(cfg, "get") else getattr(cfg, "name", None)
+    return str(name) if name is not None else DatabaseConfig.name
 
 
 def _missing_folder_message(cfg: DatabaseConfig, folder: Path, data_dir: Path) -> str:
@@ -113,9 +109,8 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
         stand-in), or any invalid file (see :mod:`bionav.db.folder`).
     """
     cfg = as_database_config(cfg)
-    source = str(cfg.source).strip().lower()
-    size = check_image_size(cfg.image_size, name="db.image_size")
-    size = None if size is None else list(size)
+    source = cfg.source
+    size = cfg.image_size
     if source == "synthetic":
         from bionav.db.synthetic import synthetic_database
 
@@ -142,11 +137,9 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
 
         db = mesh_grid_database(cfg, cache_dir=Path(cache_dir), progress=_render_progress(cfg.name))
         size = None  # rendered directly at db.image_size
-    elif source == "route":
+    else:  # route (db.source is one of its declared choices)
         raise UserError(f"db={cfg.name} holds views along a route, not a grid; evaluate it with "
                         "experiment=route_homing (grid experiments need a grid database such as db=sim_seville).")
-    else:
-        raise UserError(f"db.source={cfg.source!r} is not a database source; use synthetic, folder or mesh.")
     _check_image_memory(db, size)
     db = preprocess_database(db, preprocess)
     if size is not None:

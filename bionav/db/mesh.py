@@ -57,32 +57,35 @@ def seville_routes_path() -> Path:
 
 @dataclass(frozen=True)
 class MeshDatabaseSpec:
-    """Validated parameters of a mesh-world database (ranges checked in :meth:`from_config`).
+    """Parameters of a mesh-world database, derived from a checked ``db`` config (:meth:`from_config`).
+
+    The ranges are declared once, on :class:`bionav.db.config.DatabaseConfig`,
+    and checked where the ``db`` node enters (:func:`bionav.db.loading.as_database_config`).
 
     Attributes
     ----------
     path : Path
         Mesh file (``.mat``, ``.obj``, ``.ply``).
     grid_shape : (int, int)
-        ``(nx, ny)``, each in 1..500.
+        ``(nx, ny)`` cells; ``(1, 1)`` for route databases.
     spacing_m : float
-        Grid spacing, 0 < s <= 100 m.
+        Grid spacing, metres.
     origin_m : (float, float) or None
-        World ``(x, y)`` of cell ``(0, 0)``; ``None`` centres the grid on the world.
+        World ``(x, y)`` of cell ``(0, 0)``, metres; ``None`` centres the grid on the world.
     camera_height_m : float
-        Over the local terrain, 0 < h <= 100 m.
+        Over the local terrain, metres.
     ground : str
-        ``plane``, ``mesh`` or ``auto`` (``.mat``: plane, else mesh).
+        ``plane`` or ``mesh`` (``auto`` resolved: ``.mat``: plane, else mesh).
     channels : str
         ``grey`` or ``spectral``.
     clearance_m : float or None
-        > 0, or ``None`` (any triangle straight above makes a cell missing).
+        Metres, or ``None`` (any triangle straight above makes a cell missing).
     size : (int, int)
-        Rendered ``(W, H)``, W >= 8, H >= 2.
+        Rendered ``(W, H)``.
     noise : float
         Camera noise std before quantisation, 0..1.
     step_m : float
-        Route databases: 0 < step <= 10 m.
+        Route databases: path length between views, metres.
     """
 
     path: Path
@@ -99,59 +102,19 @@ class MeshDatabaseSpec:
 
     @classmethod
     def from_config(cls, cfg, *, grid: bool = True) -> "MeshDatabaseSpec":
-        """Check every mesh-related ``db.*`` value; raise :class:`UserError` naming the key and its range."""
-        if cfg.path is not None:
-            path = Path(str(cfg.path)).expanduser()
-        elif cfg.world is not None:
-            if str(cfg.world) not in PACKAGED_WORLDS:
-                raise UserError(f"db.world={cfg.world!r} is not a packaged world; packaged worlds: "
-                                f"{', '.join(PACKAGED_WORLDS)}. Or give your own mesh with db.path=FILE.")
-            path = seville_world_path()
-        else:
-            raise UserError("db=mesh needs the mesh file: pass db.path=FILE (.mat with X/Y/Z[/colp], .obj or .ply), "
-                            "or db.world=seville2009 for the packaged Seville ant world.")
-        if grid:
-            shape = cfg.grid_shape
-            if shape is None or len(shape) != 2 or any(int(v) != v or not 1 <= int(v) <= 500 for v in shape):
-                raise UserError(f"db.grid_shape={None if shape is None else list(shape)} must be [nx, ny] with "
-                                "integers in 1..500, e.g. db.grid_shape=[10,10].")
-            shape = (int(shape[0]), int(shape[1]))
-        else:
-            shape = (1, 1)
-        spacing = float(cfg.spacing_m)
-        if not 0 < spacing <= 100:
-            raise UserError(f"db.spacing_m={cfg.spacing_m} must lie in (0, 100] metres.")
-        origin = cfg.origin_m
-        if origin is not None:
-            if len(origin) != 2 or not all(np.isfinite(float(v)) for v in origin):
-                raise UserError(f"db.origin_m={list(origin)} must be [x, y] in metres (or null to centre the grid).")
-            origin = (float(origin[0]), float(origin[1]))
-        height = float(cfg.camera_height_m)
-        if not 0 < height <= 100:
-            raise UserError(f"db.camera_height_m={cfg.camera_height_m} must lie in (0, 100] metres "
-                            "(0.01 = ant eye, 0.2-1 = robots).")
-        if cfg.ground not in ("auto", "plane", "mesh"):
-            raise UserError(f"db.ground={cfg.ground!r} must be auto, plane or mesh.")
-        if cfg.channels not in ("grey", "spectral"):
-            raise UserError(f"db.channels={cfg.channels!r} must be grey or spectral (UV B G R IR).")
-        clearance = cfg.clearance_m
-        if clearance is not None and not float(clearance) > 0:
-            raise UserError(f"db.clearance_m={clearance} must be positive (or null: any triangle above a cell "
-                            "makes it missing).")
-        size = NATIVE_SIZE if cfg.image_size is None else tuple(int(v) for v in cfg.image_size)
-        if len(size) != 2 or size[0] < 8 or size[1] < 2:
-            raise UserError(f"db.image_size={list(size)} must be [W, H] with W >= 8 and H >= 2.")
-        noise = float(cfg.noise)
-        if not 0 <= noise <= 1:
-            raise UserError(f"db.noise={cfg.noise} must lie in [0, 1].")
-        step = float(cfg.step_m)
-        if not 0 < step <= 10:
-            raise UserError(f"db.step_m={cfg.step_m} must lie in (0, 10] metres.")
-        ground = str(cfg.ground)
+        """The spec of a checked :class:`~bionav.db.config.DatabaseConfig` (``source`` mesh or route).
+
+        The mesh file is ``db.path``, else the packaged ``db.world``
+        (:meth:`DatabaseConfig.validate` requires one of them).
+        """
+        path = Path(cfg.path).expanduser() if cfg.path is not None else seville_world_path()
+        ground = cfg.ground
         if ground == "auto":
             ground = "plane" if path.suffix.lower() == ".mat" else "mesh"
-        return cls(path, shape, spacing, origin, height, ground, str(cfg.channels),
-                   None if clearance is None else float(clearance), (int(size[0]), int(size[1])), noise, step)
+        return cls(path, tuple(cfg.grid_shape) if grid else (1, 1), cfg.spacing_m,
+                   None if cfg.origin_m is None else tuple(cfg.origin_m), cfg.camera_height_m, ground, cfg.channels,
+                   cfg.clearance_m, NATIVE_SIZE if cfg.image_size is None else tuple(cfg.image_size), cfg.noise,
+                   cfg.step_m)
 
     def geometry(self) -> PanoramaGeometry:
         """Square pixels, horizon on the middle row, rendered directly at ``size``."""
@@ -269,9 +232,15 @@ def mesh_grid_database(cfg, *, cache_dir=None, progress: Callable[[Iterable], It
         Heading-0 canonical panoramas of the free cells; ``meta`` holds
         ``origin_m``, ``world_xy`` (N, 2) and ``camera_z`` (N,).
     """
+    from bionav.validation import check_allocation
     from bionav.world.mesh_render import MESH_RENDERER_VERSION
 
     spec = MeshDatabaseSpec.from_config(cfg)
+    nx, ny = spec.grid_shape
+    check_allocation(  # float32 render buffer plus the 8-bit images of every cell, all bands
+        5.0 * nx * ny * spec.size[0] * spec.size[1] * (5 if spec.channels == "spectral" else 1),
+        what=f"rendering the {nx} x {ny} cells of {cfg.name!r} at {spec.size[0]} x {spec.size[1]} pixels",
+        fix="choose a smaller db.grid_shape=[nx,ny] or db.image_size=[W,H]")
     world = world_from_spec(spec)
     xy, origin = grid_world_positions(spec, world)
     cam, free = world.camera_positions(xy.reshape(-1, 2), height=spec.camera_height_m, clearance_m=spec.clearance_m)
@@ -286,16 +255,16 @@ def mesh_grid_database(cfg, *, cache_dir=None, progress: Callable[[Iterable], It
               "mesh": world.mesh.digest(), "ground": spec.ground, "ground_z": float(world.ground_z),
               "channels": spec.channels, "geometry": [geometry.width, geometry.height, geometry.horizon_row,
                                                       geometry.rad_per_row],
-              "cameras": np.round(cam, 9).tolist(), "noise": spec.noise, "seed": int(cfg.seed)}
+              "cameras": np.round(cam, 9).tolist(), "noise": spec.noise, "seed": cfg.seed}
     images, path, cached = _cached_render(
-        str(cfg.name), params, cache_dir,
+        cfg.name, params, cache_dir,
         lambda: _render_views(world, cam, np.zeros(len(cam)), geometry, progress=progress, threads=threads),
-        spec.noise, int(cfg.seed))
+        spec.noise, cfg.seed)
     meta = {"source": "mesh", "world": str(spec.path), "origin_m": list(origin), "spacing_m": spec.spacing_m,
             "camera_height_m": spec.camera_height_m, "ground": spec.ground, "channels": list(world.band_names),
             "world_xy": cam[:, :2].tolist(), "camera_z": cam[:, 2].tolist(), "cache_file": str(path),
             "from_cache": cached, "n_missing": int((~free).sum())}
-    db = ImageDatabase(name=str(cfg.name), images=images, positions=positions, grid_shape=spec.grid_shape,
+    db = ImageDatabase(name=cfg.name, images=images, positions=positions, grid_shape=spec.grid_shape,
                        geometry=geometry, spacing_m=spec.spacing_m, meta=meta)
     if cfg.rotate_current:
         from bionav.db.rotation import rotate_views
@@ -450,11 +419,11 @@ def route_database(cfg, *, cache_dir=None, progress=None, threads: int | None = 
               "mesh": world.mesh.digest(), "ground": spec.ground, "channels": spec.channels,
               "geometry": [geometry.width, geometry.height, geometry.horizon_row, geometry.rad_per_row],
               "cameras": np.round(cam, 9).tolist(), "headings": np.round(route.heading, 12).tolist(),
-              "noise": spec.noise, "seed": int(cfg.seed)}
+              "noise": spec.noise, "seed": cfg.seed}
     images, path, cached = _cached_render(
         f"{cfg.name}-{route.name}", params, cache_dir,
         lambda: _render_views(world, cam, route.heading, geometry, progress=progress, threads=threads),
-        spec.noise, int(cfg.seed))
+        spec.noise, cfg.seed)
     n = len(route.xy)
     meta = {"source": "route", "kind": "route", "world": str(spec.path), "route": route.name,
             "step_m": spec.step_m, "world_xy": route.xy.tolist(), "camera_z": cam[:, 2].tolist(),

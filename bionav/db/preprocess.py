@@ -44,21 +44,22 @@ panorama``) keep a cutoff relative to the panorama's own Nyquist frequency.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import MISSING, dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from bionav.db.config import MAX_IMAGE_SIDE
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.homing.imageops import (
     butterworth_lowpass,
-    check_image_size,
     edge_filter,
     equalize_histogram,
     panorama_cutoff_from_raw,
     resize_images,
 )
+from bionav.validation import Range, bounded, typed_config
 
 OPS = ("butterworth", "edges", "equalize", "resize")
 
@@ -78,46 +79,59 @@ class PreprocessConfig:
 
 
 # ---------------------------------------------------------------------------
-# chains
+# chains: one typed dataclass per op, each step through bionav.validation.typed_config
 
-_PARAMS = {
-    "butterworth": {"order", "cutoff", "relative_to"},
-    "edges": {"method"},
-    "equalize": {"levels"},
-    "resize": {"size"},
-}
+
+@dataclass
+class ButterworthStep:
+    """``{op: butterworth, order, cutoff, relative_to}``: cutoff relative to the Nyquist frequency of the
+    panorama, or of the raw camera frame (``relative_to: raw``, as in the thesis)."""
+
+    cutoff: float = bounded(MISSING, gt=0.0, le=1e6)
+    order: int = bounded(1, ge=1, le=100)
+    relative_to: str = bounded("panorama", choices=("panorama", "raw"))
+
+
+@dataclass
+class EdgesStep:
+    """``{op: edges, method}``."""
+
+    method: str = bounded("sobel", choices=("sobel",))
+
+
+@dataclass
+class EqualizeStep:
+    """``{op: equalize, levels}``: grey levels of the histogram equalisation."""
+
+    levels: int = bounded(256, ge=2, le=65536)
+
+
+@dataclass
+class ResizeStep:
+    """``{op: resize, size: [W, H]}`` in pixels."""
+
+    size: list[int] = bounded(MISSING, length=2, items=(Range(ge=1, le=MAX_IMAGE_SIDE), Range(ge=1, le=MAX_IMAGE_SIDE)),
+                              names=("W", "H"))
+
+
+#: op -> the dataclass of its parameters
+STEPS: dict[str, type] = {"butterworth": ButterworthStep, "edges": EdgesStep, "equalize": EqualizeStep,
+                          "resize": ResizeStep}
 
 
 def _normalise_step(step) -> dict:
+    """A step mapping with its ``op`` and every parameter typed and checked (defaults filled)."""
+    import dataclasses
+
     try:
         step = {str(k): v for k, v in dict(step).items()}
     except (TypeError, ValueError):
         raise UserError(f"a preprocessing step must be a mapping like {{op: butterworth, cutoff: 0.03}}, got {step!r}.") from None
-    op = str(step.pop("op", "")).strip().lower()
+    op = step.pop("op", "")
     if op not in OPS:
         raise UserError(f"unknown preprocessing op {op!r}; the ops are {', '.join(OPS)}.")
-    unknown = set(step) - _PARAMS[op]
-    if unknown:
-        raise UserError(
-            f"preprocessing op {op!r} has no parameter(s) {', '.join(sorted(unknown))}; "
-            f"it takes {', '.join(sorted(_PARAMS[op]))}."
-        )
-    if op == "butterworth":
-        if "cutoff" not in step:
-            raise UserError("preprocessing op 'butterworth' needs a cutoff (relative to the Nyquist frequency).")
-        order, cutoff = int(step.get("order", 1)), float(step["cutoff"])
-        if order < 1 or not cutoff > 0:
-            raise UserError(f"butterworth needs order >= 1 and cutoff > 0 (got order={order}, cutoff={cutoff}).")
-        rel = str(step.get("relative_to", "panorama")).strip().lower()
-        if rel not in ("panorama", "raw"):
-            raise UserError(f"butterworth relative_to={rel!r}: use relative_to: raw (cutoff relative to the raw "
-                            "camera frame's Nyquist frequency, as in the thesis) or relative_to: panorama.")
-        step["relative_to"] = rel
-    if op == "resize":
-        if "size" not in step or len(list(step["size"])) != 2:
-            raise UserError("preprocessing op 'resize' needs size: [W, H].")
-        step["size"] = list(check_image_size(step["size"], name="resize size"))
-    return {"op": op, **step}
+    typed = typed_config(step, STEPS[op], key="preprocess.step", what=f"the preprocessing op {op!r}")
+    return {"op": op, **dataclasses.asdict(typed)}
 
 
 def preprocess_images(images: np.ndarray, steps, *, raw_horizon_radius_px: float | None = None) -> np.ndarray:
@@ -144,7 +158,7 @@ def preprocess_images(images: np.ndarray, steps, *, raw_horizon_radius_px: float
         step = _normalise_step(raw_step)
         op = step.pop("op")
         if op == "butterworth":
-            cutoff = float(step["cutoff"])
+            cutoff = step["cutoff"]
             if step["relative_to"] == "raw":
                 if raw_horizon_radius_px is None:
                     from bionav.db.camera import raw_horizon_radius
@@ -152,11 +166,11 @@ def preprocess_images(images: np.ndarray, steps, *, raw_horizon_radius_px: float
                     raw_horizon_radius_px = raw_horizon_radius("ultra-wide")
                 cutoff = panorama_cutoff_from_raw(cutoff, width=out.shape[-1],
                                                   raw_horizon_radius_px=raw_horizon_radius_px)
-            out = butterworth_lowpass(out, order=int(step.get("order", 1)), cutoff=cutoff, clip=(0.0, 1.0))
+            out = butterworth_lowpass(out, order=step["order"], cutoff=cutoff, clip=(0.0, 1.0))
         elif op == "edges":
-            out = edge_filter(out, method=str(step.get("method", "sobel")))
+            out = edge_filter(out, method=step["method"])
         elif op == "equalize":
-            out = equalize_histogram(out, levels=int(step.get("levels", 256)))
+            out = equalize_histogram(out, levels=step["levels"])
         else:
             out = resize_images(out, step["size"])
     return out

@@ -41,7 +41,6 @@ from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.files import cache_key, default_cache_dir, write_atomic
 from bionav.geometry import PanoramaGeometry
-from bionav.homing.imageops import check_image_size
 
 #: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
 NATIVE_SIZE = (561, 81)
@@ -246,7 +245,10 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     image_size : (int, int), optional
         ``(W, H)``; the images are rendered directly at this size with the
         mirror's field of view (:meth:`PanoramaGeometry.resized`). Default
-        :data:`NATIVE_SIZE`.
+        :data:`NATIVE_SIZE`. Values are not checked here: the limits of
+        ``db.image_size`` are declared once (:data:`bionav.db.config.IMAGE_SIZE`,
+        W >= 8, H >= 2) and checked where the ``db`` node enters
+        (:func:`bionav.db.loading.as_database_config`).
     seed : int
         Which world of this kind (``db.seed``); also seeds the camera noise.
     noise : float
@@ -286,7 +288,7 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
         in [0, 1], positions ``(N, 2)`` of the existing cells.
     """
     spec = get_spec(name)
-    w, h = _checked_request(spec, name, image_size, noise, realism)
+    w, h = image_size if image_size is not None else spec.native_size
     geometry = spec.geometry(w, h)
     world = spec.builder(int(seed))
     positions = np.argwhere(world.cells).astype(np.int64)
@@ -304,17 +306,6 @@ def synthetic_database(name: str, *, image_size: tuple[int, int] | list[int] | N
     db = ImageDatabase(name=name, images=_float_images(images_u8), positions=positions,
                        grid_shape=tuple(spec.grid_shape), geometry=geometry, spacing_m=float(spec.spacing_m), meta=meta)
     return _rotated(db, rotation_seed) if rotate_current else db
-
-
-def _checked_request(spec, name: str, image_size, noise: float, realism: str) -> tuple[int, int]:
-    """``(W, H)`` of the images (the stand-in's native size by default); a bad size, noise or realism refused."""
-    w, h = check_image_size(image_size, name="db.image_size", minimum=(8, 2)) or spec.native_size
-    if noise < 0:
-        raise UserError(f"db.noise must be >= 0, got {noise}.")
-    if realism not in ("ideal", "camera"):
-        raise UserError(f"db.realism={realism!r} is not a realism level; use db.realism=camera (raw mirror image, "
-                        "sensor, pose errors) or db.realism=ideal (the clean original panoramas).")
-    return w, h
 
 
 def _check_world(name: str, spec, world, positions: np.ndarray, w: int, h: int) -> None:
@@ -475,15 +466,3 @@ def _camera_configs(spec: SyntheticSpec, camera, pose_error, geometry: PanoramaG
         raise UserError(f"db.camera.rim_radius_px={camera.rim_radius_px:g} does not fit in the raw frame "
                         f"db.camera.raw_size={list(camera.raw_size)}; choose at most {0.5 * min(camera.raw_size):g}.")
     return camera, pose_error
-
-
-def synthetic_database_from_config(cfg, *, cache_dir: str | Path | None = None,
-                                   progress: Callable[[Iterable], Iterable] | None = None) -> ImageDatabase:
-    """:func:`synthetic_database` from a ``db`` config node (:class:`bionav.db.config.DatabaseConfig`)."""
-    size = cfg.image_size
-    return synthetic_database(
-        cfg.name, image_size=None if size is None else list(size), seed=int(cfg.seed), noise=float(cfg.noise),
-        rotate_current=bool(cfg.rotate_current), rotation_seed=int(cfg.rotation_seed), cache_dir=cache_dir,
-        progress=progress, realism=str(getattr(cfg, "realism", "ideal")), camera=getattr(cfg, "camera", None),
-        pose_error=getattr(cfg, "pose_error", None),
-    )

@@ -117,12 +117,12 @@ def rendered_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
     from bionav.robot.worldview import load_world, place_plan, render_camera
 
     ex = experiment_config(cfg, "cleaning")
-    world = load_world(str(ex.world), seed=int(ex.world_seed))
+    world = load_world(ex.world, seed=ex.world_seed)
     cam = ex.camera
     geometry = PanoramaGeometry.square_pixels(
         int(cam.width), int(cam.height), horizon_row=None if cam.horizon_row is None else float(cam.horizon_row))
-    floor = floorplan_from_scene(world.scene, max_height=float(ex.robot_height))
-    placement = place_plan(world, floor, plan, layout=cfg.layout, robot_radius=float(ex.robot_radius))
+    floor = floorplan_from_scene(world.scene, max_height=ex.robot_height)
+    placement = place_plan(world, floor, plan, layout=cfg.layout, robot_radius=ex.robot_radius)
     height = float(cam.height_m)
     noise = float(cam.noise)
 
@@ -190,26 +190,26 @@ def _simulate_run(cfg: DictConfig, world: CleaningWorld, plan: LanePlan, make_co
 
     ex = experiment_config(cfg, "cleaning")
     lo, hi = plan.target_rectangle()
-    raster = Raster.around(lo, hi, cell=float(ex.raster_cell), margin=float(ex.raster_margin))
+    raster = Raster.around(lo, hi, cell=ex.raster_cell, margin=ex.raster_margin)
     target = raster.rectangle_mask(lo, hi)
-    dt = float(ex.dt)
+    dt = ex.dt
     controller = make_controller()
     speed = float(getattr(controller.config, "speed", 0.1))
-    max_time = float(ex.time_limit_factor) * plan.ideal_path_length / speed + 600.0
+    max_time = ex.time_limit_factor * plan.ideal_path_length / speed + 600.0
     controller_seed, camera_seed, sim_seed = (int(s) for s in seeds)
     sim_rng = np.random.default_rng(sim_seed)
     start = world.start.compose(Pose(
-        float(ex.start_position_std) * float(sim_rng.standard_normal()),
-        float(ex.start_position_std) * float(sim_rng.standard_normal()),
-        float(np.radians(float(ex.start_heading_std_deg)) * sim_rng.standard_normal())))
+        ex.start_position_std * float(sim_rng.standard_normal()),
+        ex.start_position_std * float(sim_rng.standard_normal()),
+        float(np.radians(ex.start_heading_std_deg) * sim_rng.standard_normal())))
     confine = (lo, hi, world.start) if controller.confined else None
     camera = world.camera_factory(camera_seed) if controller.uses_camera else None
     robot = SimulatedRobot(
-        DriveModel(track_width=float(ex.track_width), wheel_error=error), start, floor=world.floor,
-        radius=float(ex.robot_radius), confine=confine, camera=camera, rng=sim_rng)
+        DriveModel(track_width=ex.track_width, wheel_error=error), start, floor=world.floor,
+        radius=ex.robot_radius, confine=confine, camera=camera, rng=sim_rng)
     controller.reset(plan, homing=homing if controller.uses_camera else None,
                      rng=np.random.default_rng(controller_seed))
-    recorder = EpisodeRecorder(log, k, time_offset_ns=offset_ns, log_images=bool(ex.log_images))
+    recorder = EpisodeRecorder(log, k, time_offset_ns=offset_ns, log_images=ex.log_images)
     recorder.start({
         "controller": str(cfg.controller.name),
         "controller_config": asdict(controller.config),
@@ -272,7 +272,9 @@ def _init_worker(cfg_container: dict) -> None:
     world = make_world(cfg, plan)
     cls, config = plugin_config("controller", cfg.controller)
     homing = make_vision_homing(cfg, world) if cls.uses_camera else None
-    _WORKER.update(cfg=cfg, plan=plan, world=world, make_controller=lambda: cls(config), homing=homing)
+    track_width = experiment_config(cfg, "cleaning").track_width
+    _WORKER.update(cfg=cfg, plan=plan, world=world, make_controller=lambda: cls(config, track_width=track_width),
+                   homing=homing)
 
 
 def _worker_run(job: tuple[int, tuple, tuple]) -> tuple[CleaningRun, list, int]:
@@ -296,10 +298,10 @@ def simulate(cfg: DictConfig, ctx, world: CleaningWorld, plan: LanePlan, make_co
     from bionav.robot.recording import RESULT_TOPIC
 
     ex = experiment_config(cfg, "cleaning")
-    runs = int(ex.runs)
+    runs = ex.runs
     if runs < 1:
         raise UserError(f"runs must be at least 1, got {runs}; set runs=10 as in the thesis.")
-    errors = wheel_errors(runs, float(ex.wheel_error))
+    errors = wheel_errors(runs, ex.wheel_error)
     seeds = ctx.rng.integers(0, 2**31 - 1, size=(runs, 3))
     results = []
     # log times: the log's wall-clock start plus simulated time (Foxglove shows real dates, not 1970)
@@ -380,22 +382,20 @@ def make_oracle_homing(cfg: DictConfig):
     from bionav.robot.oracle import GeometricHoming, GeometricHomingConfig
 
     node = experiment_config(cfg, "cleaning").oracle
-    return GeometricHoming(GeometricHomingConfig(angle_noise_deg=float(node.angle_noise_deg),
-                                                 compass_noise_deg=float(node.compass_noise_deg),
+    return GeometricHoming(GeometricHomingConfig(angle_noise_deg=node.angle_noise_deg,
+                                                 compass_noise_deg=node.compass_noise_deg,
                                                  seed=int(cfg.seed)))
 
 
 def make_world(cfg: DictConfig, plan: LanePlan) -> CleaningWorld:
     """The :class:`CleaningWorld` that ``cfg.experiment.vision`` asks for."""
-    vision = str(experiment_config(cfg, "cleaning").vision)
-    if vision not in ("render", "oracle"):
-        raise UserError(f"experiment.vision must be 'render' or 'oracle', got {vision!r}.")
+    vision = experiment_config(cfg, "cleaning").vision
     return rendered_world(cfg, plan) if vision == "render" else oracle_world(plan)
 
 
 def make_vision_homing(cfg: DictConfig, world: CleaningWorld):
     """The homing method of a run: ``cfg.homing`` on rendered images, or the oracle."""
-    if str(experiment_config(cfg, "cleaning").vision) == "oracle":
+    if experiment_config(cfg, "cleaning").vision == "oracle":
         return make_oracle_homing(cfg)
     from bionav.config import plugin_config
 
@@ -433,6 +433,7 @@ def replay_log(path, *, runs: list[int] | None = None) -> dict[int, Any]:
         raise UserError(f"{path} is a log of experiment={cfg.experiment.name}, not of experiment=cleaning.")
     plan = plan_from_layout(cfg.layout)
     logged = load_logged_runs(read_messages(path))
+    ex = experiment_config(cfg, "cleaning")
     cls, config = plugin_config("controller", cfg.controller)
     world = make_world(cfg, plan) if cls.uses_camera else None
     homing = make_vision_homing(cfg, world) if cls.uses_camera else None
@@ -441,7 +442,8 @@ def replay_log(path, *, runs: list[int] | None = None) -> dict[int, Any]:
         if k not in logged:
             raise UserError(f"{path} has no run {k}; it holds runs {sorted(logged)}.")
         camera = world.camera_factory(int(logged[k].meta["camera_seed"])) if world is not None else None
-        out[k] = replay_episode(logged[k], cls(config), plan, homing=homing, camera=camera)
+        out[k] = replay_episode(logged[k], cls(config, track_width=ex.track_width), plan, homing=homing,
+                               camera=camera)
     return out
 
 
@@ -458,7 +460,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         raise UserError("experiment=cleaning needs a controller; choose controller=triangulation, "
                         "controller=odometry or controller=random.")
     plan = plan_from_layout(cfg.layout)
-    vision = str(ex.vision)
+    vision = ex.vision
     world = make_world(cfg, plan)
 
     from bionav.config import plugin_config
@@ -466,7 +468,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     cls, config = plugin_config("controller", cfg.controller)
 
     def make_controller():
-        return cls(config)
+        return cls(config, track_width=ex.track_width)
 
     homing = None
     if cls.uses_camera:
@@ -475,7 +477,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     results = simulate(cfg, ctx, world, plan, make_controller, homing, workers=int(cfg.get("workers") or 1))
 
     lo, hi = plan.target_rectangle()
-    raster = Raster.around(lo, hi, cell=float(ex.raster_cell), margin=float(ex.raster_margin))
+    raster = Raster.around(lo, hi, cell=ex.raster_cell, margin=ex.raster_margin)
     ideal = coverage_fractions(sweep_counts(ideal_meander(plan), raster, width=plan.unit_width),
                                raster.rectangle_mask(lo, hi))
     metrics = summarise(results, plan, ideal)

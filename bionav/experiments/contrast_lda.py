@@ -127,6 +127,6 @@ def run(cfg, ctx) -> dict:
             ctx.log.write(FEATURE_TOPIC, {"feature": name, "J": r.J, "J_sigma": r.J_sigma, "n_f": r.n_f},
                           schema_name="bionav.SpectralFeatureLda", schema=FEATURE_SCHEMA)
 
-    return analyse(samples, sigma=float(exp.sigma), n_resamples=int(exp.n_resamples),
+    return analyse(samples, sigma=exp.sigma, n_resamples=exp.n_resamples,
                    rng=ctx.rng, out_dir=ctx.dir, plots_dir=ctx.plots, title=title,
-                   plots=bool(exp.plots), on_features=log_features)
+                   plots=exp.plots, on_features=log_features)

@@ -93,28 +93,28 @@ def run(cfg, ctx) -> dict:
         raise UserError("experiment.times is empty; give the scan times, e.g. experiment.times=[2009-06-17T11:27:04+02:00].")
     n_scans = len(times)
     grid = ScanGrid.from_steps(
-        n_pan=int(exp.n_pan), pan_step=np.deg2rad(float(exp.pan_step_deg)),
-        n_tilt=int(exp.n_tilt), tilt_step=np.deg2rad(float(exp.tilt_step_deg)),
-        tilt_start=np.deg2rad(float(exp.tilt_start_deg)),
-        pan_centre=np.deg2rad(float(exp.pan_centre_deg)),
+        n_pan=exp.n_pan, pan_step=np.deg2rad(exp.pan_step_deg),
+        n_tilt=exp.n_tilt, tilt_step=np.deg2rad(exp.tilt_step_deg),
+        tilt_start=np.deg2rad(exp.tilt_start_deg),
+        pan_centre=np.deg2rad(exp.pan_centre_deg),
     )
     sensor, pantilt, pantilt_node, simulated = _scan_devices(cfg, ctx)
 
     covers = exp.cloud_cover
     depths = exp.cloud_optical_depth
-    scan_s = 60.0 * float(exp.scan_minutes)
-    cloud_seed = int(exp.cloud_seed)
+    scan_s = 60.0 * exp.scan_minutes
+    cloud_seed = exp.cloud_seed
     t0 = times[0]
 
     def sky_at(k, t):
         clouds = CloudLayer(cover=_per_scan(covers, k, n_scans, "cloud_cover"),
                             optical_depth=_per_scan(depths, k, n_scans, "cloud_optical_depth"), seed=cloud_seed)
         return SkyState.from_time(t, clouds=clouds, time_s=(t - t0).total_seconds(),
-                                  turbidity=float(exp.turbidity))
+                                  turbidity=exp.turbidity)
 
     scene = None
     if simulated:
-        scene = backyard_scene(sky_at(0, t0), seed=int(exp.scene_seed))
+        scene = backyard_scene(sky_at(0, t0), seed=exp.scene_seed)
         for device in (sensor, pantilt):
             if hasattr(device, "attach_simulation"):
                 device.attach_simulation(scene, ctx.rng)
@@ -169,20 +169,20 @@ def analyse_scans(scans, times, truths, *, cfg, ctx, grid) -> dict:
     from bionav.spectral.stability import MEASURES
 
     exp = experiment_config(cfg, "contrast_scan")
-    sigma = float(exp.sigma)
+    sigma = exp.sigma
     disc = learn_discriminants(load_samples(exp.learn), sigma=sigma)
     names = list(CHANNELS) + list(dual_contrasts())
     np.savez_compressed(ctx.dir / "scans.npz", counts=scans, times=np.array([t.isoformat() for t in times]),
                         pans=grid.pans, tilts=grid.tilts)
     # every scan's separation images, once: for the stability after separation, the plots and the accuracy
-    seps = [separation_images(s[..., :5], {n: disc[n] for n in names}, threshold=str(exp.separation)) for s in scans]
+    seps = [separation_images(s[..., :5], {n: disc[n] for n in names}, threshold=exp.separation) for s in scans]
     rows = stability_series(scans[..., :5], seps, names=names)
     header = ["scan", "time", "feature", "separated", *MEASURES]
     write_csv_atomic(ctx.dir / "stability.csv", header,
                      ([{**r, "time": times[r["scan"]].isoformat()}.get(c, "") for c in header] for r in rows))
     hours = np.array([(t - times[0]).total_seconds() / 3600.0 for t in times])
-    if bool(exp.plots):
-        _plots(scans, times, hours, rows, disc, seps, ctx.plots, str(exp.separation))
+    if exp.plots:
+        _plots(scans, times, hours, rows, disc, seps, ctx.plots, exp.separation)
     metrics: dict = {"n_scans": int(len(scans)), "n_readings": int(scans.shape[0] * scans.shape[1] * scans.shape[2])}
     if len(scans) > 1:
         for sep, key in ((False, "logMSEvar"), (True, "logMSEvar_separated")):

@@ -94,7 +94,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                 f"{names[0]} ({db.grid_shape} vs {first.grid_shape}); choose databases of one family."
             )
     method = make_homing(cfg, ctx, first.geometry, raw_horizon_radius_px=first.meta.get("raw_horizon_radius_px"))
-    stride = max(1, int(exp.snapshot_stride))
+    stride = max(1, exp.snapshot_stride)
     pos = first.positions
     all_snaps = np.flatnonzero((pos[:, 0] % stride == 0) & (pos[:, 1] % stride == 0))
     n = len(dbs)
@@ -113,7 +113,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         )
         ae = angular_errors(hv.angles, ideal_home_angles(dbs[i].positions[snap_idx], dbs[j].positions))
         success, _ = evaluate_agents(
-            dbs[j], hv, step_length=float(exp.step_length), success_radius=float(exp.success_radius)
+            dbs[j], hv, step_length=exp.step_length, success_radius=exp.success_radius
         )
         q = quality_measures(ae, success)
         matrices["aae"][i, j], matrices["mae"][i, j], matrices["rr"][i, j] = q.aae, q.mae, q.rr

@@ -170,10 +170,10 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     )
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
-    n_plots = min(int(exp.n_quiver_plots), len(hv.snapshot_index))
+    n_plots = min(exp.n_quiver_plots, len(hv.snapshot_index))
     plotted = set(np.linspace(0, len(hv.snapshot_index) - 1, n_plots).round().astype(int).tolist()) if n_plots else set()
     success, paths = evaluate_agents(
-        db, hv, step_length=float(exp.step_length), success_radius=float(exp.success_radius), record=plotted
+        db, hv, step_length=exp.step_length, success_radius=exp.success_radius, record=plotted
     )
     q = quality_measures(ae, success)
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 from bionav.errors import UserError
+from bionav.validation import bounded, typed_config
 
 DIRECTIONS = ("minimize", "maximize")
 
@@ -38,7 +39,12 @@ class Objective:
     """
 
     metric: str
-    direction: str = "minimize"
+    direction: str = bounded("minimize", choices=DIRECTIONS)
+
+    def validate(self) -> None:
+        """A metric name is given (called by :func:`bionav.validation.typed_config`)."""
+        if self.metric.strip() == "":
+            raise UserError("objective.metric is empty; name a metrics.json key, e.g. objective.metric=aae.")
 
     @property
     def worst(self) -> float:
@@ -68,14 +74,9 @@ def objective_from_config(node: Any) -> Objective | None:
     Raises
     ------
     UserError
-        For a direction other than ``minimize``/``maximize`` or an empty metric name.
+        For a direction other than ``minimize``/``maximize`` or a missing or empty metric name
+        (:func:`bionav.validation.typed_config`).
     """
     if node is None:
         return None
-    metric = node.get("metric")
-    direction = str(node.get("direction") or "minimize")
-    if metric is None or str(metric).strip() == "":
-        raise UserError("objective.metric is empty; name a metrics.json key, e.g. objective.metric=aae.")
-    if direction not in DIRECTIONS:
-        raise UserError(f"objective.direction must be minimize or maximize, not {direction!r}.")
-    return Objective(metric=str(metric), direction=direction)
+    return typed_config(node, Objective, key="objective")

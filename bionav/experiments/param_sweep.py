@@ -248,7 +248,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     from bionav.experiments.common import load_configured_database
 
     exp = experiment_config(cfg, "param_sweep")
-    if str(exp.scope) == "grid":
+    if exp.scope == "grid":
         return _run_grid(cfg, ctx, exp)
     homing_cls, homing_cfg, sig_name, sig_cls, sig_cfg = _signature_setup(cfg, ctx)
     db = load_configured_database(cfg)
@@ -257,7 +257,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     size = f"{db.geometry.width}x{db.geometry.height}"
     homings, measures, ms = evaluate_levels(
         homing_cls, homing_cfg, sig_cls, sig_cfg, levels, db,
-        step_length=float(exp.step_length), success_radius=float(exp.success_radius),
+        step_length=exp.step_length, success_radius=exp.success_radius,
     )
     rows = _rows(db, sig_name, preprocess, homings, measures, ms)
     _write_rows(ctx, rows)
@@ -389,22 +389,22 @@ def _run_grid(cfg: DictConfig, ctx, exp) -> dict[str, Any]:
             f"Drop the homing= override (the experiment selects homing=parameter)."
         )
     _, homing_cfg = plugin_config("homing", cfg.homing)
-    grid_name = str(exp.grid)
+    grid_name = exp.grid
     grid = exp.grids.get(grid_name) if exp.grids else None
     if grid is None:
         raise UserError(f"experiment.grid={grid_name!r} is not one of the sweep grids "
                         f"({', '.join(exp.grids or [])}); choose one of them.")
-    signatures = tuple(str(v) for v in _grid_values(grid.signature, what="signature"))
+    signatures = tuple(str(v) for v in _grid_values(grid.get("signature"), what="signature"))
     for name in signatures:
         signature_class(name)  # a clear error for an unknown name before any work
-    sizes = [tuple(int(v) for v in size) for size in _grid_values(grid.image_size, what="image_size")]
+    sizes = [tuple(int(v) for v in size) for size in _grid_values(grid.get("image_size"), what="image_size")]
     sizes.sort(key=lambda wh: -wh[0] * wh[1])  # largest first: the pool ends with short tasks
-    preprocessings = [_preprocess_node(str(v)) for v in _grid_values(grid.preprocess, what="preprocess")]
+    preprocessings = [_preprocess_node(str(v)) for v in _grid_values(grid.get("preprocess"), what="preprocess")]
     base = _GridTask(db_node=OmegaConf.to_container(cfg.db, resolve=True), data_dir=str(cfg.data_dir),
                      cache_dir=str(user_path(str(cfg.cache_dir))), size=sizes[0], preprocess=None, signatures=signatures,
                      homing_cfg=homing_cfg, rings=tuple(int(r) for r in exp.rings),
-                     n_coeffs=tuple(int(k) for k in exp.n_coeffs), step_length=float(exp.step_length),
-                     success_radius=float(exp.success_radius))
+                     n_coeffs=tuple(int(k) for k in exp.n_coeffs), step_length=exp.step_length,
+                     success_radius=exp.success_radius)
     renders = [dataclasses.replace(base, size=size) for size in sizes]
     tasks = [dataclasses.replace(base, size=size, preprocess=pre) for size in sizes for pre in preprocessings]
     # never more processes than tasks or CPUs (worker_pool caps at the CPUs as well; recorded as used)

@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from bionav.errors import UserError
 from bionav.geometry import wrap_angle
@@ -49,36 +49,10 @@ FAULT_TOPIC = "/pol_recordings/faults"
 
 def recordings_config(cfg: DictConfig):
     """The run's ``recordings`` node as a checked :class:`~bionav.experiments.configs.RecordingsConfig`."""
-    from omegaconf.errors import OmegaConfBaseException
-
     from bionav.experiments.configs import RecordingsConfig
-    from bionav.validation import check_config
+    from bionav.validation import typed_config
 
-    node = cfg.get("recordings")
-    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node or {})
-    names = set(RecordingsConfig.__dataclass_fields__)
-    unknown = sorted(set(plain) - names)
-    if unknown:
-        from bionav.config import unknown_key_message
-
-        raise UserError(unknown_key_message("recordings", unknown[0], sorted(names), what="experiment=pol_recordings"))
-    try:
-        rc = OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(RecordingsConfig), plain))
-    except OmegaConfBaseException as exc:
-        key = getattr(exc, "full_key", "") or "recordings"
-        raise UserError(f"bad value for recordings.{key}: {str(exc).splitlines()[0]}.") from None
-    check_config(rc, prefix="recordings")
-    ex = rc.exclude_units
-    if isinstance(ex, str) and ex not in ("auto", "none"):
-        raise UserError(f"bad value recordings.exclude_units={ex}: allowed: auto, none or a list of unit numbers such as [5,7].")
-    if not isinstance(ex, str):
-        try:
-            rc.exclude_units = [int(u) for u in (ex or [])]
-        except (TypeError, ValueError):
-            raise UserError(
-                f"bad value recordings.exclude_units={ex}: allowed: auto, none or a list of unit numbers such as [5,7]."
-            ) from None
-    return rc
+    return typed_config(cfg.get("recordings"), RecordingsConfig, key="recordings", what="experiment=pol_recordings")
 
 
 # ---------------------------------------------------------------------------

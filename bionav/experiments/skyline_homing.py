@@ -117,17 +117,17 @@ def run(cfg, ctx) -> dict:
     conditions = _conditions(exp)
     reps = _representations(exp)
     world_name, (nx, ny), spacing, geometry = _world_grid(exp)
-    sensor_model = LogSensorModel(noise_counts=float(exp.noise_counts))
-    disc = learn_discriminants(load_samples(exp.learn), sigma=float(exp.sigma))
-    border = str(exp.separation)
+    sensor_model = LogSensorModel(noise_counts=exp.noise_counts)
+    disc = learn_discriminants(load_samples(exp.learn), sigma=exp.sigma)
+    border = exp.separation
 
     gx, gy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     positions = np.c_[gx.ravel(), gy.ravel()]
-    side = float(exp.square_side_m)
+    side = exp.square_side_m
     square_cells = np.array([[0, 0], [1, 0], [0, 1], [1, 1]])
     centre = np.array([nx - 1, ny - 1]) * spacing / 2
     square_pos = centre - side / 2 + square_cells * side
-    do_square = bool(exp.square_test)
+    do_square = exp.square_test
 
     counts, squares, truths = _render_conditions(exp, ctx, conditions, world_name, geometry, positions, (nx, ny),
                                                  spacing, square_pos if do_square else None, sensor_model)
@@ -135,7 +135,7 @@ def run(cfg, ctx) -> dict:
                         positions=positions, conditions=np.array([c[0] for c in conditions]))
 
     method = make_homing(cfg, ctx, geometry)
-    stride = max(1, int(exp.snapshot_stride))
+    stride = max(1, exp.snapshot_stride)
     snap_idx = np.flatnonzero((positions[:, 0] % stride == 0) & (positions[:, 1] % stride == 0))
     names = [c[0] for c in conditions]
     n = len(conditions)
@@ -157,7 +157,7 @@ def run(cfg, ctx) -> dict:
                                                                "current_condition", "aae"])
     metrics = _summary_metrics(cfg, reps, n, len(positions), len(snap_idx), results, ms,
                                square if do_square else None)
-    if bool(exp.plots):
+    if exp.plots:
         _plots(ctx.plots, counts, disc, reps, names, metrics, results, geometry, border)
     return metrics
 
@@ -189,17 +189,15 @@ def _world_grid(exp):
     """
     from bionav.geometry import PanoramaGeometry
 
-    world_name = str(exp.world)
-    if world_name not in ("garden", "campus"):
-        raise UserError(f"experiment.world={world_name!r} is unknown; choose garden or campus.")
-    nx, ny = (int(v) for v in exp.grid)
-    spacing = float(exp.spacing_m)
+    world_name = exp.world
+    nx, ny = exp.grid
+    spacing = exp.spacing_m
     if world_name == "campus":
         from bionav.world.worlds.outdoor import GRID_SHAPE, SPACING
 
         (nx, ny), spacing = GRID_SHAPE, SPACING
-    width, height = int(exp.image_width), int(exp.image_height)
-    top = np.deg2rad(float(exp.elevation_top_deg))
+    width, height = exp.image_width, exp.image_height
+    top = np.deg2rad(exp.elevation_top_deg)
     rad_per_row = 2 * np.pi / width
     geometry = PanoramaGeometry(width, height, top / rad_per_row, rad_per_row)
     return world_name, (nx, ny), spacing, geometry
@@ -214,13 +212,13 @@ def _render_conditions(exp, ctx, conditions, world_name, geometry, positions, gr
     from bionav.spectral.scene import garden_scene
 
     nx, ny = grid_shape
-    seed = int(exp.world_seed)
+    seed = exp.world_seed
     extent = max(nx - 1, ny - 1) * spacing
     world_pos = positions * spacing
     counts, squares, truths = [], [], []
     for k, (name, t, cover, tau) in enumerate(conditions):
         sky = SkyState.from_time(t, clouds=CloudLayer(cover=cover, optical_depth=tau, seed=seed + 1),
-                                 turbidity=float(exp.turbidity))
+                                 turbidity=exp.turbidity)
         if world_name == "campus":
             world = campus_world(sky, seed=seed)
             c, truth = render_campus_counts(world, geometry, positions, sensor_model=sensor_model, rng=ctx.rng,
@@ -249,7 +247,7 @@ def _grid_cells(cfg, ctx, exp, method, rep, images, names, positions, grid_shape
     from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
     from bionav.evaluation.pairs import home_vector_matrix, prepare_images
 
-    step, radius = float(exp.step_length), float(exp.success_radius)
+    step, radius = exp.step_length, exp.success_radius
     dbs, prepared = [], []
     for imgs in images:
         db = ImageDatabase(name=rep, images=imgs, positions=positions, grid_shape=grid_shape, geometry=geometry,

@@ -6,7 +6,6 @@ mirror at the top and bottom rows. Homing methods (per-image work) and the
 database preprocessing chain (:mod:`bionav.db.preprocess`, thesis 5.2.1) both
 use them.
 
-* :func:`check_image_size` -- a ``[W, H]`` size from a config value (one message).
 * :func:`resize_panorama` (one image, geometry updated), :func:`resize_images` (a stack).
 * :func:`butterworth_lowpass`, :func:`butterworth_response`, :func:`gaussian_lowpass`.
 * :func:`edge_filter` (Sobel magnitude), :func:`vertical_difference` (the
@@ -26,7 +25,6 @@ from bionav.geometry import PanoramaGeometry
 __all__ = [
     "butterworth_lowpass",
     "butterworth_response",
-    "check_image_size",
     "edge_filter",
     "equalize_histogram",
     "gaussian_lowpass",
@@ -35,36 +33,6 @@ __all__ = [
     "resize_panorama",
     "vertical_difference",
 ]
-
-
-def check_image_size(size, *, name: str, minimum: tuple[int, int] = (1, 1)) -> tuple[int, int] | None:
-    """A ``(W, H)`` image size from a config value, or a clear :class:`UserError`.
-
-    Parameters
-    ----------
-    size : sequence of two ints or None
-        The value as configured (``None`` keeps the native size and is returned as is).
-    name : str
-        The config key, for the message (e.g. ``"db.image_size"``).
-    minimum : (int, int)
-        Smallest usable ``(W, H)`` for the consumer.
-
-    Returns
-    -------
-    (int, int) or None
-    """
-    if size is None:
-        return None
-    example = f"{name}=[288,50]"
-    try:
-        width, height = (int(v) for v in size)
-    except (TypeError, ValueError):
-        raise UserError(f"{name}={size!r} is not an image size; give [W, H] with two integers such as {example}, "
-                        "or null to keep the native size.") from None
-    if width < minimum[0] or height < minimum[1]:
-        raise UserError(f"{name}=[{width}, {height}] is too small; give [W, H] with W >= {minimum[0]} and "
-                        f"H >= {minimum[1]} such as {example}, or null to keep the native size.")
-    return width, height
 
 
 def resize_images(images: np.ndarray, size: Sequence[int]) -> np.ndarray:

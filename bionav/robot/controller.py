@@ -187,8 +187,16 @@ class Controller:
     uses_camera: ClassVar[bool] = False
     confined: ClassVar[bool] = False
 
-    def __init__(self, config: Any) -> None:
+    def __init__(self, config: Any, *, track_width: float = 0.30) -> None:
+        """A controller with its ``config`` for a robot whose wheels are ``track_width`` metres apart.
+
+        The track width is the robot's, not the controller's: one setting
+        (``experiment.track_width``) drives the simulated wheels
+        (:class:`~bionav.robot.kinematics.DriveModel`) and the controller's
+        conversion of ``(v, omega)`` into wheel speeds.
+        """
         self.config = config
+        self.track_width = track_width
 
     def reset(self, plan: LanePlan, *, homing: Any = None, rng: np.random.Generator | None = None) -> None:
         """Start a new run.

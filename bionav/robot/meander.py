@@ -50,9 +50,6 @@ class MeanderConfig:
         Forward speed on lanes, m/s.
     turn_rate : float
         Turn rate of the 90-degree turns on the spot, rad/s.
-    track_width : float
-        The controller's belief about the wheel distance (m), used to turn
-        ``(v, omega)`` into wheel speeds.
     lookahead : float
         Pure-pursuit look-ahead distance on the desired lane, m.
     heading_gain : float
@@ -81,7 +78,6 @@ class MeanderConfig:
 
     speed: float = bounded(0.10, gt=0.0, le=5.0)
     turn_rate: float = bounded(0.5, gt=0.0, le=20.0)
-    track_width: float = bounded(0.30, gt=0.0, le=5.0)
     lookahead: float = bounded(0.60, gt=0.0, le=100.0)
     heading_gain: float = bounded(1.5, ge=0.0, le=100.0)
     max_steer_rate: float = bounded(0.5, gt=0.0, le=20.0)
@@ -161,7 +157,7 @@ class MeanderController(Controller):
         self._apply_fix(obs.wall.distance - self.plan.wall_offset, heading, 1.0)
 
     def _wheels(self, v: float, omega: float) -> tuple[float, float]:
-        return wheel_speeds(v, omega, track_width=self.config.track_width)
+        return wheel_speeds(v, omega, track_width=self.track_width)
 
     def _lane_command(self) -> tuple[float, float]:
         c = self.config

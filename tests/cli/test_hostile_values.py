@@ -180,3 +180,82 @@ def test_every_built_in_value_declares_its_range():
             if range_of(f) is None and not ("SkyCondition" in text or text == "list[str]"):
                 undeclared.append(f"{owner}: {key} ({text})")
     assert not undeclared, "\n".join(undeclared)
+
+
+# --------------------------------------------------------------------------- keys a database does not use
+UNUSED = [
+    (["db.grid_shape=[5,5]"], ["db.grid_shape=[5,5] is not used by db=sim_original",
+                               "it uses: name, source, image_size, seed"]),
+    (["db.spacing_m=0.5"], ["db.spacing_m=0.5 is not used by db=sim_original", "rotation_seed"]),
+    (["db=sim_seville", "db.realism=camera"], ["db.realism=camera is not used by db=sim_seville",
+                                               "grid_shape, spacing_m, origin_m"]),
+    (["db=folder", "db.path=.", "db.seed=3"], ["db.seed=3 is not used by db=folder", "naming, azimuth"]),
+    (["experiment=cleaning", "experiment.vision=oracle", "experiment.camera.width=100"],
+     ["experiment.camera.width=100 is not used by experiment=cleaning", "oracle"]),
+    (["experiment=skyline_homing", "experiment.world=campus", "experiment.grid=[5,5]"],
+     ["experiment.grid=[5,5] is not used by experiment=skyline_homing", "world_seed, image_width"]),
+    (["db=seville_route", "db.grid_shape=[3,3]"], ["db.grid_shape=[3,3] is not used by db=seville_route",
+                                                   "route, routes_path, step_m"]),
+]
+
+
+@pytest.mark.parametrize("overrides,needles", UNUSED, ids=[" ".join(o) for o, _ in UNUSED])
+def test_key_a_database_does_not_use_is_an_error(tmp_path, overrides, needles):
+    """``db.grid_shape`` on a stand-in with its own grid is refused, naming the keys the database uses (issue 28)."""
+    proc = run_bionav(*overrides, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    assert_fails_cleanly(proc, *needles, "Remove", code=2)
+    run = tmp_path / "run"
+    assert not run.exists() or not any(run.iterdir())
+
+
+def test_typed_config_is_the_one_path():
+    """Types, declared ranges, per-position ranges, the ``unused_keys`` and ``validate`` hooks, one error style."""
+    from omegaconf import OmegaConf
+
+    from bionav.errors import UserError
+    from bionav.validation import typed_config
+
+    @dataclasses.dataclass
+    class Node:
+        lo: float = bounded(1.0, ge=0.0, le=10.0)
+        hi: float = bounded(2.0, ge=0.0, le=10.0)
+        size: typing.Optional[list[int]] = bounded(None, length=2, items=(Range(ge=8), Range(ge=2)), names=("W", "H"))
+        kind: str = bounded("a", choices=("a", "b"))
+        only_b: int = bounded(0, ge=0, le=5)
+
+        def unused_keys(self):
+            used = ("lo", "hi", "size", "kind") + (("only_b",) if self.kind == "b" else ())
+            return [k for k in ("only_b",) if k not in used and self.only_b != 0], used
+
+        def validate(self):
+            if not self.lo < self.hi:
+                raise UserError(f"node.lo={self.lo} must be below node.hi={self.hi}.")
+
+    got = typed_config(OmegaConf.create({"lo": 1, "size": [8, 2]}), Node, key="node")
+    assert isinstance(got, Node) and got.lo == 1.0 and type(got.lo) is float and got.size == [8, 2]
+    assert typed_config({"kind": "b", "only_b": 4}, Node, key="node").only_b == 4
+    cases = [
+        ({"lo": -1}, r"bad value node.lo=-1.0: it is too small; allowed: a finite number >= 0 and <= 10"),
+        ({"size": [8, 1]}, r"bad value node.size=\[8,1\]: it has H=1 that is too small; allowed: a list of 2 items, "
+                           r"W an integer >= 8, H an integer >= 2"),
+        ({"sise": [8, 2]}, r"unknown key node.sise: node \(the node\) has no key 'sise'; its keys are lo, hi, size, "
+                           r"kind, only_b. Did you mean node.size\?"),
+        ({"lo": "x"}, r"bad value node.lo=x \(the node\): .*Give node.lo a value of the declared type"),
+        ({"only_b": 2}, r"node.only_b=2 is not used by the node; it uses: lo, hi, size, kind. Remove node.only_b"),
+        ({"lo": 5, "hi": 4}, r"node.lo=5.0 must be below node.hi=4.0"),
+    ]
+    for node, message in cases:
+        with pytest.raises(UserError, match=message):
+            typed_config(node, Node, key="node", what="the node")
+
+
+def test_every_db_preset_uses_every_key_it_sets():
+    """The presets' own values pass the unused-key check (a stand-in's grid as its preset records it)."""
+    from bionav.config import compose, config_options
+    from bionav.db.loading import as_database_config
+
+    names = config_options("db")
+    assert {"sim_original", "sim_uni", "original", "mesh", "sim_seville", "seville_route"} <= set(names)
+    for name in names:
+        extra = {"folder": ["db.path=."], "mesh": ["db.world=seville2009"]}.get(name, [])
+        assert as_database_config(compose([f"db={name}", *extra]).db).name == name

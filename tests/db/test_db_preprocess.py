@@ -99,7 +99,7 @@ def test_chains_and_errors():
     np.testing.assert_array_equal(preprocess_images(imgs, chain), expected)
     with pytest.raises(UserError, match="unknown preprocessing op"):
         preprocess_images(imgs, [{"op": "sharpen"}])
-    with pytest.raises(UserError, match="no parameter"):
+    with pytest.raises(UserError, match="has no key .sigma."):
         preprocess_images(imgs, [{"op": "edges", "sigma": 2}])
     with pytest.raises(UserError, match="cutoff"):
         preprocess_images(imgs, [{"op": "butterworth", "order": 2}])

@@ -3,11 +3,9 @@
 import numpy as np
 import pytest
 
-from bionav.errors import UserError
 from bionav.geometry import PanoramaGeometry
 from bionav.homing.imageops import (
     butterworth_lowpass,
-    check_image_size,
     resize_images,
     resize_panorama,
     vertical_difference,
@@ -46,12 +44,3 @@ def test_resize_panorama_keeps_the_field_of_view_and_matches_the_stack_resize():
 
 def test_vertical_difference():
     np.testing.assert_array_equal(vertical_difference([[1.0, 2.0], [4.0, 2.0], [4.0, 5.0]]), [[3.0, 0.0], [0.0, 3.0]])
-
-
-def test_check_image_size_names_the_key():
-    assert check_image_size(None, name="db.image_size") is None
-    assert check_image_size([288, 50], name="db.image_size") == (288, 50)
-    with pytest.raises(UserError, match=r"homing.image_size=\[4, 4\] is too small.*W >= 8"):
-        check_image_size([4, 4], name="homing.image_size", minimum=(8, 8))
-    with pytest.raises(UserError, match="db.image_size=.*not an image size"):
-        check_image_size([1, 2, 3], name="db.image_size")

@@ -133,3 +133,20 @@ def test_blocked_moves_and_escape_from_a_slightly_bad_start():
     assert robot.bumper
     robot.apply(-0.1, -0.1, 0.1)
     assert not robot.bumper and robot.pose.x == pytest.approx(0.0)
+
+
+def test_track_width_is_the_robots_one_setting(tmp_path):
+    """The controllers turn (v, omega) into wheel speeds with the robot's track width (issue 28: one setting)."""
+    import dataclasses
+
+    from helpers import assert_fails_cleanly, run_bionav
+
+    for config_cls in (OdometryConfig, TriangulationConfig, RandomConfig):
+        assert "track_width" not in {f.name for f in dataclasses.fields(config_cls)}
+    ctrl = OdometryController(OdometryConfig(), track_width=0.5)
+    # a turn on the spot at 1 rad/s: the wheels run at -/+ omega * b / 2
+    assert ctrl._wheels(0.0, 1.0) == pytest.approx((-0.25, 0.25))
+    assert OdometryController(OdometryConfig())._wheels(0.0, 1.0) == pytest.approx((-0.15, 0.15))  # default 0.30 m
+    proc = run_bionav("experiment=cleaning", "controller.track_width=0.4", f"hydra.run.dir={tmp_path / 'run'}",
+                      cwd=tmp_path)
+    assert_fails_cleanly(proc, "unknown key controller.track_width", code=2)

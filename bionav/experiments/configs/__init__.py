@@ -20,7 +20,6 @@ import path of the experiments and of plugin authors
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
@@ -50,7 +49,7 @@ from bionav.experiments.configs.spectral import (
     SkyConditionConfig,
     SkylineHomingConfig,
 )
-from bionav.validation import bounded, check_config
+from bionav.validation import bounded, typed_config
 
 __all__ = [
     "EXPERIMENT_CONFIGS", "GROUP_CONFIGS", "ROUTE_METHODS", "ROUTE_PROTOCOLS", "CleaningCameraConfig",
@@ -59,59 +58,12 @@ __all__ = [
     "PolCompassConfig", "PolFilterConfig", "PolPartialConfig", "PolRecordingsConfig", "PolScanConfig",
     "PolSkyConfig", "PolVsEmConfig", "RecordingsConfig", "RouteHomingConfig", "RunSettings",
     "SkyConditionConfig", "SkylineHomingConfig", "check_group_nodes", "check_run_settings",
-    "experiment_config", "register", "typed_node",
+    "experiment_config", "register",
 ]
-
-
-def _schema_file(schema: type) -> str:
-    """The source file of a config dataclass as users find it (``bionav/experiments/configs/grid.py``)."""
-    return schema.__module__.replace(".", "/") + ".py"
 
 
 #: other option groups with a typed schema: group -> dataclass (checked by :func:`check_group_nodes`)
 GROUP_CONFIGS: dict[str, type] = {"layout": LayoutConfig, "data": DataConfig}
-
-
-def typed_node(node: Any, schema: type, *, prefix: str, what: str) -> DictConfig:
-    """``node`` merged onto ``schema``: unknown keys and wrong types named, every value range-checked.
-
-    Parameters
-    ----------
-    node : DictConfig or Mapping
-        The (resolved) config node.
-    schema : type
-        Its dataclass.
-    prefix : str
-        The key users type for the node (``layout``).
-    what : str
-        Said in messages (``layout=short_lanes``).
-    """
-    from omegaconf.errors import OmegaConfBaseException
-
-    from bionav.config import unknown_key_message
-    from bionav.errors import UserError
-
-    plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else dict(node)
-    try:
-        typed = OmegaConf.merge(OmegaConf.structured(schema), plain)
-        instance = OmegaConf.to_object(typed)
-    except OmegaConfBaseException as exc:
-        key = str(getattr(exc, "full_key", "") or "")
-        if type(exc).__name__ in ("ConfigKeyError", "ConfigAttributeError") and key:
-            parent, bad = key.rsplit(".", 1) if "." in key else ("", key)
-            where = OmegaConf.select(OmegaConf.structured(schema), parent) if parent else OmegaConf.structured(schema)
-            valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
-            full_parent = f"{prefix}.{parent}" if parent else prefix
-            raise UserError(unknown_key_message(full_parent, bad, valid, what=what)) from None
-        if type(exc).__name__ == "MissingMandatoryValue" and key:
-            raise UserError(f"{prefix}.{key} has no value ({what} needs it); add {prefix}.{key}=<value> "
-                            "on the command line.") from None
-        raise UserError(
-            f"bad value for {prefix}.{key or '<key>'} ({what}): {str(exc).splitlines()[0]}. "
-            f"Give it a value of the declared type (see {schema.__name__} in {_schema_file(schema)})."
-        ) from None
-    check_config(instance, prefix=prefix)
-    return typed
 
 
 def check_group_nodes(cfg: DictConfig) -> None:
@@ -119,7 +71,7 @@ def check_group_nodes(cfg: DictConfig) -> None:
     for group, schema in GROUP_CONFIGS.items():
         node = cfg.get(group) if isinstance(cfg, DictConfig) else None
         if node is not None:
-            typed_node(node, schema, prefix=group, what=f"{group}={node.get('name', '?')}")
+            typed_config(node, schema, key=group, what=f"{group}={node.get('name', '?')}")
 
 
 @dataclass
@@ -130,20 +82,11 @@ class RunSettings:
     workers: int = bounded(2, ge=1, le=1024)
 
 
-def check_run_settings(cfg: DictConfig) -> None:
-    """Check the top-level ``seed`` and ``workers`` against :class:`RunSettings` (key, value, range)."""
-    from bionav.errors import UserError
-
-    values = {}
-    for f in ("seed", "workers"):
-        value = cfg.get(f) if isinstance(cfg, DictConfig) else None
-        if value is None:
-            continue
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise UserError(f"bad value {f}={value}: it must be an integer; allowed: "
-                            f"{RunSettings.__dataclass_fields__[f].metadata['range'].describe(integer=True)}.")
-        values[f] = value
-    check_config(RunSettings(**values), prefix="")
+def check_run_settings(cfg: DictConfig) -> RunSettings:
+    """The top-level ``seed`` and ``workers`` as :class:`RunSettings` (key, value and range named)."""
+    values = {f: cfg.get(f) for f in ("seed", "workers")} if isinstance(cfg, DictConfig) else {}
+    return typed_config({f: v for f, v in values.items() if v is not None}, RunSettings, key="",
+                        what="the run settings")
 
 
 #: experiment name -> its config dataclass
@@ -175,6 +118,13 @@ def register(store=None) -> None:
 def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
     """The run's ``experiment`` node typed by its dataclass, defaults filled, every value checked.
 
+    Finds the dataclass by the experiment's name and types the node with
+    :func:`bionav.validation.typed_config` (the one config path), in the
+    context of the whole config so that defaults such as ``${seed}`` and
+    ``${experiment.grid}`` resolve; the checked instance is handed back as a
+    structured node, so experiments read it as attributes (``exp.step_length``,
+    already a ``float``) or as a mapping (``exp.sky.get("time")``).
+
     Parameters
     ----------
     cfg : DictConfig
@@ -188,9 +138,10 @@ def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
     Returns
     -------
     DictConfig
-        A structured node (attribute access, ``.get``, typed assignment) of
-        :data:`EXPERIMENT_CONFIGS` ``[name]``; an experiment without a
-        dataclass gets its node back unchanged.
+        A structured node of the checked :data:`EXPERIMENT_CONFIGS` ``[name]``
+        instance (values of their declared types; ``OmegaConf.to_object`` gives
+        the instance); an experiment without a dataclass gets its node back
+        unchanged.
 
     Raises
     ------
@@ -199,36 +150,11 @@ def experiment_config(cfg: DictConfig, name: str | None = None) -> DictConfig:
         value of the wrong type, or a value outside its range (key, value and
         allowed range named).
     """
-    from omegaconf.errors import OmegaConfBaseException
-
-    from bionav.config import unknown_key_message
-    from bionav.errors import UserError
-
     node = cfg.get("experiment") if isinstance(cfg, DictConfig) else None
     if node is not None and node.get("name") is not None:
         name = str(node.get("name"))
     schema = EXPERIMENT_CONFIGS.get(name or "")
     if schema is None:
         return node
-    try:
-        root = OmegaConf.merge(OmegaConf.create({"seed": 0, "experiment": OmegaConf.structured(schema)}), cfg)
-        exp = root.experiment
-        instance = OmegaConf.to_object(exp)
-    except OmegaConfBaseException as exc:
-        key = str(getattr(exc, "full_key", "") or "")
-        kind = type(exc).__name__
-        if kind in ("ConfigKeyError", "ConfigAttributeError") and key:
-            parent, bad = key.rsplit(".", 1) if "." in key else ("", key)
-            where = OmegaConf.select(OmegaConf.structured(schema), parent.partition(".")[2]) if "." in parent \
-                else OmegaConf.structured(schema)
-            valid = [str(k) for k in where.keys()] if isinstance(where, DictConfig) else []
-            raise UserError(unknown_key_message(parent, bad, valid, what=f"experiment={name}")) from None
-        if kind == "MissingMandatoryValue" and key:
-            raise UserError(f"{key} has no value (experiment={name} needs it); add {key}=<value> "
-                            "on the command line.") from None
-        raise UserError(
-            f"bad value for {key or 'experiment'} (experiment={name}): {str(exc).splitlines()[0]}. "
-            f"Give it a value of the declared type (see {schema.__name__} in {_schema_file(schema)})."
-        ) from None
-    check_config(instance, prefix="experiment")
-    return exp
+    root = cfg if "seed" in cfg else OmegaConf.merge(OmegaConf.create({"seed": 0}), cfg)
+    return OmegaConf.structured(typed_config(None, schema, key="experiment", what=f"experiment={name}", root=root))

@@ -70,6 +70,18 @@ class CleaningConfig:
     raster_margin: float = bounded(0.5, ge=0.0, le=100.0)
     log_images: bool = False
 
+    def unused_keys(self) -> tuple[list[str], tuple[str, ...]]:
+        """``camera`` is not used with ``vision=oracle``, ``oracle`` not with ``vision=render``
+        (called by :func:`bionav.validation.typed_config`)."""
+        import dataclasses
+
+        other = {"render": "oracle", "oracle": "camera"}[self.vision]
+        default = {"oracle": CleaningOracleConfig(), "camera": CleaningCameraConfig()}[other]
+        used = tuple(f for f in self.__dataclass_fields__ if f != other)
+        given = getattr(self, other)
+        return [f"{other}.{f.name}" for f in dataclasses.fields(default)
+                if getattr(given, f.name) != getattr(default, f.name)], used
+
 
 @dataclass
 class LayoutConfig:

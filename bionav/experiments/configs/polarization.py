@@ -150,7 +150,7 @@ class RecordingsConfig:
     """
 
     path: Optional[str] = None
-    exclude_units: Any = bounded("auto")  # auto | none | [unit, ...]: checked in pol_recordings.excluded_units
+    exclude_units: Any = bounded("auto")  # auto | none | [unit, ...]: checked in validate()
     saturation_counts: float = bounded(11000.0, gt=0.0, le=1e12)
     dark_counts: float = bounded(1.0, ge=0.0, le=1e12)
     imbalance_decades: float = bounded(0.15, gt=0.0, le=3.0)
@@ -167,6 +167,17 @@ class RecordingsConfig:
     calibration: str = "none"
     calibration_parts: list[str] = bounded(["angles"], length=(1, 2), item=Range(choices=("gains", "angles")))
     calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
+
+    def validate(self) -> None:
+        """``exclude_units`` is ``auto``, ``none`` or a list of unit numbers (called by ``typed_config``)."""
+        ex = self.exclude_units
+        ok = ex in ("auto", "none") if isinstance(ex, str) else (
+            isinstance(ex, (list, tuple)) and all(isinstance(u, int) and not isinstance(u, bool) for u in ex))
+        if not ok:
+            from bionav.errors import UserError
+
+            raise UserError(f"bad value recordings.exclude_units={ex}: allowed: auto, none or a list of unit "
+                            "numbers such as [5,7].")
 
 
 @dataclass

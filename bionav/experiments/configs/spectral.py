@@ -142,6 +142,18 @@ class SkylineHomingConfig:
     plots: bool = True
     learn: LearnSamplesConfig = field(default_factory=LearnSamplesConfig)
 
+    def unused_keys(self) -> tuple[list[str], tuple[str, ...]]:
+        """``grid`` and ``spacing_m`` are the garden's: the campus has its own 10 x 17 grid at 1 m
+        (called by :func:`bionav.validation.typed_config`)."""
+        import dataclasses
+
+        fields = {f.name: f for f in dataclasses.fields(self)}
+        own = () if self.world == "garden" else ("grid", "spacing_m")
+        used = tuple(name for name in fields if name not in own)
+        unused = [name for name in own if getattr(self, name) != (
+            fields[name].default if fields[name].default is not dataclasses.MISSING else fields[name].default_factory())]
+        return unused, used
+
 
 @dataclass
 class DataConfig:

@@ -3,38 +3,24 @@
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import numpy as np
 
-from bionav.errors import UserError
+from bionav.validation import typed_config
 
 
-def coerce_config(config_cls: type, config: Any):
-    """Turn ``None``, a mapping (dict, OmegaConf node) or a ``config_cls`` into a ``config_cls``.
+def parameters_of(config: Any, config_cls: type) -> Any:
+    """The entries of a mapping that are fields of ``config_cls``; ``None`` and instances unchanged.
 
-    Keys of a mapping that are not fields of ``config_cls`` (e.g. a ``name`` or
-    Hydra's ``_target_``) are ignored.
+    Keys that are not fields (a ``name`` or Hydra's ``_target_``, or the parameters of another
+    signature in a shared mapping) are left out, as the Python API always did; the command line
+    refuses unknown keys before this (:func:`bionav.config.plugin_config`).
     """
-    if config is None:
-        return config_cls()
-    if isinstance(config, config_cls):
+    if config is None or dataclasses.is_dataclass(config) or not hasattr(config, "keys"):
         return config
-    if isinstance(config, Mapping) or hasattr(config, "keys"):
-        names = {f.name for f in dataclasses.fields(config_cls)}
-        return config_cls(**{k: config[k] for k in config.keys() if k in names})
-    raise TypeError(f"cannot build {config_cls.__qualname__} from {type(config).__name__}")
-
-
-def _check_positive(config: Any, owner: str) -> None:
-    for name in ("rings", "n_coeffs", "bins"):
-        value = getattr(config, name, None)
-        if value is not None and (int(value) != value or value < 1):
-            raise UserError(
-                f"signature.{name}={value!r} is not valid for signature {owner!r}: it must be a "
-                f"positive integer. Set signature.{name} to 1 or more."
-            )
+    names = {f.name for f in dataclasses.fields(config_cls)}
+    return {k: config[k] for k in config.keys() if k in names}
 
 
 class Signature:
@@ -63,8 +49,8 @@ class Signature:
     uses_raw: ClassVar[bool] = False
 
     def __init__(self, config: Any = None) -> None:
-        self.config = coerce_config(self.Config, config)
-        _check_positive(self.config, self.name)
+        self.config = typed_config(parameters_of(config, self.Config), self.Config, key="signature",
+                                   what=f"signature={self.name}")
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.config!r})"

@@ -30,8 +30,6 @@ class RandomConfig:
         Forward speed, m/s.
     turn_rate : float
         Turn rate on the spot, rad/s.
-    track_width : float
-        Believed wheel distance, m.
     backoff : float
         Distance backed off after a bump, m.
     min_turn_deg, max_turn_deg : float
@@ -42,7 +40,6 @@ class RandomConfig:
 
     speed: float = bounded(0.10, gt=0.0, le=5.0)
     turn_rate: float = bounded(0.5, gt=0.0, le=20.0)
-    track_width: float = bounded(0.30, gt=0.0, le=5.0)
     backoff: float = bounded(0.03, ge=0.0, le=10.0)
     min_turn_deg: float = bounded(45.0, ge=0.0, le=360.0)
     max_turn_deg: float = bounded(180.0, ge=0.0, le=360.0)
@@ -90,7 +87,7 @@ class RandomController(Controller):
             err = float(wrap_angle(self._target - obs.odometry.theta))
             if abs(err) > np.radians(0.5):
                 omega = float(np.clip(2.0 * err, -c.turn_rate, c.turn_rate))
-                return Command(*wheel_speeds(0.0, omega, track_width=c.track_width), False, info)
+                return Command(*wheel_speeds(0.0, omega, track_width=self.track_width), False, info)
             self.phase = "forward"
         if self.phase == "back":
             return Command(-c.speed, -c.speed, False, info)

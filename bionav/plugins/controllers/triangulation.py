@@ -136,9 +136,6 @@ class TriangulationController(MeanderController):
         if homing is None:
             raise UserError("controller=triangulation needs a homing method (homing=minwarping or another "
                             "homing plugin); none was given.")
-        if self.config.orientation not in ("compass", "odometry"):
-            raise UserError(f"controller.orientation must be 'compass' or 'odometry', got "
-                            f"{self.config.orientation!r}; fix the override.")
         super().reset(plan, homing=homing, rng=rng)
         self.nodes: list[MapNode] = []
         self._lane_nodes: dict[int, list[MapNode]] = {}

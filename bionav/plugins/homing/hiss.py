@@ -7,9 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
-from bionav.homing.imageops import check_image_size
 from bionav.validation import Range, bounded
 
 
@@ -50,14 +48,6 @@ class HissHoming(HomingMethod):
 
     def __init__(self, config: Any, *, geometry) -> None:
         super().__init__(config, geometry=geometry)
-        cfg = self.config
-        check_image_size(cfg.image_size, name="homing.image_size", minimum=(8, 8))
-        if not (0.0 <= cfg.wrap_pad <= 1.0):
-            raise UserError(f"homing.wrap_pad={cfg.wrap_pad} must lie in [0, 1] (a fraction of the width)")
-        if not (0.0 < cfg.ratio <= 1.0):
-            raise UserError(f"homing.ratio={cfg.ratio} must lie in (0, 1] (Lowe's ratio test; 0.8 is usual)")
-        if cfg.scale_threshold < 0:
-            raise UserError(f"homing.scale_threshold={cfg.scale_threshold} must be >= 0")
 
     def prepare(self, image):
         """SIFT features of the (resized) panorama, seamless across the border (:func:`bionav.homing.features.sift_features`)."""

@@ -48,9 +48,8 @@ class MfdidHoming(HomingMethod):
 
     def __init__(self, config: MfdidConfig, *, geometry) -> None:
         super().__init__(config, geometry=geometry)
-        from bionav.homing.imageops import check_image_size, resize_panorama
+        from bionav.homing.imageops import resize_panorama
 
-        check_image_size(config.image_size, name="homing.image_size")
         _, self.work_geometry = resize_panorama(
             np.zeros((geometry.height, geometry.width), np.float32), geometry=geometry, size=config.image_size
         )

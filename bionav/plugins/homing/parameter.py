@@ -15,7 +15,6 @@ from typing import Any, Mapping, Optional
 
 import numpy as np
 
-from bionav.errors import UserError
 from bionav.geometry import PanoramaGeometry
 from bionav.homing.base import HomeVector, HomingMethod
 from bionav.validation import bounded
@@ -95,16 +94,12 @@ class ParameterHoming(HomingMethod):
     uses_test_steps = True
 
     def __init__(self, config: Any = None, *, geometry: PanoramaGeometry, signature: Any = None) -> None:
-        from bionav.homing.signatures.base import coerce_config
+        from bionav.homing.signatures.base import parameters_of
         from bionav.plugins.signatures import signature_class
+        from bionav.validation import typed_config
 
-        config = coerce_config(Config, config)
+        config = typed_config(parameters_of(config, Config), Config, key="homing", what="homing=parameter")
         super().__init__(config, geometry=geometry)
-        if config.gradient not in GRADIENTS:
-            raise UserError(
-                f"homing.gradient={config.gradient!r} is not a gradient estimator of homing=parameter. "
-                f"Choose one of: {', '.join(GRADIENTS)}."
-            )
         if not hasattr(signature, "compute"):  # a mapping of parameters, or None
             signature = signature_class(config.signature)(signature)
         names = {f.name for f in dataclasses.fields(signature.config)}
@@ -113,8 +108,6 @@ class ParameterHoming(HomingMethod):
         }
         if overrides:
             signature = type(signature)(dataclasses.replace(signature.config, **overrides))
-        if not config.mf_step > 0:
-            raise UserError(f"homing.mf_step={config.mf_step} must be positive; the default is 0.05.")
         self.signature = signature
         self.signature_name = str(getattr(signature, "name", "") or type(signature).__name__)
         gradient = config.gradient

@@ -52,14 +52,9 @@ class SiftHoming(HomingMethod):
     cache_version = "2"  # prepare() returns bionav.homing.features.SiftFeatures with size and width
 
     def __init__(self, config: SiftConfig, *, geometry) -> None:
-        if config.combine not in ("average", "max"):
-            from bionav.errors import UserError
-
-            raise UserError(f"homing.combine must be 'average' or 'max', not {config.combine!r}.")
         super().__init__(config, geometry=geometry)
-        from bionav.homing.imageops import check_image_size, resize_panorama
+        from bionav.homing.imageops import resize_panorama
 
-        check_image_size(config.image_size, name="homing.image_size")
         _, self.work_geometry = resize_panorama(
             np.zeros((geometry.height, geometry.width), np.float32), geometry=geometry, size=config.image_size
         )

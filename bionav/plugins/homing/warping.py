@@ -17,7 +17,6 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.homing.base import HomeVector, HomingMethod
-from bionav.homing.imageops import check_image_size
 from bionav.homing.warping.scaleplanes import THRESHOLD_RULES
 from bionav.validation import Range, bounded
 
@@ -32,17 +31,6 @@ def _grey(image) -> np.ndarray:
             "check the database's images"
         )
     return img
-
-
-def _check_common(name: str, cfg) -> None:
-    check_image_size(cfg.image_size, name="homing.image_size", minimum=(3, 3))
-    if cfg.butterworth_cutoff is not None and not (0.0 < cfg.butterworth_cutoff <= 1.0):
-        raise UserError(
-            f"homing.butterworth_cutoff={cfg.butterworth_cutoff} is outside (0, 1]; give the cutoff "
-            "relative to the Nyquist frequency (the thesis uses 0.1) or null to switch the filter off"
-        )
-    if cfg.butterworth_order < 1:
-        raise UserError(f"homing.butterworth_order={cfg.butterworth_order} must be >= 1 (the thesis uses 3)")
 
 
 #: what ``homing.butterworth_cutoff`` is relative to: the loaded panorama's Nyquist frequency, or the raw
@@ -66,7 +54,7 @@ def panorama_cutoff(method: HomingMethod, width: int) -> float | None:
     if cfg.butterworth_cutoff is None:
         return None
     if getattr(cfg, "butterworth_relative_to", "panorama") != "raw":
-        return float(cfg.butterworth_cutoff)
+        return cfg.butterworth_cutoff
     from bionav.homing.imageops import panorama_cutoff_from_raw
 
     radius = getattr(method, "raw_horizon_radius_px", None)
@@ -132,12 +120,6 @@ class _PlaneWarping(HomingMethod):
     def _check(self) -> None:
         cfg = self.config
         name = self.name
-        _check_common(name, cfg)
-        rule = getattr(cfg, "threshold_rule", "geometric")
-        if rule not in THRESHOLD_RULES:
-            raise UserError(
-                f"homing.threshold_rule={rule!r} is not one of {', '.join(THRESHOLD_RULES)}"
-            )
         try:
             self._scales()
         except ValueError as exc:
@@ -154,11 +136,6 @@ class _PlaneWarping(HomingMethod):
                     f"homing.{key}={n} must lie between 1 and the image width {width} (the search "
                     f"shifts whole columns); e.g. homing.{key}={max(1, width // 3)}"
                 )
-        if not (0.0 < cfg.compass_fraction <= 1.0):
-            raise UserError(
-                f"homing.compass_fraction={cfg.compass_fraction} must lie in (0, 1] (the fraction of "
-                "rotations searched with compass acceleration)"
-            )
 
     def prepare(self, image):
         """Resize (and low-pass) the panorama and build its scale-plane stack.
@@ -383,15 +360,6 @@ class Warping1D(HomingMethod):
     def __init__(self, config: Any, *, geometry, raw_horizon_radius_px: float | None = None) -> None:
         super().__init__(config, geometry=geometry)
         self.raw_horizon_radius_px = None if raw_horizon_radius_px is None else float(raw_horizon_radius_px)
-        cfg = self.config
-        _check_common(self.name, cfg)
-        if cfg.strip_rows < 1:
-            raise UserError(f"homing.strip_rows={cfg.strip_rows} must be >= 1")
-        if min(cfg.n_alpha, cfg.n_psi, cfg.n_rho) < 1 or not (0.0 <= cfg.rho_max < 1.0):
-            raise UserError(
-                f"1D warping needs n_alpha, n_psi, n_rho >= 1 and 0 <= rho_max < 1; got "
-                f"{cfg.n_alpha}, {cfg.n_psi}, {cfg.n_rho} and {cfg.rho_max}"
-            )
 
     def prepare(self, image):
         """Resize (and low-pass) the panorama and average its horizon rows; shape (W,)."""

@@ -37,12 +37,7 @@ class HistogramConfig:
 
 
 def _value_range(signature):
-    mode = signature.config.bin_range
-    if mode not in ("image", "unit"):
-        from bionav.errors import UserError
-
-        raise UserError(f"signature.bin_range={mode!r} is not valid; choose image or unit.")
-    return None if mode == "image" else (0.0, 1.0)
+    return None if signature.config.bin_range == "image" else (0.0, 1.0)
 
 
 class Hist(Signature):

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.errors import UserError
 from bionav.homing.signatures.base import Signature
 from bionav.validation import bounded
 
@@ -45,13 +44,6 @@ class Zernike(Signature):
 
     def __init__(self, config=None) -> None:
         super().__init__(config)
-        c = self.config
-        if int(c.order) != c.order or not 1 <= int(c.order) <= 40:
-            raise UserError(f"signature.order={c.order!r} must be an integer in 1..40 (the paper uses 16).")
-        if c.mode not in MODES:
-            raise UserError(f"signature.mode={c.mode!r} must be one of {', '.join(MODES)}.")
-        if not 0.0 <= float(c.threshold) <= 1.0:
-            raise UserError(f"signature.threshold={c.threshold} must lie in [0, 1].")
 
     def _input(self, image) -> np.ndarray:
         img = np.asarray(image, np.float64)
@@ -63,7 +55,7 @@ class Zernike(Signature):
         """Complex moments and their ``(n, m)`` (:func:`bionav.homing.signatures.zernike.zernike_moments`)."""
         from bionav.homing.signatures.zernike import zernike_moments
 
-        return zernike_moments(self._input(image), order=int(self.config.order))
+        return zernike_moments(self._input(image), order=self.config.order)
 
     def compute(self, image, *, raw=None) -> np.ndarray:
         return np.abs(self.moments(image)[0])
