@@ -223,6 +223,23 @@ def _nominal_gauge(m, alpha0, free=None):
     return b
 
 
+def _fix_gauge(m, c, w, f, alpha0, *, n_harmonics: int, symmetric: bool):
+    """Channel vectors ``m`` (K, P, 3) in the fixed gauge (:func:`calibrate_session`), their polarizer angles before
+    :func:`_nominal_gauge` (radians, (K, P)) and the mirror symmetry's strength (NaN without ``symmetric``)."""
+    strength = float("nan")
+    free = None
+    if symmetric:
+        # the mirror symmetry: rotate the ring's components into (even, even, odd) first
+        grid = 2.0 * np.pi * np.arange(180) / 180
+        ring = _ring_fit(m, c, w, f)
+        a, _phi, asym = mirror_gauge(_basis(grid, n_harmonics) @ ring.T, grid)
+        m = m @ np.linalg.inv(a)  # S -> A S, m -> A^-T m
+        strength = 1.0 - asym
+        free = np.array([[1, 1, 0], [1, 1, 0], [0, 0, 1]], bool)  # only gauges that keep the symmetry
+    before = 0.5 * np.arctan2(m[..., 2], m[..., 1])
+    return m @ _nominal_gauge(m, alpha0, free).T, before, strength
+
+
 def calibrate_session(counts, yaw, valid, array, *, n_bins: int = 120, n_harmonics: int = 12,
                       iterations: int = 40, symmetric: bool = True) -> SessionCalibration:
     """Fit photodiode gains and polarizer offsets to one session (see the module docstring).
@@ -288,19 +305,7 @@ def calibrate_session(counts, yaw, valid, array, *, n_bins: int = 120, n_harmoni
     pred = np.einsum("kpi,bki->bkp", m, stokes)
     ok = w > 0
     rms = float(np.sqrt(np.mean((np.log(np.clip(pred[ok], 1e-300, None)) - np.log(c[ok])) ** 2)))
-    strength = float("nan")
-    free = None
-    if symmetric:
-        # the mirror symmetry: rotate the ring's components into (even, even, odd) first
-        grid = 2.0 * np.pi * np.arange(180) / 180
-        ring = _ring_fit(m, c, w, f)
-        a, _phi, asym = mirror_gauge(_basis(grid, n_harmonics) @ ring.T, grid)
-        m = m @ np.linalg.inv(a)  # S -> A S, m -> A^-T m
-        strength = 1.0 - asym
-        free = np.array([[1, 1, 0], [1, 1, 0], [0, 0, 1]], bool)  # only gauges that keep the symmetry
-    before = 0.5 * np.arctan2(m[..., 2], m[..., 1])
-    b = _nominal_gauge(m, alpha0, free)
-    m = m @ b.T
+    m, before, strength = _fix_gauge(m, c, w, f, alpha0, n_harmonics=n_harmonics, symmetric=symmetric)
     gain = 2.0 * m[..., 0]
     angle = 0.5 * np.arctan2(m[..., 2], m[..., 1])
     lam = np.log(np.clip(np.abs(gain), 1e-300, None))

@@ -300,51 +300,71 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     -------
     SunEstimate
     """
+    w0 = _fit_weights(ev, valid, weight_power=weight_power, noise_counts=noise_counts, model_error=model_error,
+                      min_units=min_units)
+    robust = {"iterations": robust_iterations, "scale": robust_scale, "reject": reject}
+    if residual == "perpendicular":
+        if sun_elevation is None:
+            raise ValueError("residual='perpendicular' needs the sun elevation")
+        score, w = _perpendicular_scores(ev, w0, table=table, array=array, sun_elevation=float(sun_elevation), **robust)
+    elif residual == "angle":
+        score, w = _angle_scores(ev, w0, table=table, **robust)
+    else:
+        raise ValueError(f"residual must be 'perpendicular' or 'angle', got {residual!r}")
+    _, first, second, gap = _pick_pair(score, table.azimuths, np.maximum(w.sum(axis=-1), 1e-12), margin)
+    resolved = gap > margin
+    by_light, other = _choose_by_brightness(first, second, brightness_azimuth(ev, valid, array))
+    usable = w0.sum(axis=-1) > 0
+    azimuth = np.where(usable, np.where(resolved, first, by_light), np.nan)
+    return SunEstimate(azimuth, np.where(usable, np.where(resolved, second, other), np.nan), resolved & usable)
+
+
+def _fit_weights(ev: UnitEvectors, valid, *, weight_power, noise_counts, model_error, min_units):
+    """``sky_fit``'s unit weights before re-weighting, shape ``(N, K)`` (see :func:`sun_from_sky_fit`)."""
     w0 = _weights(ev, valid, weight_power)
     if noise_counts > 0:
         sigma = angle_noise(ev, noise_counts)
         readable = sigma <= model_error
         w0 = np.where(readable, w0 * model_error**2 / (model_error**2 + np.where(readable, sigma, 0.0) ** 2), 0.0)
     enough = np.sum(w0 > 0, axis=-1) >= max(int(min_units), 1)
-    w0 = np.where(enough[:, None], w0, 0.0)
+    return np.where(enough[:, None], w0, 0.0)
+
+
+def _perpendicular_scores(ev: UnitEvectors, w0, *, table: SkyTable, array: PolArray, sun_elevation: float,
+                          iterations: int, scale: float, reject):
+    """Scores ``-sum_k w_k (e_k . s(phi))^2`` on the table's azimuths, shape ``(N, G)``, and the last weights ``(N, K)``.
+
+    Re-weighting on each unit's angle residual ``arcsin(e_k . s / |s_perp,k|)`` (:func:`sun_from_sky_fit`).
+    """
+    e = np.nan_to_num(ev.evector)
+    v = sun_directions(table.azimuths, sun_elevation)  # (G, 3)
+    views = array.unit_frames()[:, :, 2]  # (K, 3) view directions in the sensor frame
+    iu, ju = np.triu_indices(3)
+    mono = v[:, iu] * v[:, ju] * np.where(iu == ju, 1.0, 2.0)  # (G, 6): quadratic form as a matmul
     w = w0
-    total = w0.sum(axis=-1)
-    if residual == "perpendicular":
-        if sun_elevation is None:
-            raise ValueError("residual='perpendicular' needs the sun elevation")
-        e = np.nan_to_num(ev.evector)
-        v = sun_directions(table.azimuths, float(sun_elevation))  # (G, 3)
-        views = array.unit_frames()[:, :, 2]  # (K, 3) view directions in the sensor frame
-        iu, ju = np.triu_indices(3)
-        mono = v[:, iu] * v[:, ju] * np.where(iu == ju, 1.0, 2.0)  # (G, 6): quadratic form as a matmul
-        for it in range(robust_iterations + 1):
-            m6 = np.einsum("nk,nki,nki->ni", w, e[..., iu], e[..., ju])  # upper triangle of sum_k w e e^T
-            score = -(m6 @ mono.T)
+    for it in range(iterations + 1):
+        m6 = np.einsum("nk,nki,nki->ni", w, e[..., iu], e[..., ju])  # upper triangle of sum_k w e e^T
+        score = -(m6 @ mono.T)
+        if it < iterations:
+            s = v[np.argmax(score, axis=1)]  # (N, 3)
+            across = np.sqrt(np.maximum(1.0 - (s @ views.T) ** 2, 1e-6))  # |s_perp| per unit, (N, K)
+            r = np.arcsin(np.clip(np.einsum("nki,ni->nk", e, s) / across, -1.0, 1.0))
+            w = _robust_weights(w0, r, scale, reject, last=it == iterations - 1)
+    return score, w
+
+
+def _angle_scores(ev: UnitEvectors, w0, *, table: SkyTable, iterations: int, scale: float, reject):
+    """Scores ``sum_k w_k cos 2(a_k - a^_k(phi))`` on the table's azimuths, shape ``(N, G)``, and the last weights."""
+    a2 = 2.0 * np.nan_to_num(ev.angle)
+    ca, sa = np.cos(a2), np.sin(a2)
+    w = w0
+    for it in range(iterations + 1):
+        score = (w * ca) @ table.cos2.T + (w * sa) @ table.sin2.T  # (N, G)
+        if it < iterations:
             best = np.argmax(score, axis=1)
-            if it < robust_iterations:
-                s = v[best]  # (N, 3)
-                across = np.sqrt(np.maximum(1.0 - (s @ views.T) ** 2, 1e-6))  # |s_perp| per unit, (N, K)
-                r = np.arcsin(np.clip(np.einsum("nki,ni->nk", e, s) / across, -1.0, 1.0))
-                w = _robust_weights(w0, r, robust_scale, reject, last=it == robust_iterations - 1)
-    elif residual == "angle":
-        a2 = 2.0 * np.nan_to_num(ev.angle)
-        ca, sa = np.cos(a2), np.sin(a2)
-        for it in range(robust_iterations + 1):
-            score = (w * ca) @ table.cos2.T + (w * sa) @ table.sin2.T  # (N, G)
-            best = np.argmax(score, axis=1)
-            if it < robust_iterations:
-                r = 0.5 * np.arccos(np.clip(ca * table.cos2[best] + sa * table.sin2[best], -1.0, 1.0))
-                w = _robust_weights(w0, r, robust_scale, reject, last=it == robust_iterations - 1)
-    else:
-        raise ValueError(f"residual must be 'perpendicular' or 'angle', got {residual!r}")
-    _, first, second, gap = _pick_pair(score, table.azimuths, np.maximum(w.sum(axis=-1), 1e-12), margin)
-    resolved = gap > margin
-    bright = brightness_azimuth(ev, valid, array)
-    by_light, other = _choose_by_brightness(first, second, bright)
-    azimuth = np.where(resolved, first, by_light)
-    alternative = np.where(resolved, second, other)
-    usable = total > 0
-    return SunEstimate(np.where(usable, azimuth, np.nan), np.where(usable, alternative, np.nan), resolved & usable)
+            r = 0.5 * np.arccos(np.clip(ca * table.cos2[best] + sa * table.sin2[best], -1.0, 1.0))
+            w = _robust_weights(w0, r, scale, reject, last=it == iterations - 1)
+    return score, w
 
 
 def _sun_candidates(s, expected_elevation, margin):
