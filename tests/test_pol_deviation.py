@@ -1,0 +1,82 @@
+"""Deviation curves (compass swinging) on known curves, and the held-out study on real recordings."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+from helpers import external_data, run_bionav
+
+from bionav.geometry import wrap_angle
+from bionav.polcompass.deviation import corrected_heading, deviation_from_errors, fourier_basis, pooled_deviation
+
+COMPASS = external_data() / "celestial-compass"
+
+
+def test_a_known_curve_is_recovered_and_removed():
+    rng = np.random.default_rng(3)
+    phi = rng.uniform(-np.pi, np.pi, 2000)
+    truth = np.deg2rad([1.5, -1.0, 0.0, -0.5])  # a1, b1, a2, b2
+    dev = fourier_basis(phi, 2) @ truth
+    np.testing.assert_allclose(dev, np.deg2rad(1.5 * np.cos(phi) - np.sin(phi) - 0.5 * np.sin(2 * phi)), atol=1e-12)
+    errors = dev + np.deg2rad(0.2) * rng.standard_normal(phi.size)
+    errors[:50] = np.pi - 0.1  # the wrong member of the eq. 4.6 pair: left out (|error| > 30 degrees)
+    coef = deviation_from_errors(phi, errors, n_harmonics=2)
+    np.testing.assert_allclose(np.degrees(coef), np.degrees(truth), atol=0.05)
+    heading = wrap_angle(1.0 + dev)  # true heading 1 rad plus the deviation
+    np.testing.assert_allclose(corrected_heading(heading, phi, truth), 1.0, atol=1e-12)
+    assert np.isnan(corrected_heading(np.array([np.nan]), np.array([0.3]), truth)).all()
+    np.testing.assert_array_equal(corrected_heading(heading, phi, None), heading)
+
+
+def test_pooling_is_the_median_and_too_few_samples_give_none():
+    assert deviation_from_errors(np.zeros(5), np.zeros(5), n_harmonics=2) is None
+    pooled = pooled_deviation([np.array([1.0, 0.0]), None, np.array([3.0, 2.0]), np.array([2.0, 10.0])])
+    np.testing.assert_array_equal(pooled, [2.0, 2.0])
+    assert pooled_deviation([None]) is None
+
+
+@pytest.mark.skipif(not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)")
+def test_deviation_bench_learns_on_the_other_day(tmp_path):
+    from omegaconf import OmegaConf
+
+    from bionav.experiments import pol_recordings as pr
+    from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
+    from bionav.polcompass.decoders import heading_from_sun
+
+    days = {"12-05-22": "17-01__Thursday_12-05-22", "14-05-22": "08-30__Saturday_14-05-22"}
+    for day, folder in days.items():
+        src = next((COMPASS / "tod_data").glob(f"*{day}/{folder}"))
+        shutil.copytree(src, tmp_path / "rec" / "tod_data" / src.parent.name / folder)
+    proc = run_bionav("--recordings", str(tmp_path / "rec"), "--harmonics", "1", cwd=tmp_path,
+                      module="bionav.bench.decoders.deviation")
+    assert proc.returncode == 0, proc.stderr
+    lines = [json.loads(line) for line in proc.stdout.splitlines()]
+    daylight = lines[0]
+    assert daylight["condition"] == "tod_daylight" and len(lines) == 2
+    # the same numbers in-process: each session corrected with the curve of the *other* day's session
+    rc = pr.recordings_config(OmegaConf.create({"recordings": {"path": str(tmp_path / "rec")}}))
+    prepared, _ = pr._prepared_sessions(rc)
+    dec = SkyFit(SkyFitConfig())
+    out = []
+    for d in prepared:
+        phi = dec.decode(d.evectors, d.valid, array=d.array, sun_elevation=float(d.sun.elevation)).azimuth
+        heading = heading_from_sun(phi, d.sun.azimuth)
+        out.append((heading, phi, pr.session_errors(heading, d.yaw)[0], d.yaw))
+    before = np.concatenate([o[2] for o in out])
+    after = []
+    for i, (heading, phi, _err, yaw) in enumerate(out):
+        other = out[1 - i]
+        curve = deviation_from_errors(other[1], other[2], n_harmonics=1)
+        after.append(pr.session_errors(corrected_heading(heading, phi, curve), yaw)[0])
+    assert daylight["n_samples"] == before.size
+    assert daylight["mae_deg"] == pytest.approx(np.degrees(np.mean(np.abs(before))), abs=1e-3)
+    assert daylight["mae_deviation_removed_deg"] == pytest.approx(np.degrees(np.mean(np.abs(np.concatenate(after)))),
+                                                                  abs=1e-3)
+    assert len(lines[1]["curve_all_days_deg"]) == 2
+
+
+def test_deviation_bench_refuses_a_bad_harmonics_count(tmp_path):
+    proc = run_bionav("--recordings", str(tmp_path), "--harmonics", "0", cwd=tmp_path,
+                      module="bionav.bench.decoders.deviation")
+    assert proc.returncode == 2 and "--harmonics" in proc.stderr and "Traceback" not in proc.stderr
