@@ -29,6 +29,21 @@ def test_a_known_curve_is_recovered_and_removed():
     np.testing.assert_array_equal(corrected_heading(heading, phi, None), heading)
 
 
+def test_the_tilt_form_gives_the_tilt_and_scales_with_the_sun_elevation():
+    # a mount tilt beta towards the device azimuth phi0 reads the sun's azimuth off by beta tan(h) sin(phi - phi0)
+    rng = np.random.default_rng(5)
+    phi = rng.uniform(-np.pi, np.pi, 1000)
+    beta, phi0 = np.deg2rad(2.5), np.deg2rad(40.0)
+    coef_true = beta * np.array([-np.sin(phi0), np.cos(phi0)])  # sin(phi - phi0) = cos(phi) (-sin phi0) + sin(phi) cos phi0
+    for elevation_deg in (20.0, 60.0):
+        scale = np.tan(np.deg2rad(elevation_deg))
+        errors = beta * scale * np.sin(phi - phi0)
+        coef = deviation_from_errors(phi, errors, n_harmonics=1, scale=scale)
+        np.testing.assert_allclose(coef, coef_true, atol=1e-12)
+        assert np.degrees(np.hypot(*coef)) == pytest.approx(2.5)
+        np.testing.assert_allclose(corrected_heading(0.5 + errors, phi, coef, scale=scale), 0.5, atol=1e-12)
+
+
 def test_pooling_is_the_median_and_too_few_samples_give_none():
     assert deviation_from_errors(np.zeros(5), np.zeros(5), n_harmonics=2) is None
     pooled = pooled_deviation([np.array([1.0, 0.0]), None, np.array([3.0, 2.0]), np.array([2.0, 10.0])])
@@ -74,6 +89,19 @@ def test_deviation_bench_learns_on_the_other_day(tmp_path):
     assert daylight["mae_deviation_removed_deg"] == pytest.approx(np.degrees(np.mean(np.abs(np.concatenate(after)))),
                                                                   abs=1e-3)
     assert len(lines[1]["curve_all_days_deg"]) == 2
+    # with the self-calibration, the "before" numbers are those of experiment=pol_recordings recordings.calibration=auto
+    proc = run_bionav("--recordings", str(tmp_path / "rec"), "--harmonics", "1", "--form", "tilt", "--calibration", "auto",
+                      cwd=tmp_path, module="bionav.bench.decoders.deviation")
+    assert proc.returncode == 0, proc.stderr
+    tilt = json.loads(proc.stdout.splitlines()[0])
+    assert tilt["form"] == "tilt" and tilt["calibration"] == "auto"
+    run = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path / 'rec'}", "recordings.calibration=auto",
+                     "experiment.simulate=false", "experiment.compare=[sky_fit]", f"hydra.run.dir={tmp_path / 'run'}",
+                     cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    metrics = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    assert tilt["mae_deg"] == pytest.approx(metrics["tod_daylight_mae_deg"], abs=1e-3)
+    assert tilt["mae_deg"] != pytest.approx(daylight["mae_deg"], abs=1e-3)  # the calibration was applied
 
 
 def test_deviation_bench_refuses_a_bad_harmonics_count(tmp_path):

@@ -9,13 +9,18 @@ curve is a low-order Fourier series
 
     D(phi) = sum_{h=1..H} a_h cos(h phi) + b_h sin(h phi)     (radians)
 
+or its *tilt form* ``D(phi) = tan(h) sum_h (...)`` with ``h`` the sun's elevation: a compass whose
+up-axis is tilted by a small angle ``beta`` (a mount not level) reads the sun's azimuth wrong by
+``beta tan(h) sin(phi - phi_beta)`` to first order (the trunnion error of a theodolite), so one harmonic
+of the tilt form is a mount tilt of ``hypot(a_1, b_1)``. Either is
 fitted to the errors ``wrap(heading - yaw - c)`` of rotation sessions (the logged yaw only, ``c``
 one constant per session, so no constant term: it is indistinguishable from ``c``), and removed
 from a heading as ``heading - D(phi)``. Per-session fits are pooled by their median (a session
 with another sky does not move it). Measured on the recordings (leave one day out, docs/polcompass.md):
-a curve learned on clear-sky days lowers the held-out daylight MAE a little and raises canopy and
-dusk, so ``experiment=pol_recordings`` does not apply one; ``python -m bionav.bench.decoders.deviation``
-repeats that study.
+learned on clear-sky days, the plain curve lowers the held-out daylight MAE a little and raises canopy
+and dusk; the tilt form lowers daylight by half a degree without array calibration, by 0.1 with it, and
+raises canopy without it; ``experiment=pol_recordings`` applies neither, and
+``python -m bionav.bench.decoders.deviation`` repeats that study.
 """
 
 from __future__ import annotations
@@ -33,7 +38,7 @@ def fourier_basis(phi, n_harmonics: int):
     return np.stack([np.cos(ang), np.sin(ang)], axis=-1).reshape(phi.size, -1)
 
 
-def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2,
+def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2, scale: float = 1.0,
                           max_error: float = np.deg2rad(30.0), min_samples: int = 20):
     """Fourier coefficients of one rotation session's heading errors against the solar azimuth in the device frame.
 
@@ -45,6 +50,9 @@ def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2,
         ``wrap(heading - yaw - c)``, radians.
     n_harmonics : int
         ``H``.
+    scale : float
+        The curve is ``scale`` times the series: 1 (plain form) or ``tan(h)`` of the session's sun
+        elevation ``h`` (tilt form; the coefficients are then radians of tilt).
     max_error : float
         Samples with ``|error|`` above it (a wrong member of the eq. 4.6 pair, a glitch) are left out, radians.
     min_samples : int
@@ -60,7 +68,7 @@ def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2,
     ok = np.isfinite(phi) & np.isfinite(e) & (np.abs(e) <= max_error)
     if ok.sum() < max(int(min_samples), 2 * int(n_harmonics)):
         return None
-    coef, *_ = np.linalg.lstsq(fourier_basis(phi[ok], n_harmonics), e[ok], rcond=None)
+    coef, *_ = np.linalg.lstsq(float(scale) * fourier_basis(phi[ok], n_harmonics), e[ok], rcond=None)
     return coef
 
 
@@ -70,12 +78,13 @@ def pooled_deviation(per_session):
     return np.median(np.stack(got), axis=0) if got else None
 
 
-def corrected_heading(heading, sun_sensor_azimuth, coefficients):
-    """``wrap(heading - D(phi))`` (radians; NaN headings stay NaN; ``coefficients`` None: unchanged)."""
+def corrected_heading(heading, sun_sensor_azimuth, coefficients, *, scale: float = 1.0):
+    """``wrap(heading - scale D(phi))`` (radians; NaN headings stay NaN; ``coefficients`` None: unchanged;
+    ``scale``: see :func:`deviation_from_errors`)."""
     heading = np.asarray(heading, float)
     if coefficients is None:
         return heading
     coefficients = np.asarray(coefficients, float)
     phi = np.nan_to_num(np.asarray(sun_sensor_azimuth, float))
-    d = fourier_basis(phi, coefficients.size // 2) @ coefficients
+    d = float(scale) * (fourier_basis(phi, coefficients.size // 2) @ coefficients)
     return np.where(np.isfinite(heading), wrap_angle(heading - d), np.nan)
