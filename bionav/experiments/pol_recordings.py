@@ -253,14 +253,43 @@ def calibrated(data: SessionData, calibration, parts, solver: str = "pol_op") ->
                        data.excluded, data.sun, data.period)
 
 
-def decode_session(decoder, data: SessionData):
-    """Decode every sample of a session; returns ``(heading, resolved, seconds)``."""
+def decode_session(decoder, data: SessionData, mount_tilt=None):
+    """Decode every sample of a session; returns ``(heading, resolved, seconds)``.
+
+    ``mount_tilt`` (radians, ``(2,)``, :attr:`~bionav.polcompass.array_calibration.ArrayCalibration.mount_tilt`):
+    its heading deviation ``tan(h) (a cos phi + b sin phi)`` is removed (:mod:`bionav.polcompass.deviation`).
+    """
     from bionav.polcompass.decoders import heading_from_sun
+    from bionav.polcompass.deviation import corrected_heading
 
     t0 = time.perf_counter()
     est = decoder.decode(data.evectors, data.valid, array=data.array, sun_elevation=float(data.sun.elevation))
     heading = heading_from_sun(est.azimuth, data.sun.azimuth)
+    if mount_tilt is not None:
+        heading = corrected_heading(heading, est.azimuth, mount_tilt, scale=float(np.tan(data.sun.elevation)))
     return heading, np.asarray(est.resolved, bool), time.perf_counter() - t0
+
+
+def mount_tilt(datas, rc, calibration, decoder, *, leave_out_day=None):
+    """The sensor's first-order mount tilt (radians, ``(2,)``, or None) from the daylight rotations of the other days.
+
+    Each session (:func:`calibration_sessions`, not of ``leave_out_day``) is decoded through ``calibration``
+    with ``decoder``; its errors against the logged yaw are fitted with ``tan(h) (a cos phi + b sin phi)``
+    (:func:`bionav.polcompass.deviation.deviation_from_errors`, tilt form), and the sessions are pooled by
+    the median. Only the logged yaw is used, no heading truth.
+    """
+    from bionav.polcompass.deviation import deviation_from_errors, pooled_deviation
+
+    fits = []
+    for d in calibration_sessions(datas, rc):
+        if d.session.day == leave_out_day:
+            continue
+        dc = calibrated(d, calibration, rc.calibration_parts, rc.calibration_solver)
+        heading, _resolved, _seconds = decode_session(decoder, dc)
+        err, _c = session_errors(heading, dc.yaw)
+        fits.append(deviation_from_errors(wrap_angle(dc.sun.azimuth - heading), err, n_harmonics=1,
+                                          scale=float(np.tan(dc.sun.elevation))))
+    return pooled_deviation(fits)
 
 
 def view_field(rng, heading, unit_azimuths, n_photodiodes: int, *, n_harmonics: int = 12):
@@ -416,25 +445,45 @@ def _prepared_sessions(rc) -> tuple[list, list]:
     return prepared, bad_files
 
 
-def _calibration_for(prepared, rc, ctx):
+def _calibration_for(prepared, rc, ctx, decoder):
     """``calibration(day) -> (ArrayCalibration or None, label)`` for ``recordings.calibration``.
 
     ``auto`` self-calibrates the daylight sessions, writes ``calibration.json`` pooled over all days and
-    gives each day the calibration of the others; a file is loaded once; ``none`` gives none.
+    gives each day the calibration of the others (with ``tilt`` in ``calibration_parts`` also the mount tilt
+    learned on the others with ``decoder``); a file is loaded once; ``none`` gives none.
     """
+    from dataclasses import replace
+
     how = str(rc.calibration)
+    tilt = "tilt" in rc.calibration_parts
     if how == "auto":
         estimates = self_calibrate(prepared, rc, progress=ctx.progress)
         if estimates:
             from bionav.polcompass.array_calibration import combine_sessions
 
-            combine_sessions([e for _d, e in estimates.values()], sorted(estimates)).save(ctx.dir / "calibration.json")
-        return lambda day: leave_one_day_out(estimates, day)
+            pooled = combine_sessions([e for _d, e in estimates.values()], sorted(estimates))
+            if tilt:
+                pooled = replace(pooled, mount_tilt=mount_tilt(prepared, rc, pooled, decoder))
+            pooled.save(ctx.dir / "calibration.json")
+        cache = {}
+
+        def for_day(day):
+            if day not in cache:
+                cal, label = leave_one_day_out(estimates, day)
+                if tilt and cal is not None:
+                    cal = replace(cal, mount_tilt=mount_tilt(prepared, rc, cal, decoder, leave_out_day=day))
+                    label += " + mount tilt"
+                cache[day] = (cal, label)
+            return cache[day]
+
+        return for_day
     fixed = None
     if how != "none":
         from bionav.polcompass.array_calibration import ArrayCalibration
 
         fixed = ArrayCalibration.load(how)
+        if tilt and fixed.mount_tilt is None:
+            log.warning("recordings.calibration_parts has tilt but %s holds no mount tilt; none is applied", how)
     label = "none" if fixed is None else f"file {how}"
     return lambda day: (fixed, label)
 
@@ -480,10 +529,10 @@ def _record_rotations(ctx, data: SessionData, name: str, heading, err, resolved)
             schema_name="bionav.PolRecordingRotation")
 
 
-def _score_session(ctx, exp, tally: _Tally, data: SessionData, sim_runs, decoders, chosen, base) -> None:
+def _score_session(ctx, exp, tally: _Tally, data: SessionData, sim_runs, decoders, chosen, base, tilt=None) -> None:
     """Decode one (calibrated) session with every decoder and add its rows and errors to ``tally``."""
     for name, dec in decoders.items():
-        heading, resolved, seconds = decode_session(dec, data)
+        heading, resolved, seconds = decode_session(dec, data, tilt)
         err, c = session_errors(heading, data.yaw)
         decoded = np.isfinite(heading)
         row = {**base, "decoder": name, **error_stats(err),
@@ -526,7 +575,8 @@ def _score_all(ctx, exp, rc, prepared, calibration_for, decoders, chosen) -> _Ta
                                     "units": [f.to_dict() for f in data.faults]}, schema_name="bionav.PolOpFaults")
         sim_runs = [simulate_session(data, exp, rng_sim) for _ in range(exp.sim_repeats)] if exp.simulate else []
         data = calibrated(data, cal, rc.calibration_parts, rc.calibration_solver)
-        _score_session(ctx, exp, tally, data, sim_runs, decoders, chosen, _session_base(data, cal_label))
+        tilt = cal.mount_tilt if cal is not None and "tilt" in rc.calibration_parts else None
+        _score_session(ctx, exp, tally, data, sim_runs, decoders, chosen, _session_base(data, cal_label), tilt)
     return tally
 
 
@@ -627,7 +677,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         )
     chosen, decoders = _decoders(cfg, ctx, exp)
     prepared, bad_files = _prepared_sessions(rc)
-    calibration_for = _calibration_for(prepared, rc, ctx)
+    calibration_for = _calibration_for(prepared, rc, ctx, decoders[chosen])
     tally = _score_all(ctx, exp, rc, prepared, calibration_for, decoders, chosen)
     if not tally.session_rows:
         raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")

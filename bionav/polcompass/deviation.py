@@ -18,9 +18,10 @@ one constant per session, so no constant term: it is indistinguishable from ``c`
 from a heading as ``heading - D(phi)``. Per-session fits are pooled by their median (a session
 with another sky does not move it). Measured on the recordings (leave one day out, docs/polcompass.md):
 learned on clear-sky days, the plain curve lowers the held-out daylight MAE a little and raises canopy
-and dusk; the tilt form lowers daylight by half a degree without array calibration, by 0.1 with it, and
-raises canopy without it; ``experiment=pol_recordings`` applies neither, and
-``python -m bionav.bench.decoders.deviation`` repeats that study.
+and dusk; the tilt form lowers daylight by half a degree without array calibration and by 0.1 on top of
+the polarizer offsets, without changing canopy or dusk there: it is the ``tilt`` part of
+``experiment=pol_recordings``'s calibration (:func:`bionav.experiments.pol_recordings.mount_tilt`), the plain
+form is not used. ``python -m bionav.bench.decoders.deviation`` repeats the study.
 """
 
 from __future__ import annotations

@@ -143,7 +143,8 @@ class RecordingsConfig:
     calibration : ``none`` (nominal gains and polarizer angles), ``auto`` (self-calibration from the
         recordings' daylight rotations, each day decoded with the calibration of the other days:
         leave one day out; ``calibration.json`` of all days in the run folder) or the path of such a file.
-    calibration_parts : which parts to apply: ``gains`` (photodiode gains), ``angles`` (polarizer offsets).
+    calibration_parts : which parts to apply: ``gains`` (photodiode gains), ``angles`` (polarizer offsets), ``tilt``
+        (the sensor's first-order mount tilt, learned from the daylight rotations with the chosen decoder).
         Default ``[angles]``: on the recordings the estimated gains made every decoder worse (docs/polcompass.md).
     calibration_solver : ``pol_op`` (the POL-OP chain, each pair at its mean calibrated orientation) or
         ``stokes`` (every photodiode at its own angle, linear least squares).
@@ -165,7 +166,7 @@ class RecordingsConfig:
     dusk_elevation_deg: float = bounded(10.0, ge=-90.0, le=90.0)
     on_bad_file: str = bounded("error", choices=("error", "skip"))
     calibration: str = "none"
-    calibration_parts: list[str] = bounded(["angles"], length=(1, 2), item=Range(choices=("gains", "angles")))
+    calibration_parts: list[str] = bounded(["angles", "tilt"], length=(1, 3), item=Range(choices=("gains", "angles", "tilt")))
     calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
 
 
