@@ -33,7 +33,6 @@ reproduces the metrics exactly.
 
 from __future__ import annotations
 
-import csv
 from contextlib import ExitStack
 from typing import Any
 
@@ -47,13 +46,14 @@ from bionav.experiments.pol_compass_session import (
     CALIBRATION_TOPIC,
     SESSION_SCHEMA,
     SESSION_TOPIC,
-    Session,
+    CompassSession,
     cloud_field,
     resolve_sun,
     sky_model,
     start_fakes,
 )
-from bionav.polcompass.compass import evectors_from_counts
+from bionav.files import write_csv_atomic
+from bionav.polcompass.compass import evector_from_compass_counts
 from bionav.polcompass.headings import pose_headings
 
 MODES = ("filter_test", "rotation", "vs_em_compass", "evector_scan", "partial_sky")
@@ -122,7 +122,7 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir, fixed=None):
     return cal, how
 
 
-def _pan_grid(session: Session, exp, step_deg: float):
+def _pan_grid(session: CompassSession, exp, step_deg: float):
     lo, hi, tlo, thi = session.pantilt.limits()
     rng = exp.pan_range_deg
     if rng is not None:
@@ -140,7 +140,7 @@ def _check_tilt(tilt: float, limits) -> None:
         )
 
 
-def _scan(session: Session, poses, samples: int, *, desc: str | None, with_reference: bool = False):
+def _scan(session: CompassSession, poses, samples: int, *, desc: str | None, with_reference: bool = False):
     """Visit poses ``[(pan, tilt), ...]``, take ``samples`` readings at each; all recorded.
 
     ``desc=None`` draws no progress bar.
@@ -162,7 +162,7 @@ def _scan(session: Session, poses, samples: int, *, desc: str | None, with_refer
 # ---------------------------------------------------------------------------
 # modes
 # ---------------------------------------------------------------------------
-def rotation_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None, filter_test=False) -> dict:
+def rotation_mode(session: CompassSession, exp, *, unit_angles, plots=None, out_dir=None, filter_test=False) -> dict:
     """``rotation`` and ``filter_test``: turn the compass through the pan range."""
     from bionav.experiments import pol_compass_plots as plots_mod
     from bionav.polcompass import CompassOptics, EvectorPredictor, counts_to_volts, heading_errors
@@ -177,7 +177,7 @@ def rotation_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=Non
     volts = counts_to_volts(counts)
     cal, how = _calibration(exp, volts, pans, tilts, unit_angles=unit_angles, out_dir=out_dir,
                             fixed=session.fixed_calibration)
-    angle, degree, x = evectors_from_counts(counts, cal, solver=str(exp.solver))
+    angle, degree, x = evector_from_compass_counts(counts, cal, solver=str(exp.solver))
     predictor = EvectorPredictor(sky_model(exp.sky, session.sun), CompassOptics(unit_angles=tuple(cal.unit_angles)))
     heading, resolved = pose_headings(
         angle, x, tilts, sun=session.sun, predictor=predictor, unit_angles=cal.unit_angles, margin=float(exp.ambiguity_margin)
@@ -204,7 +204,7 @@ def rotation_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=Non
     return metrics
 
 
-def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
+def vs_em_mode(session: CompassSession, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
     """``vs_em_compass``: the polarized-light compass against the TCM2 (figs. 4.4, 4.5)."""
     from bionav.experiments import pol_compass_plots as plots_mod
     from bionav.geometry import compass_to_azimuth
@@ -221,7 +221,7 @@ def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) 
     counts = counts_of(readings)
     cal, how = _calibration(exp, counts_to_volts(counts), pans, tilts, unit_angles=unit_angles, out_dir=out_dir,
                             fixed=session.fixed_calibration)
-    angle, _, _ = evectors_from_counts(counts, cal, solver=str(exp.solver))
+    angle, _, _ = evector_from_compass_counts(counts, cal, solver=str(exp.solver))
     pol = np.asarray(zenith_heading(angle, sun_azimuth=session.sun.azimuth))
     tcm2 = np.asarray(compass_to_azimuth(np.deg2rad([r["heading_deg"] for r in refs])))
     errors = heading_errors(pol, tcm2, axial=True)
@@ -243,7 +243,7 @@ def vs_em_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) 
     return metrics
 
 
-def _scan_poses(session: Session, node, *, pan_step_deg: float):
+def _scan_poses(session: CompassSession, node, *, pan_step_deg: float):
     lo, hi, tlo, thi = session.pantilt.limits()
     step = np.deg2rad(pan_step_deg)
     pans = lo + step * np.arange(int(np.floor((hi - lo) / step + 1e-9)) + 1)
@@ -253,7 +253,7 @@ def _scan_poses(session: Session, node, *, pan_step_deg: float):
     return [(p, t) for t in tilts for p in pans]
 
 
-def evector_scan_mode(session: Session, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
+def evector_scan_mode(session: CompassSession, exp, *, unit_angles, plots=None, out_dir=None) -> dict:
     """``evector_scan``: a pan/tilt grid over the sky (fig. 4.6) against the sky model."""
     from bionav.experiments import pol_compass_plots as plots_mod
     from bionav.geometry import wrap_axial
@@ -262,7 +262,7 @@ def evector_scan_mode(session: Session, exp, *, unit_angles, plots=None, out_dir
     poses = _scan_poses(session, exp.scan, pan_step_deg=float(exp.scan.pan_step_deg))
     cal = _rotation_calibration(session, exp, unit_angles=unit_angles, out_dir=out_dir)
     pans, tilts, readings, _, index = _scan(session, poses, int(exp.scan.samples), desc="e-vector scan")
-    angle, degree, _ = evectors_from_counts(counts_of(readings), cal, solver=str(exp.solver))
+    angle, degree, _ = evector_from_compass_counts(counts_of(readings), cal, solver=str(exp.solver))
     predictor = EvectorPredictor(sky_model(exp.sky, session.sun), CompassOptics(unit_angles=tuple(cal.unit_angles)))
     fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=float(exp.min_degree))
     model_angle, model_degree = predictor.at(fit.heading + pans, tilts)
@@ -298,7 +298,7 @@ def evector_scan_mode(session: Session, exp, *, unit_angles, plots=None, out_dir
     return metrics
 
 
-def _rotation_calibration(session: Session, exp, *, unit_angles, out_dir):
+def _rotation_calibration(session: CompassSession, exp, *, unit_angles, out_dir):
     """Calibrate the units from one zenith rotation (one reading per pan step, recorded) before a scan.
 
     ``experiment.calibration``: ``auto``/``rotation`` rotate, ``nominal`` and
@@ -319,7 +319,7 @@ def _rotation_calibration(session: Session, exp, *, unit_angles, out_dir):
     return _calibration(exp, counts_to_volts(counts_of(readings)), pans, tilts, unit_angles=unit_angles, out_dir=out_dir)[0]
 
 
-def partial_sky_mode(session: Session, exp, *, unit_angles, rng_scene, plots=None, out_dir=None) -> dict:
+def partial_sky_mode(session: CompassSession, exp, *, unit_angles, rng_scene, plots=None, out_dir=None) -> dict:
     """``partial_sky`` (thesis 9.1): heading error against clear-sky fraction and sun elevation."""
     from bionav.experiments import pol_compass_plots as plots_mod
     from bionav.geometry import wrap_angle, wrap_axial
@@ -348,7 +348,7 @@ def partial_sky_mode(session: Session, exp, *, unit_angles, rng_scene, plots=Non
             session.scene.mount_heading = float(rng_scene.uniform(-np.pi, np.pi))
             clear = 1.0 if clouds is None else clouds.clear_fraction()
             pans, tilts, readings, _, _ = _scan(session, poses, int(node.samples), desc=None)
-            angle, degree, _ = evectors_from_counts(counts_of(readings), cal, solver=str(exp.solver))
+            angle, degree, _ = evector_from_compass_counts(counts_of(readings), cal, solver=str(exp.solver))
             fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=float(exp.min_degree))
             zen = np.abs(tilts) < 1e-12
             zen_heading = zenith_heading(angle[zen], sun_azimuth=sun.azimuth) - pans[zen]
@@ -380,10 +380,8 @@ def partial_sky_mode(session: Session, exp, *, unit_angles, rng_scene, plots=Non
         "zenith_rmse_deg": float(np.sqrt(np.nanmean(np.array([r["zenith_error_deg"] for r in rows]) ** 2))),
     }
     if out_dir is not None:
-        with open(out_dir / "partial_sky.csv", "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
+        header = list(rows[0])
+        write_csv_atomic(out_dir / "partial_sky.csv", header, ([r.get(c, "") for c in header] for r in rows))
     if plots is not None:
         plots_mod.plot_partial_sky(plots / "partial_sky.png", rows)
     return metrics
@@ -428,29 +426,11 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
     else:
         true_mount = None if scene is None or mode == "partial_sky" else float(scene.mount_heading)
         sim_info = None if scene is None else simulation_parameters(exp, sensor)
-    session = Session(
-        sensor,
-        devices.get("pantilt"),
-        devices.get("reference"),
-        write,
-        scene,
-        sun,
-        progress or (lambda it, desc="", total=None: it),
-        true_mount,
-    )
-    write(
-        SESSION_TOPIC,
-        {
-            "mode": mode,
-            "time_utc": time_utc,
-            "sun_azimuth": float(sun.azimuth),
-            "sun_elevation": float(sun.elevation),
-            "true_mount_heading": true_mount,
-            "sim": sim_info,
-        },
-        schema_name="bionav.PolCompassSession",
-        schema=SESSION_SCHEMA,
-    )
+    session = CompassSession(sensor, devices.get("pantilt"), devices.get("reference"), write, scene, sun,
+                             progress or (lambda it, desc="", total=None: it), true_mount)
+    write(SESSION_TOPIC, {"mode": mode, "time_utc": time_utc, "sun_azimuth": float(sun.azimuth),
+                          "sun_elevation": float(sun.elevation), "true_mount_heading": true_mount, "sim": sim_info},
+          schema_name="bionav.PolCompassSession", schema=SESSION_SCHEMA)
     session.record_pantilt_info()
     if devices.get("decoder") is None:  # the thesis compass: sensor.calibration=FILE, or what a replayed run applied
         session.fixed_calibration = sensor_calibration(sensor)

@@ -84,7 +84,7 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
 
     Parameters
     ----------
-    session : pol_compass_session.Session
+    session : pol_compass_session.CompassSession
         ``session.read()`` records each reading; ``session.sun`` is the sun.
     exp : DictConfig
         ``cfg.experiment``.

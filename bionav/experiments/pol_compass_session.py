@@ -58,7 +58,7 @@ CALIBRATION_SCHEMA = {
 
 
 @dataclass
-class Session:
+class CompassSession:
     """Devices of one compass session and the recorder.
 
     Attributes

@@ -26,7 +26,6 @@ sessions) and decoded the same way: the sim-to-real gap.
 
 from __future__ import annotations
 
-import csv
 import logging
 import time
 from dataclasses import dataclass
@@ -228,14 +227,43 @@ def calibrated(data: SessionData, calibration, parts, solver: str = "pol_op") ->
                        data.excluded, data.sun, data.period)
 
 
-def decode_session(decoder, data: SessionData):
-    """Decode every sample of a session; returns ``(heading, resolved, seconds)``."""
+def decode_session(decoder, data: SessionData, mount_tilt=None):
+    """Decode every sample of a session; returns ``(heading, resolved, seconds)``.
+
+    ``mount_tilt`` (radians, ``(2,)``, :attr:`~bionav.polcompass.array_calibration.ArrayCalibration.mount_tilt`):
+    its heading deviation ``tan(h) (a cos phi + b sin phi)`` is removed (:mod:`bionav.polcompass.deviation`).
+    """
     from bionav.polcompass.decoders import heading_from_sun
+    from bionav.polcompass.deviation import corrected_heading
 
     t0 = time.perf_counter()
     est = decoder.decode(data.evectors, data.valid, array=data.array, sun_elevation=float(data.sun.elevation))
     heading = heading_from_sun(est.azimuth, data.sun.azimuth)
+    if mount_tilt is not None:
+        heading = corrected_heading(heading, est.azimuth, mount_tilt, scale=float(np.tan(data.sun.elevation)))
     return heading, np.asarray(est.resolved, bool), time.perf_counter() - t0
+
+
+def mount_tilt(datas, rc, calibration, decoder, *, leave_out_day=None):
+    """The sensor's first-order mount tilt (radians, ``(2,)``, or None) from the daylight rotations of the other days.
+
+    Each session (:func:`calibration_sessions`, not of ``leave_out_day``) is decoded through ``calibration``
+    with ``decoder``; its errors against the logged yaw are fitted with ``tan(h) (a cos phi + b sin phi)``
+    (:func:`bionav.polcompass.deviation.deviation_from_errors`, tilt form), and the sessions are pooled by
+    the median. Only the logged yaw is used, no heading truth.
+    """
+    from bionav.polcompass.deviation import deviation_from_errors, pooled_deviation
+
+    fits = []
+    for d in calibration_sessions(datas, rc):
+        if d.session.day == leave_out_day:
+            continue
+        dc = calibrated(d, calibration, rc.calibration_parts, rc.calibration_solver)
+        heading, _resolved, _seconds = decode_session(decoder, dc)
+        err, _c = session_errors(heading, dc.yaw)
+        fits.append(deviation_from_errors(wrap_angle(dc.sun.azimuth - heading), err, n_harmonics=1,
+                                          scale=float(np.tan(dc.sun.elevation))))
+    return pooled_deviation(fits)
 
 
 def view_field(rng, heading, unit_azimuths, n_photodiodes: int, *, n_harmonics: int = 12):
@@ -309,17 +337,16 @@ def _cell(value):
 
 
 def _write_csv(path: Path, rows: list[dict]) -> None:
+    """Rows of dicts through the one CSV writer (columns in order of first appearance; empty file for no rows)."""
+    from bionav.files import write_atomic, write_csv_atomic
+
     if not rows:
-        path.write_text("")
+        write_atomic(path, "")
         return
     keys = list(rows[0])
     for r in rows[1:]:
         keys += [k for k in r if k not in keys]
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=keys)
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: _cell(r.get(k)) for k in keys})
+    write_csv_atomic(path, keys, ([_cell(r.get(k)) for k in keys] for r in rows))
 
 
 def _fmt(v, digits=1):
@@ -362,11 +389,258 @@ def _decoder(ctx, cfg, name):
     return ctx.plugin("decoder", node)
 
 
+def _decoders(cfg, ctx, exp) -> tuple[str, dict]:
+    """The chosen decoder's name and every decoder to score, chosen first (after the run's config checks)."""
+    if cfg.get("decoder") is None or not cfg.decoder.get("name"):
+        raise UserError(
+            "experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them)."
+        )
+    chosen = str(cfg.decoder.name)
+    names = [chosen] + [str(n) for n in exp.compare if str(n) != chosen]
+    return chosen, {n: _decoder(ctx, cfg, n) for n in names}
+
+
+def _prepared_sessions(rc) -> tuple[list, list]:
+    """Every session of ``recordings.path`` prepared for decoding, and ``(path, message)`` of the unusable ones."""
+    from bionav.polcompass.recordings import load_sessions
+
+    sessions, bad_files = load_sessions(rc.path)
+    for _path, message in bad_files:
+        log.warning("%s", message)
+    if not sessions:
+        raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
+    prepared = []
+    for session in sessions:
+        try:
+            prepared.append(prepare_session(session, rc))
+        except UserError as exc:  # e.g. a folder name without the recording time: skip that session, keep the rest
+            bad_files.append((Path(session.name), str(exc)))
+            log.warning("%s", exc)
+    return prepared, bad_files
+
+
+def _calibration_for(prepared, rc, ctx, decoder):
+    """``calibration(day) -> (ArrayCalibration or None, label)`` for ``recordings.calibration``.
+
+    ``auto`` self-calibrates the daylight sessions, writes ``calibration.json`` pooled over all days and
+    gives each day the calibration of the others (with ``tilt`` in ``calibration_parts`` also the mount tilt
+    learned on the others with ``decoder``); a file is loaded once; ``none`` gives none.
+    """
+    from dataclasses import replace
+
+    how = str(rc.calibration)
+    tilt = "tilt" in rc.calibration_parts
+    if how == "auto":
+        estimates = self_calibrate(prepared, rc, progress=ctx.progress)
+        if estimates:
+            from bionav.polcompass.array_calibration import combine_sessions
+
+            pooled = combine_sessions([e for _d, e in estimates.values()], sorted(estimates))
+            if tilt:
+                pooled = replace(pooled, mount_tilt=mount_tilt(prepared, rc, pooled, decoder))
+            pooled.save(ctx.dir / "calibration.json")
+        cache = {}
+
+        def for_day(day):
+            if day not in cache:
+                cal, label = leave_one_day_out(estimates, day)
+                if tilt and cal is not None:
+                    cal = replace(cal, mount_tilt=mount_tilt(prepared, rc, cal, decoder, leave_out_day=day))
+                    label += " + mount tilt"
+                cache[day] = (cal, label)
+            return cache[day]
+
+        return for_day
+    fixed = None
+    if how != "none":
+        from bionav.polcompass.array_calibration import ArrayCalibration
+
+        fixed = ArrayCalibration.load(how)
+        if tilt and fixed.mount_tilt is None:
+            log.warning("recordings.calibration_parts has tilt but %s holds no mount tilt; none is applied", how)
+    label = "none" if fixed is None else f"file {how}"
+    return lambda day: (fixed, label)
+
+
+class _Tally:
+    """Rows, errors (radians) and flags gathered over the sessions: per decoder and condition, and of the chosen decoder."""
+
+    def __init__(self, names):
+        self.names = list(names)
+        self.errors = {n: {g: [] for g in GROUPS} for n in self.names}
+        self.chosen_err, self.chosen_res = [], []
+        self.res_by_group, self.valid_by_group = {g: [] for g in GROUPS}, {g: [] for g in GROUPS}
+        self.sim_err, self.real_err = {g: [] for g in GROUPS}, {g: [] for g in GROUPS}
+        self.per_session_plot, self.decode_times, self.session_rows, self.fault_rows = [], [], [], []
+        self.n_rotations = 0
+
+
+def _session_base(data: SessionData, cal_label: str) -> dict:
+    session = data.session
+    return {
+        "session": session.name,
+        "day": session.day,
+        "time_of_day": session.time_of_day,
+        "condition": session.condition,
+        "period": data.period,
+        "sun_elevation_deg": float(np.degrees(data.sun.elevation)),
+        "sun_azimuth_deg": float(np.degrees(data.sun.azimuth)),
+        "n_rotations": len(session.rotations),
+        "excluded_units": " ".join(str(u) for u in data.excluded),
+        "calibration": cal_label,
+    }
+
+
+def _record_rotations(ctx, data: SessionData, name: str, heading, err, resolved) -> None:
+    session = data.session
+    for r in range(len(session.rotations)):
+        sel = data.rotation_index == r
+        ctx.log.write(ROTATION_TOPIC, {
+            "session": session.name, "file": session.rotations[r].path.name, "decoder": name,
+            "yaw": data.yaw[sel].tolist(),
+            "heading": [float(v) if np.isfinite(v) else None for v in heading[sel]],
+            "error": err[sel].tolist(), "resolved": resolved[sel].tolist()},
+            schema_name="bionav.PolRecordingRotation")
+
+
+def _score_session(ctx, exp, tally: _Tally, data: SessionData, sim_runs, decoders, chosen, base, tilt=None) -> None:
+    """Decode one (calibrated) session with every decoder and add its rows and errors to ``tally``."""
+    for name, dec in decoders.items():
+        heading, resolved, seconds = decode_session(dec, data, tilt)
+        err, c = session_errors(heading, data.yaw)
+        decoded = np.isfinite(heading)
+        row = {**base, "decoder": name, **error_stats(err),
+               "decoded_fraction": float(np.mean(decoded)),
+               "mae_decoded_deg": error_stats(err[decoded])["mae_deg"],
+               "resolved_fraction": float(np.mean(resolved)),
+               "offset_deg": float(np.degrees(c)),
+               "decode_ms": 1000.0 * seconds}
+        tally.errors[name][data.period].append(err)
+        if name == chosen:
+            tally.decode_times.append(seconds)
+            tally.chosen_err.append(err)
+            tally.chosen_res.append(resolved)
+            tally.res_by_group[data.period].append(resolved)
+            tally.valid_by_group[data.period].append(decoded)
+            tally.real_err[data.period].append(err)
+            tally.per_session_plot.append((data.session, data, err))
+            if sim_runs:  # every repeat its own simulated device (gains) and cloud draw, errors pooled
+                s_err = np.concatenate([session_errors(decode_session(dec, sd)[0], sd.yaw)[0] for sd in sim_runs])
+                s_stats = error_stats(s_err)
+                row["sim_mae_deg"] = s_stats["mae_deg"]
+                row["sim_rmse_deg"] = s_stats["rmse_deg"]
+                tally.sim_err[data.period].append(s_err)
+            if exp.record_samples:
+                _record_rotations(ctx, data, name, heading, err, resolved)
+        tally.session_rows.append(row)
+        ctx.log.write(SESSION_TOPIC, row, schema_name="bionav.PolRecordingSession")
+
+
+def _score_all(ctx, exp, rc, prepared, calibration_for, decoders, chosen) -> _Tally:
+    tally = _Tally(list(decoders))
+    rng_sim = ctx.rng.spawn(1)[0]
+    for data in ctx.progress(prepared, desc="sessions", total=len(prepared)):
+        session = data.session
+        cal, cal_label = calibration_for(session.day)
+        tally.n_rotations += len(session.rotations)
+        for f in data.faults:
+            tally.fault_rows.append({"session": session.name, **f.to_dict()})
+        ctx.log.write(FAULT_TOPIC, {"session": session.name, "excluded": data.excluded,
+                                    "units": [f.to_dict() for f in data.faults]}, schema_name="bionav.PolOpFaults")
+        sim_runs = [simulate_session(data, exp, rng_sim) for _ in range(exp.sim_repeats)] if exp.simulate else []
+        data = calibrated(data, cal, rc.calibration_parts, rc.calibration_solver)
+        tilt = cal.mount_tilt if cal is not None and "tilt" in rc.calibration_parts else None
+        _score_session(ctx, exp, tally, data, sim_runs, decoders, chosen, _session_base(data, cal_label), tilt)
+    return tally
+
+
+def _pooled_rows(tally: _Tally) -> list[dict]:
+    rows = []
+    for name in tally.names:
+        for g in GROUPS:
+            if tally.errors[name][g]:
+                rows.append({"decoder": name, "group": g, **error_stats(np.concatenate(tally.errors[name][g]))})
+        all_e = [e for g in GROUPS for e in tally.errors[name][g]]
+        rows.append({"decoder": name, "group": "all", **error_stats(np.concatenate(all_e))})
+    return rows
+
+
+def _write_outputs(ctx, exp, tally: _Tally, pooled_rows, chosen) -> None:
+    from bionav.experiments import pol_recordings_plots as plots
+
+    _write_csv(ctx.dir / "sessions.csv", tally.session_rows)
+    _write_csv(ctx.dir / "pooled.csv", pooled_rows)
+    _write_csv(ctx.dir / "faults.csv", tally.fault_rows)
+    (ctx.dir / "summary.md").write_text(summary_markdown(tally.session_rows, pooled_rows, tally.names))
+    plot_dir = ctx.plots
+    plots.error_vs_time_of_day(plot_dir / "error_vs_time_of_day.png", tally.session_rows, tally.names)
+    plots.session_distributions(plot_dir / "session_errors.png", tally.per_session_plot, chosen)
+    first = tally.per_session_plot[0]
+    plots.raw_rotation(plot_dir / "raw_unit_responses.png", first[0], first[1])
+    plots.clear_vs_canopy(plot_dir / "clear_vs_canopy.png", tally.real_err, chosen)
+    if exp.simulate:
+        plots.sim_vs_real(plot_dir / "sim_vs_real.png", tally.real_err, tally.sim_err, chosen)
+
+
+def _condition_metrics(tally: _Tally, pooled_rows, chosen) -> dict:
+    """``<condition>_*`` keys of the chosen decoder."""
+    metrics = {}
+    for g in GROUPS:
+        if tally.real_err[g]:
+            e = np.concatenate(tally.real_err[g])
+            metrics[f"{g}_resolved_fraction"] = float(np.mean(np.concatenate(tally.res_by_group[g])))
+            # the eq. 4.6 pair chosen right: the error is less than a quarter turn (undecoded samples count as wrong)
+            metrics[f"{g}_correct_side_fraction"] = float(np.mean(np.abs(e) < np.pi / 2.0 - 1e-9))
+            # the decoder's per-sample valid flag: a heading was given (enough units above the noise floor);
+            # <group>_mae_deg counts the others as 90 degrees, <group>_mae_valid_deg leaves them out
+            ok = np.concatenate(tally.valid_by_group[g])
+            metrics[f"{g}_valid_fraction"] = float(np.mean(ok))
+            metrics[f"{g}_mae_valid_deg"] = error_stats(e[ok])["mae_deg"]
+    for r in pooled_rows:
+        if r["decoder"] == chosen and r["group"] in GROUPS:
+            metrics[f"{r['group']}_mae_deg"] = r["mae_deg"]
+            metrics[f"{r['group']}_rmse_deg"] = r["rmse_deg"]
+    return metrics
+
+
+def _sim_metrics(exp, tally: _Tally) -> dict:
+    """The simulation's parameters and ``sim_<condition>_mae_deg``."""
+    metrics = {"sim_repeats": int(exp.sim_repeats)}
+    for key in ("sim_gain_sigma", "sim_angle_sigma_deg", "sim_noise", "sim_canopy_cover", "sim_max_degree",
+                "sim_view_sigma", "sim_tilt_sigma_deg", "sim_azimuth_sigma_deg"):
+        metrics[key] = float(getattr(exp, key))
+    for g in GROUPS:
+        if tally.sim_err[g]:
+            metrics[f"sim_{g}_mae_deg"] = error_stats(np.concatenate(tally.sim_err[g]))["mae_deg"]
+    return metrics
+
+
+def _metrics(rc, exp, tally: _Tally, pooled_rows, chosen, n_bad: int) -> dict[str, Any]:
+    stats = error_stats(np.concatenate(tally.chosen_err))
+    how = str(rc.calibration)
+    metrics: dict[str, Any] = {
+        "decoder": chosen,
+        "heading_mae_deg": stats["mae_deg"],
+        "heading_rmse_deg": stats["rmse_deg"],
+        "n_samples": stats["n_samples"],
+        "n_rotations": int(tally.n_rotations),
+        "n_sessions": len({r["session"] for r in tally.session_rows}),
+        "ambiguity_resolved_fraction": float(np.mean(np.concatenate(tally.chosen_res))),
+        "decode_ms_per_session_median": float(1000.0 * np.median(tally.decode_times)),
+        "decode_ms_per_session_max": float(1000.0 * max(tally.decode_times)),
+        "n_bad_files": n_bad,
+        "calibration": how if how in ("auto", "none") else "file",
+        "calibration_parts": list(rc.calibration_parts),
+    }
+    metrics.update(_condition_metrics(tally, pooled_rows, chosen))
+    if exp.simulate:
+        metrics.update(_sim_metrics(exp, tally))
+    return metrics
+
+
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     """Entry point called by :func:`bionav.experiments.runner.run_experiment`."""
-    from bionav.experiments import pol_recordings_plots as plots
     from bionav.experiments.configs import experiment_config
-    from bionav.polcompass.recordings import load_sessions
 
     rc = recordings_config(cfg)
     exp = experiment_config(cfg, "pol_recordings")
@@ -375,186 +649,20 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             "experiment=pol_recordings needs recordings.path=DIR, a folder of POL-OP recordings "
             "(e.g. recordings.path=../shared/data/celestial-compass)."
         )
-    if cfg.get("decoder") is None or not cfg.decoder.get("name"):
-        raise UserError(
-            "experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them)."
-        )
-    chosen = str(cfg.decoder.name)
-    names = [chosen] + [str(n) for n in exp.compare if str(n) != chosen]
-    decoders = {n: _decoder(ctx, cfg, n) for n in names}
-
-    sessions, bad_files = load_sessions(rc.path)
-    for path, message in bad_files:
-        log.warning("%s", message)
-    if not sessions:
+    chosen, decoders = _decoders(cfg, ctx, exp)
+    prepared, bad_files = _prepared_sessions(rc)
+    calibration_for = _calibration_for(prepared, rc, ctx, decoders[chosen])
+    tally = _score_all(ctx, exp, rc, prepared, calibration_for, decoders, chosen)
+    if not tally.session_rows:
         raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
-
-    rng_sim = ctx.rng.spawn(1)[0]
-    session_rows, fault_rows = [], []
-    errors = {n: {g: [] for g in GROUPS} for n in names}
-    chosen_err, chosen_res = [], []
-    res_by_group = {g: [] for g in GROUPS}
-    valid_by_group = {g: [] for g in GROUPS}
-    sim_err = {g: [] for g in GROUPS}
-    real_err = {g: [] for g in GROUPS}
-    per_session_plot = []
-    n_rotations = 0
-    decode_times = []
-    prepared = []
-    for session in sessions:
-        try:
-            prepared.append(prepare_session(session, rc))
-        except UserError as exc:  # e.g. a folder name without the recording time: skip that session, keep the rest
-            bad_files.append((Path(session.name), str(exc)))
-            log.warning("%s", exc)
-    how = str(rc.calibration)
-    estimates, fixed = {}, None
-    if how == "auto":
-        estimates = self_calibrate(prepared, rc, progress=ctx.progress)
-        if estimates:
-            from bionav.polcompass.array_calibration import combine_sessions
-
-            combine_sessions([e for _d, e in estimates.values()], sorted(estimates)).save(ctx.dir / "calibration.json")
-    elif how != "none":
-        from bionav.polcompass.array_calibration import ArrayCalibration
-
-        fixed = ArrayCalibration.load(how)
-    for data in ctx.progress(prepared, desc="sessions", total=len(prepared)):
-        session = data.session
-        if how == "auto":
-            cal, cal_label = leave_one_day_out(estimates, session.day)
-        else:
-            cal, cal_label = fixed, ("none" if fixed is None else f"file {how}")
-        n_rotations += len(session.rotations)
-        for f in data.faults:
-            row = {"session": session.name, **f.to_dict()}
-            fault_rows.append(row)
-        ctx.log.write(FAULT_TOPIC, {"session": session.name, "excluded": data.excluded,
-                                    "units": [f.to_dict() for f in data.faults]}, schema_name="bionav.PolOpFaults")
-        sim_runs = [simulate_session(data, exp, rng_sim) for _ in range(exp.sim_repeats)] if exp.simulate else []
-        data = calibrated(data, cal, rc.calibration_parts, rc.calibration_solver)
-        base = {
-            "session": session.name,
-            "day": session.day,
-            "time_of_day": session.time_of_day,
-            "condition": session.condition,
-            "period": data.period,
-            "sun_elevation_deg": float(np.degrees(data.sun.elevation)),
-            "sun_azimuth_deg": float(np.degrees(data.sun.azimuth)),
-            "n_rotations": len(session.rotations),
-            "excluded_units": " ".join(str(u) for u in data.excluded),
-            "calibration": cal_label,
-        }
-        for name, dec in decoders.items():
-            heading, resolved, seconds = decode_session(dec, data)
-            err, c = session_errors(heading, data.yaw)
-            stats = error_stats(err)
-            decoded = np.isfinite(heading)
-            row = {**base, "decoder": name, **stats,
-                   "decoded_fraction": float(np.mean(decoded)),
-                   "mae_decoded_deg": error_stats(err[decoded])["mae_deg"],
-                   "resolved_fraction": float(np.mean(resolved)),
-                   "offset_deg": float(np.degrees(c)),
-                   "decode_ms": 1000.0 * seconds}
-            errors[name][data.period].append(err)
-            if name == chosen:
-                decode_times.append(seconds)
-                chosen_err.append(err)
-                chosen_res.append(resolved)
-                res_by_group[data.period].append(resolved)
-                valid_by_group[data.period].append(decoded)
-                real_err[data.period].append(err)
-                per_session_plot.append((session, data, err))
-                if sim_runs:  # every repeat its own simulated device (gains) and cloud draw, errors pooled
-                    s_err = np.concatenate([session_errors(decode_session(dec, sd)[0], sd.yaw)[0] for sd in sim_runs])
-                    s_stats = error_stats(s_err)
-                    row["sim_mae_deg"] = s_stats["mae_deg"]
-                    row["sim_rmse_deg"] = s_stats["rmse_deg"]
-                    sim_err[data.period].append(s_err)
-                if exp.record_samples:
-                    for r in range(len(session.rotations)):
-                        sel = data.rotation_index == r
-                        ctx.log.write(ROTATION_TOPIC, {
-                            "session": session.name, "file": session.rotations[r].path.name, "decoder": name,
-                            "yaw": data.yaw[sel].tolist(),
-                            "heading": [float(v) if np.isfinite(v) else None for v in heading[sel]],
-                            "error": err[sel].tolist(), "resolved": resolved[sel].tolist()},
-                            schema_name="bionav.PolRecordingRotation")
-            session_rows.append(row)
-            ctx.log.write(SESSION_TOPIC, row, schema_name="bionav.PolRecordingSession")
-
-    if not session_rows:
-        raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
-    pooled_rows = []
-    for name in names:
-        for g in GROUPS:
-            if errors[name][g]:
-                pooled_rows.append({"decoder": name, "group": g, **error_stats(np.concatenate(errors[name][g]))})
-        all_e = [e for g in GROUPS for e in errors[name][g]]
-        pooled_rows.append({"decoder": name, "group": "all", **error_stats(np.concatenate(all_e))})
-    _write_csv(ctx.dir / "sessions.csv", session_rows)
-    _write_csv(ctx.dir / "pooled.csv", pooled_rows)
-    _write_csv(ctx.dir / "faults.csv", fault_rows)
-    (ctx.dir / "summary.md").write_text(summary_markdown(session_rows, pooled_rows, names))
-
-    plot_dir = ctx.plots
-    plots.error_vs_time_of_day(plot_dir / "error_vs_time_of_day.png", session_rows, names)
-    plots.session_distributions(plot_dir / "session_errors.png", per_session_plot, chosen)
-    first = per_session_plot[0]
-    plots.raw_rotation(plot_dir / "raw_unit_responses.png", first[0], first[1])
-    plots.clear_vs_canopy(plot_dir / "clear_vs_canopy.png", real_err, chosen)
-    if exp.simulate:
-        plots.sim_vs_real(plot_dir / "sim_vs_real.png", real_err, sim_err, chosen)
-
-    all_err = np.concatenate(chosen_err)
-    stats = error_stats(all_err)
-    metrics: dict[str, Any] = {
-        "decoder": chosen,
-        "heading_mae_deg": stats["mae_deg"],
-        "heading_rmse_deg": stats["rmse_deg"],
-        "n_samples": stats["n_samples"],
-        "n_rotations": int(n_rotations),
-        "n_sessions": len({r["session"] for r in session_rows}),
-        "ambiguity_resolved_fraction": float(np.mean(np.concatenate(chosen_res))),
-        "decode_ms_per_session_median": float(1000.0 * np.median(decode_times)),
-        "decode_ms_per_session_max": float(1000.0 * max(decode_times)),
-        "n_bad_files": len(bad_files),
-        "calibration": how if how in ("auto", "none") else "file",
-        "calibration_parts": list(rc.calibration_parts),
-    }
-    for g in GROUPS:
-        if real_err[g]:
-            e = np.concatenate(real_err[g])
-            metrics[f"{g}_resolved_fraction"] = float(np.mean(np.concatenate(res_by_group[g])))
-            # the eq. 4.6 pair chosen right: the error is less than a quarter turn (undecoded samples count as wrong)
-            metrics[f"{g}_correct_side_fraction"] = float(np.mean(np.abs(e) < np.pi / 2.0 - 1e-9))
-            # the decoder's per-sample valid flag: a heading was given (enough units above the noise floor);
-            # <group>_mae_deg counts the others as 90 degrees, <group>_mae_valid_deg leaves them out
-            ok = np.concatenate(valid_by_group[g])
-            metrics[f"{g}_valid_fraction"] = float(np.mean(ok))
-            metrics[f"{g}_mae_valid_deg"] = error_stats(e[ok])["mae_deg"]
-    for r in pooled_rows:
-        if r["decoder"] == chosen and r["group"] in GROUPS:
-            metrics[f"{r['group']}_mae_deg"] = r["mae_deg"]
-            metrics[f"{r['group']}_rmse_deg"] = r["rmse_deg"]
-    if exp.simulate:
-        metrics["sim_repeats"] = int(exp.sim_repeats)
-        metrics["sim_gain_sigma"] = float(exp.sim_gain_sigma)
-        metrics["sim_angle_sigma_deg"] = float(exp.sim_angle_sigma_deg)
-        metrics["sim_noise"] = float(exp.sim_noise)
-        metrics["sim_canopy_cover"] = float(exp.sim_canopy_cover)
-        metrics["sim_max_degree"] = float(exp.sim_max_degree)
-        metrics["sim_view_sigma"] = float(exp.sim_view_sigma)
-        metrics["sim_tilt_sigma_deg"] = float(exp.sim_tilt_sigma_deg)
-        metrics["sim_azimuth_sigma_deg"] = float(exp.sim_azimuth_sigma_deg)
-        for g in GROUPS:
-            if sim_err[g]:
-                metrics[f"sim_{g}_mae_deg"] = error_stats(np.concatenate(sim_err[g]))["mae_deg"]
+    pooled_rows = _pooled_rows(tally)
+    _write_outputs(ctx, exp, tally, pooled_rows, chosen)
+    metrics = _metrics(rc, exp, tally, pooled_rows, chosen, len(bad_files))
     if bad_files and rc.on_bad_file == "error":
         listed = " ".join(m for _p, m in bad_files[:3])
         more = f" ({len(bad_files) - 3} more, see the log)" if len(bad_files) > 3 else ""
         raise UserError(
-            f"{len(bad_files)} recording file(s) or session(s) are unusable; the other {n_rotations} rotations were scored and "
-            f"sessions.csv is written. {listed}{more} Set recordings.on_bad_file=skip to only warn."
+            f"{len(bad_files)} recording file(s) or session(s) are unusable; the other {tally.n_rotations} rotations were "
+            f"scored and sessions.csv is written. {listed}{more} Set recordings.on_bad_file=skip to only warn."
         )
     return metrics

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.geometry import wrap_axial
-from bionav.polcompass.compass import delogarithmise
+from bionav.polcompass.compass import delogarithmise, least_squares_evector
 from bionav.polcompass.optics import sensor_frame
 
 
@@ -201,31 +201,6 @@ class UnitEvectors:
     evector: np.ndarray
 
 
-def evector_from_pol_ops(x, alphas):
-    """E-vector angle and degree of one unit from its POL-OPs.
-
-    ``x_j = d cos(2a - 2 alpha_j)`` is linear in ``(d cos 2a, d sin 2a)``; two
-    POL-OPs give eqs. 4.4-4.5 exactly (with the quadrant from ``d > 0``), more
-    are solved by least squares.
-
-    Parameters
-    ----------
-    x : ndarray, shape ``(..., K, J)``
-        Delogarithmised outputs.
-    alphas : ndarray, shape ``(K, J)``
-        First polarizer angle of each POL-OP.
-
-    Returns
-    -------
-    angle, degree : ndarray, shape ``(..., K)``
-    """
-    alphas = np.asarray(alphas, float)
-    design = np.stack([np.cos(2.0 * alphas), np.sin(2.0 * alphas)], axis=-1)  # (K, J, 2)
-    pinv = np.linalg.pinv(design)  # (K, 2, J)
-    cs = np.einsum("kij,...kj->...ki", pinv, np.asarray(x, float))
-    return wrap_axial(0.5 * np.arctan2(cs[..., 1], cs[..., 0])), np.hypot(cs[..., 0], cs[..., 1])
-
-
 def stokes_evector(counts, array: PolArray):
     """E-vector angle and degree of each unit from all its photodiodes (``solver="stokes"``).
 
@@ -287,13 +262,13 @@ def evectors_from_counts(counts, array: PolArray) -> UnitEvectors:
     if array.solver == "stokes":
         angle, degree = stokes_evector(counts, array)
     elif all(len(g) == 1 for g in groups):
-        angle, degree = evector_from_pol_ops(x, array.pair_angles)
+        angle, degree = least_squares_evector(x, array.pair_angles)
     else:  # units looking at the same sky point (the thesis' zenith units) are solved together
         angle = np.empty(x.shape[:-1])
         degree = np.empty(x.shape[:-1])
         for g in groups:
             xs = x[..., g, :].reshape(x.shape[:-2] + (1, -1))
-            a, d = evector_from_pol_ops(xs, array.pair_angles[g].reshape(1, -1))
+            a, d = least_squares_evector(xs, array.pair_angles[g].reshape(1, -1))
             angle[..., g] = a
             degree[..., g] = d
     evector = np.cos(angle)[..., None] * frames[:, :, 0] + np.sin(angle)[..., None] * frames[:, :, 1]

@@ -223,6 +223,23 @@ def _nominal_gauge(m, alpha0, free=None):
     return b
 
 
+def _fix_gauge(m, c, w, f, alpha0, *, n_harmonics: int, symmetric: bool):
+    """Channel vectors ``m`` (K, P, 3) in the fixed gauge (:func:`calibrate_session`), their polarizer angles before
+    :func:`_nominal_gauge` (radians, (K, P)) and the mirror symmetry's strength (NaN without ``symmetric``)."""
+    strength = float("nan")
+    free = None
+    if symmetric:
+        # the mirror symmetry: rotate the ring's components into (even, even, odd) first
+        grid = 2.0 * np.pi * np.arange(180) / 180
+        ring = _ring_fit(m, c, w, f)
+        a, _phi, asym = mirror_gauge(_basis(grid, n_harmonics) @ ring.T, grid)
+        m = m @ np.linalg.inv(a)  # S -> A S, m -> A^-T m
+        strength = 1.0 - asym
+        free = np.array([[1, 1, 0], [1, 1, 0], [0, 0, 1]], bool)  # only gauges that keep the symmetry
+    before = 0.5 * np.arctan2(m[..., 2], m[..., 1])
+    return m @ _nominal_gauge(m, alpha0, free).T, before, strength
+
+
 def calibrate_session(counts, yaw, valid, array, *, n_bins: int = 120, n_harmonics: int = 12,
                       iterations: int = 40, symmetric: bool = True) -> SessionCalibration:
     """Fit photodiode gains and polarizer offsets to one session (see the module docstring).
@@ -288,19 +305,7 @@ def calibrate_session(counts, yaw, valid, array, *, n_bins: int = 120, n_harmoni
     pred = np.einsum("kpi,bki->bkp", m, stokes)
     ok = w > 0
     rms = float(np.sqrt(np.mean((np.log(np.clip(pred[ok], 1e-300, None)) - np.log(c[ok])) ** 2)))
-    strength = float("nan")
-    free = None
-    if symmetric:
-        # the mirror symmetry: rotate the ring's components into (even, even, odd) first
-        grid = 2.0 * np.pi * np.arange(180) / 180
-        ring = _ring_fit(m, c, w, f)
-        a, _phi, asym = mirror_gauge(_basis(grid, n_harmonics) @ ring.T, grid)
-        m = m @ np.linalg.inv(a)  # S -> A S, m -> A^-T m
-        strength = 1.0 - asym
-        free = np.array([[1, 1, 0], [1, 1, 0], [0, 0, 1]], bool)  # only gauges that keep the symmetry
-    before = 0.5 * np.arctan2(m[..., 2], m[..., 1])
-    b = _nominal_gauge(m, alpha0, free)
-    m = m @ b.T
+    m, before, strength = _fix_gauge(m, c, w, f, alpha0, n_harmonics=n_harmonics, symmetric=symmetric)
     gain = 2.0 * m[..., 0]
     angle = 0.5 * np.arctan2(m[..., 2], m[..., 1])
     lam = np.log(np.clip(np.abs(gain), 1e-300, None))
@@ -338,6 +343,11 @@ class ArrayCalibration:
         Sessions each unit's estimate pools.
     sessions : list of str
         The sessions used.
+    mount_tilt : ndarray, shape ``(2,)``, or None
+        First-order tilt of the whole sensor (radians): the coefficients ``(a, b)`` of the heading
+        deviation ``tan(h) (a cos phi + b sin phi)`` (``h`` the sun's elevation, ``phi`` its azimuth in
+        the device frame, :mod:`bionav.polcompass.deviation`); the tilt is ``hypot(a, b)``. None: not
+        estimated (``recordings.calibration_parts`` without ``tilt``).
     """
 
     gain: np.ndarray
@@ -349,6 +359,7 @@ class ArrayCalibration:
     calibrated: np.ndarray
     n_sessions: np.ndarray
     sessions: list = field(default_factory=list)
+    mount_tilt: np.ndarray | None = None
 
     @property
     def shape(self) -> tuple:
@@ -395,7 +406,7 @@ class ArrayCalibration:
             a = np.asarray(a, float) * scale
             return [num(r, 1.0) for r in a] if a.ndim > 1 else [None if not np.isfinite(v) else float(v) for v in a]
 
-        return {
+        out = {
             "schema": SCHEMA,
             "units": int(self.shape[0]),
             "photodiodes": int(self.shape[1]),
@@ -412,6 +423,12 @@ class ArrayCalibration:
             "n_sessions": [int(v) for v in self.n_sessions],
             "sessions": list(self.sessions),
         }
+        if self.mount_tilt is not None:  # only when estimated: files without it stay as they were
+            out["mount_tilt_deg"] = num(self.mount_tilt, 180.0 / np.pi)
+            out["mount_tilt_conventions"] = ("heading deviation tan(sun elevation) (a cos phi + b sin phi), phi the "
+                                             "sun's azimuth in the device frame; [a, b] in degrees, subtracted from "
+                                             "the decoded heading; the sensor's tilt is hypot(a, b) to first order.")
+        return out
 
     @classmethod
     def from_dict(cls, data: dict, *, source: str = "the calibration") -> "ArrayCalibration":
@@ -437,7 +454,8 @@ class ArrayCalibration:
             out = cls(arr("gain", (k, p), fill=1.0), arr("gain_log_sigma", (k, p)),
                       arr("angle_offset_deg", (k, p), rad, 0.0), arr("angle_sigma_deg", (k, p), rad),
                       arr("azimuth_offset_deg", (k,), rad, 0.0), arr("azimuth_sigma_deg", (k,), rad),
-                      calibrated, np.asarray(data.get("n_sessions", [0] * k), int), list(data.get("sessions", [])))
+                      calibrated, np.asarray(data.get("n_sessions", [0] * k), int), list(data.get("sessions", [])),
+                      None if data.get("mount_tilt_deg") is None else arr("mount_tilt_deg", (2,), rad))
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise UserError(f"{source} is malformed ({exc}); recalibrate with recordings.calibration=auto.") from None
         if np.any(out.gain <= 0) or not np.all(np.isfinite(out.gain)):

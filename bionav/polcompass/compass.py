@@ -91,29 +91,34 @@ def two_unit_evector(x_i, x_j, alpha_i: float, alpha_j: float):
 
 
 def least_squares_evector(x, unit_angles):
-    """E-vector angle and degree from ``K >= 2`` units by linear least squares.
+    """E-vector angle and degree from ``J >= 2`` POL-OP outputs by linear least squares: bionav's one e-vector solver.
 
-    Fits ``x_i = c cos 2alpha_i + s sin 2alpha_i`` with ``c = d cos 2a``,
+    Fits ``x_j = c cos 2alpha_j + s sin 2alpha_j`` with ``c = d cos 2a``,
     ``s = d sin 2a``. For three units at 0/60/120 degrees this is
-    ``(c, s) = 2/3 sum_i x_i (cos 2alpha_i, sin 2alpha_i)``.
+    ``(c, s) = 2/3 sum_j x_j (cos 2alpha_j, sin 2alpha_j)``; two POL-OPs give
+    eqs. 4.4-4.5 exactly (the quadrant from ``d > 0``). Used by the thesis
+    compass (:func:`evector_from_compass_counts`, one e-vector from its units)
+    and by every unit of a sensor array
+    (:func:`bionav.polcompass.array.evectors_from_counts`, one per unit).
 
     Parameters
     ----------
-    x : ndarray, shape ``(..., K)``
-        Delogarithmised unit outputs.
-    unit_angles : array_like, shape ``(K,)``
-        Polarizer angles, radians.
+    x : ndarray, shape ``(..., J)``
+        Delogarithmised POL-OP outputs (eq. 4.3).
+    unit_angles : array_like, shape ``(J,)`` or ``(..., J)``
+        First polarizer angle of each POL-OP, radians; leading axes broadcast
+        against those of ``x`` (e.g. ``(K, J)`` for ``K`` units of ``J`` POL-OPs each).
 
     Returns
     -------
     angle : ndarray, shape ``(...)``
-        ``[-pi/2, pi/2)``, sensor frame.
+        ``[-pi/2, pi/2)``, in the frame of the polarizer angles.
     degree : ndarray, shape ``(...)``
     """
     alpha = np.asarray(unit_angles, float)
-    design = np.stack([np.cos(2.0 * alpha), np.sin(2.0 * alpha)], axis=1)  # (K, 2)
-    pinv = np.linalg.pinv(design)  # (2, K)
-    cs = np.einsum("jk,...k->...j", pinv, np.asarray(x, float))
+    design = np.stack([np.cos(2.0 * alpha), np.sin(2.0 * alpha)], axis=-1)  # (..., J, 2)
+    pinv = np.linalg.pinv(design)  # (..., 2, J)
+    cs = np.einsum("...ij,...j->...i", pinv, np.asarray(x, float))
     return wrap_axial(0.5 * np.arctan2(cs[..., 1], cs[..., 0])), np.hypot(cs[..., 0], cs[..., 1])
 
 
@@ -235,7 +240,7 @@ def heading_errors(estimated, reference, *, axial: bool, remove_offset: bool = T
     return HeadingErrors(np.asarray(errors, float), offset, axial)
 
 
-def evectors_from_counts(counts, calibration, *, solver: str = "least_squares"):
+def evector_from_compass_counts(counts, calibration, *, solver: str = "least_squares"):
     """E-vector angle, degree and delogarithmised unit outputs from ADC counts (thesis 4.1).
 
     Parameters

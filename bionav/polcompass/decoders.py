@@ -228,9 +228,21 @@ def _pick_pair(score, azimuths, total, margin):
     return best, refine(best), refine(alt), gap
 
 
+def _robust_weights(w0, r, scale, reject, *, last: bool):
+    """Cauchy weights ``w0 / (1 + (r / scale)^2)``; on the ``last`` round with ``reject``: ``w0`` of the units with
+    ``|r| <= reject`` where at least two such units remain (shapes ``(N, K)``, radians)."""
+    w = w0 / (1.0 + (r / scale) ** 2)
+    if not last or reject is None:
+        return w
+    keep = np.abs(r) <= reject
+    enough = np.sum(keep & (w0 > 0), axis=-1) >= 2
+    return np.where(enough[:, None], np.where(keep, w0, 0.0), w)
+
+
 def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, sun_elevation: float | None = None,
                      residual: str = "perpendicular", weight_power: float = 1.0, robust_iterations: int = 2,
-                     robust_scale: float = np.deg2rad(10.0), margin: float = 0.01, noise_counts: float = 0.0,
+                     robust_scale: float = np.deg2rad(20.0), reject: float | None = np.deg2rad(30.0),
+                     model_error: float = np.deg2rad(10.0), margin: float = 0.01, noise_counts: float = 0.0,
                      min_units: int = 1) -> SunEstimate:
     """bionav's least-squares fit of the sky model's pattern (see the module docstring).
 
@@ -252,19 +264,32 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     weight_power : float
         Unit weight ``d_k ** weight_power``.
     robust_iterations : int
-        Re-weighting rounds with Cauchy weights ``1 / (1 + (r_k / scale)^2)``
-        of each unit's residual at the current solution (units contradicting
-        the others at that sample, e.g. glare, count less).
+        Re-weighting rounds with Cauchy weights ``1 / (1 + (r_k / robust_scale)^2)``
+        of each unit's angle residual ``r_k`` at the current solution: units
+        contradicting the others at that sample (glare, leaves under canopy)
+        count less. ``r_k`` is the angle, in the unit's own image plane, between
+        the measured e-vector and the model's (radians): for ``perpendicular``
+        ``r_k = arcsin(e_k . s / |s_perp,k|)`` with ``s_perp,k`` the sun vector's
+        component across unit ``k``'s view, so units that look near the sun or
+        the antisun (where the pattern's angle is ill-defined) are judged in
+        the same units as the others.
     robust_scale : float
-        Residual scale of the re-weighting (radians for ``angle``; the
-        perpendicular residual ``e . s`` is compared with its sine).
+        Cauchy scale of the re-weighting, radians.
+    reject : float or None
+        After the Cauchy rounds, units whose angle residual exceeds ``reject``
+        (radians) are dropped and the last solve weights the others by ``w_k``
+        alone: one unit seeing leaves instead of sky then leaves the heading
+        of the clean units exactly (where at least two units remain; else the
+        Cauchy weights stay). ``None``: no rejection.
+    model_error : float
+        Model-error scale ``s`` of the noise weighting below, radians.
     margin : float
         Minimum difference of the normalised errors of the pair for a
         resolved choice; below it the brighter side decides.
     noise_counts : float
         Count noise per photodiode (counts; 0: none). Each unit's angle noise ``sigma_a``
         (:func:`angle_noise`) lowers its weight to ``d^p s^2 / (s^2 + sigma_a^2)`` with the model-error
-        scale ``s = robust_scale`` (inverse-variance weighting of model error plus noise), and a unit
+        scale ``s = model_error`` (inverse-variance weighting of model error plus noise), and a unit
         whose ``sigma_a`` exceeds ``s`` takes no part: at dusk, units read by light above the noise
         floor count, dark ones not.
     min_units : int
@@ -275,49 +300,71 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     -------
     SunEstimate
     """
-    w0 = _weights(ev, valid, weight_power)
-    if noise_counts > 0:
-        sigma = angle_noise(ev, noise_counts)
-        readable = sigma <= robust_scale
-        w0 = np.where(readable, w0 * robust_scale**2 / (robust_scale**2 + np.where(readable, sigma, 0.0) ** 2), 0.0)
-    enough = np.sum(w0 > 0, axis=-1) >= max(int(min_units), 1)
-    w0 = np.where(enough[:, None], w0, 0.0)
-    w = w0
-    total = w0.sum(axis=-1)
+    w0 = _fit_weights(ev, valid, weight_power=weight_power, noise_counts=noise_counts, model_error=model_error,
+                      min_units=min_units)
+    robust = {"iterations": robust_iterations, "scale": robust_scale, "reject": reject}
     if residual == "perpendicular":
         if sun_elevation is None:
             raise ValueError("residual='perpendicular' needs the sun elevation")
-        e = np.nan_to_num(ev.evector)
-        v = sun_directions(table.azimuths, float(sun_elevation))  # (G, 3)
-        scale = np.sin(robust_scale)
-        iu, ju = np.triu_indices(3)
-        mono = v[:, iu] * v[:, ju] * np.where(iu == ju, 1.0, 2.0)  # (G, 6): quadratic form as a matmul
-        for it in range(robust_iterations + 1):
-            m6 = np.einsum("nk,nki,nki->ni", w, e[..., iu], e[..., ju])  # upper triangle of sum_k w e e^T
-            score = -(m6 @ mono.T)
-            best = np.argmax(score, axis=1)
-            if it < robust_iterations:
-                r = np.einsum("nki,ni->nk", e, v[best])
-                w = w0 / (1.0 + (r / scale) ** 2)
+        score, w = _perpendicular_scores(ev, w0, table=table, array=array, sun_elevation=float(sun_elevation), **robust)
     elif residual == "angle":
-        a2 = 2.0 * np.nan_to_num(ev.angle)
-        ca, sa = np.cos(a2), np.sin(a2)
-        for it in range(robust_iterations + 1):
-            score = (w * ca) @ table.cos2.T + (w * sa) @ table.sin2.T  # (N, G)
-            best = np.argmax(score, axis=1)
-            if it < robust_iterations:
-                r = 0.5 * np.arccos(np.clip(ca * table.cos2[best] + sa * table.sin2[best], -1.0, 1.0))
-                w = w0 / (1.0 + (r / robust_scale) ** 2)
+        score, w = _angle_scores(ev, w0, table=table, **robust)
     else:
         raise ValueError(f"residual must be 'perpendicular' or 'angle', got {residual!r}")
     _, first, second, gap = _pick_pair(score, table.azimuths, np.maximum(w.sum(axis=-1), 1e-12), margin)
     resolved = gap > margin
-    bright = brightness_azimuth(ev, valid, array)
-    by_light, other = _choose_by_brightness(first, second, bright)
-    azimuth = np.where(resolved, first, by_light)
-    alternative = np.where(resolved, second, other)
-    usable = total > 0
-    return SunEstimate(np.where(usable, azimuth, np.nan), np.where(usable, alternative, np.nan), resolved & usable)
+    by_light, other = _choose_by_brightness(first, second, brightness_azimuth(ev, valid, array))
+    usable = w0.sum(axis=-1) > 0
+    azimuth = np.where(usable, np.where(resolved, first, by_light), np.nan)
+    return SunEstimate(azimuth, np.where(usable, np.where(resolved, second, other), np.nan), resolved & usable)
+
+
+def _fit_weights(ev: UnitEvectors, valid, *, weight_power, noise_counts, model_error, min_units):
+    """``sky_fit``'s unit weights before re-weighting, shape ``(N, K)`` (see :func:`sun_from_sky_fit`)."""
+    w0 = _weights(ev, valid, weight_power)
+    if noise_counts > 0:
+        sigma = angle_noise(ev, noise_counts)
+        readable = sigma <= model_error
+        w0 = np.where(readable, w0 * model_error**2 / (model_error**2 + np.where(readable, sigma, 0.0) ** 2), 0.0)
+    enough = np.sum(w0 > 0, axis=-1) >= max(int(min_units), 1)
+    return np.where(enough[:, None], w0, 0.0)
+
+
+def _perpendicular_scores(ev: UnitEvectors, w0, *, table: SkyTable, array: PolArray, sun_elevation: float,
+                          iterations: int, scale: float, reject):
+    """Scores ``-sum_k w_k (e_k . s(phi))^2`` on the table's azimuths, shape ``(N, G)``, and the last weights ``(N, K)``.
+
+    Re-weighting on each unit's angle residual ``arcsin(e_k . s / |s_perp,k|)`` (:func:`sun_from_sky_fit`).
+    """
+    e = np.nan_to_num(ev.evector)
+    v = sun_directions(table.azimuths, sun_elevation)  # (G, 3)
+    views = array.unit_frames()[:, :, 2]  # (K, 3) view directions in the sensor frame
+    iu, ju = np.triu_indices(3)
+    mono = v[:, iu] * v[:, ju] * np.where(iu == ju, 1.0, 2.0)  # (G, 6): quadratic form as a matmul
+    w = w0
+    for it in range(iterations + 1):
+        m6 = np.einsum("nk,nki,nki->ni", w, e[..., iu], e[..., ju])  # upper triangle of sum_k w e e^T
+        score = -(m6 @ mono.T)
+        if it < iterations:
+            s = v[np.argmax(score, axis=1)]  # (N, 3)
+            across = np.sqrt(np.maximum(1.0 - (s @ views.T) ** 2, 1e-6))  # |s_perp| per unit, (N, K)
+            r = np.arcsin(np.clip(np.einsum("nki,ni->nk", e, s) / across, -1.0, 1.0))
+            w = _robust_weights(w0, r, scale, reject, last=it == iterations - 1)
+    return score, w
+
+
+def _angle_scores(ev: UnitEvectors, w0, *, table: SkyTable, iterations: int, scale: float, reject):
+    """Scores ``sum_k w_k cos 2(a_k - a^_k(phi))`` on the table's azimuths, shape ``(N, G)``, and the last weights."""
+    a2 = 2.0 * np.nan_to_num(ev.angle)
+    ca, sa = np.cos(a2), np.sin(a2)
+    w = w0
+    for it in range(iterations + 1):
+        score = (w * ca) @ table.cos2.T + (w * sa) @ table.sin2.T  # (N, G)
+        if it < iterations:
+            best = np.argmax(score, axis=1)
+            r = 0.5 * np.arccos(np.clip(ca * table.cos2[best] + sa * table.sin2[best], -1.0, 1.0))
+            w = _robust_weights(w0, r, scale, reject, last=it == iterations - 1)
+    return score, w
 
 
 def _sun_candidates(s, expected_elevation, margin):

@@ -5,7 +5,7 @@ angle noise ``sigma_a = sqrt(2) sigma_c / (2 C * 2 d sqrt(J / 2))`` for ``C`` co
 ``J`` POL-OPs, degree ``d`` and count noise ``sigma_c``) and the twilight sky's brightness
 (:func:`bionav.light.twilight.twilight_zenith_radiance`: single scattering with the Earth's shadow).
 A unit is readable while ``sigma_a`` stays below the decoder's model-error scale (``sky_fit``'s
-``robust_scale_deg``, 10 degrees), i.e. while it reads at least :func:`readable_counts` per photodiode;
+``model_error_deg``, 10 degrees), i.e. while it reads at least :func:`readable_counts` per photodiode;
 scaling a measured count at a reference sun elevation with the sky's brightness gives the sun
 elevation where that ends (:func:`lowest_readable_elevation`). Radians throughout.
 """

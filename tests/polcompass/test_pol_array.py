@@ -90,6 +90,32 @@ def test_dropping_units_keeps_the_answer_and_no_units_gives_nan():
     assert np.isnan(est.azimuth).all() and not est.resolved.any()
 
 
+@pytest.mark.parametrize("elevation_deg", [20.0, 40.0])
+def test_sky_fit_rejects_a_unit_seeing_leaves_and_keeps_the_clean_units_heading(elevation_deg):
+    # unit 3 sees leaves: its e-vector turned by 40 degrees (a polarized reflection), the other 7 see the sky;
+    # closed form: the fit of the 7 clean units alone gives the sun exactly, and so must the robust fit of all 8
+    arr = PolArray.fan8()
+    phi = np.deg2rad(np.arange(-170.0, 180.0, 23.0))
+    el = np.deg2rad(elevation_deg)
+    intensity, q, u = stokes_from_sky(SkyModel(SunPosition(0.0, el), max_degree=0.6), arr, -phi)
+    turn = np.deg2rad(80.0)  # twice the e-vector turn
+    q[:, 3], u[:, 3] = np.cos(turn) * q[:, 3] - np.sin(turn) * u[:, 3], np.sin(turn) * q[:, 3] + np.cos(turn) * u[:, 3]
+    ev = evectors_from_counts(counts_from_stokes(1000.0 * intensity, q, u, arr), arr)
+    valid = np.ones(ev.angle.shape, bool)
+    clean = valid.copy()
+    clean[:, 3] = False
+    table = sky_table(arr, el)
+
+    def err_deg(v, **kw):
+        est = sun_from_sky_fit(ev, v, table=table, array=arr, sun_elevation=el, **kw)
+        return np.abs(np.degrees(wrap_angle(est.azimuth - phi)))
+
+    np.testing.assert_allclose(err_deg(clean), 0.0, atol=0.05)
+    np.testing.assert_allclose(err_deg(valid), 0.0, atol=0.05)  # default: Cauchy rounds, then the outlier rejected
+    assert err_deg(valid, robust_iterations=0).mean() > 4.0  # plain least squares is pulled off by the leaves
+    assert err_deg(valid, reject=None).mean() > 0.5  # Cauchy weights alone keep some of the leaves' pull
+
+
 def test_sol_population_vector_points_to_a_cosine_intensity_peak():
     # closed form: i_k = cos(theta_k - phi) makes the SOL first harmonic point at phi
     arr = PolArray.fan8()

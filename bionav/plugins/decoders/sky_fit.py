@@ -19,12 +19,15 @@ class SkyFitConfig:
         place) or ``angle`` (the tabulated model e-vector angles of any sky model).
     n_grid : solar azimuths tried, then refined by a parabola.
     weight_power : unit weight = measured degree ** weight_power.
-    robust_iterations, robust_scale_deg : Cauchy re-weighting rounds and their residual scale.
+    robust_iterations, robust_scale_deg : Cauchy re-weighting rounds and their scale on each unit's angle residual
+        (degrees); reject_deg: after them, units whose angle residual exceeds it are dropped and the last solve
+        is unweighted by the loss (0: no rejection). Choice of 20 / 30 degrees: docs/polcompass.md.
+    model_error_deg : model-error scale of the noise weighting (``noise_counts``).
     margin : normalised error gap for a resolved eq. 4.6 pair (else the brighter side decides).
     max_degree, neutral_point_separation_deg : the sky model of ``residual=angle`` (0: Rayleigh).
     noise_counts : count noise of one photodiode (counts; 0: off). Units are weighted by their signal above
         it (:func:`bionav.polcompass.decoders.angle_noise`), units whose angle noise exceeds
-        ``robust_scale_deg`` take no part. 0.5 is measured on the recorded sensor: quantisation (0.29) and
+        ``model_error_deg`` take no part. 0.5 is measured on the recorded sensor: quantisation (0.29) and
         dark noise (0.0-0.5 counts rms per photodiode after sunset, docs/polcompass.md "Dusk").
     min_units : fewest units taking part for a sample to be decoded; fewer: no heading (``valid`` false).
     """
@@ -33,7 +36,9 @@ class SkyFitConfig:
     n_grid: int = bounded(720, ge=36, le=7200)
     weight_power: float = bounded(1.0, ge=0.0, le=4.0)
     robust_iterations: int = bounded(2, ge=0, le=10)
-    robust_scale_deg: float = bounded(10.0, gt=0.0, le=90.0)
+    robust_scale_deg: float = bounded(20.0, gt=0.0, le=90.0)
+    reject_deg: float = bounded(30.0, ge=0.0, le=90.0)
+    model_error_deg: float = bounded(10.0, gt=0.0, le=90.0)
     margin: float = bounded(0.01, ge=0.0, le=1.0)
     max_degree: float = bounded(0.76, gt=0.0, le=1.0)
     neutral_point_separation_deg: float = bounded(0.0, ge=0.0, le=60.0)
@@ -74,6 +79,8 @@ class SkyFit(Decoder):
             weight_power=self.config.weight_power,
             robust_iterations=self.config.robust_iterations,
             robust_scale=np.deg2rad(self.config.robust_scale_deg),
+            reject=np.deg2rad(self.config.reject_deg) if self.config.reject_deg > 0 else None,
+            model_error=np.deg2rad(self.config.model_error_deg),
             margin=self.config.margin,
             noise_counts=self.config.noise_counts,
             min_units=self.config.min_units,
