@@ -27,22 +27,23 @@ def _prepared(path: str):
     from omegaconf import OmegaConf
 
     from bionav.experiments import pol_recordings as pr
+    from bionav.experiments import pol_recordings_session as ps
 
     rc = pr.recordings_config(OmegaConf.create({"recordings": {"path": path}}))
-    return rc, pr._prepared_sessions(rc)[0]
+    return rc, ps.prepared_sessions(rc)[0]
 
 
 def _decoded(prepared, dec, calibration=None):
     """``(session data, heading, sun azimuth in the device frame, errors)`` per session, through ``calibration``."""
-    from bionav.experiments import pol_recordings as pr
+    from bionav.experiments import pol_recordings_session as ps
     from bionav.polcompass.decoders import heading_from_sun
 
     out = []
     for d in prepared:
-        d = pr.calibrated(d, calibration, ["angles"])
+        d = ps.calibrated(d, calibration, ["angles"])
         est = dec.decode(d.evectors, d.valid, array=d.array, sun_elevation=float(d.sun.elevation))
         heading = heading_from_sun(est.azimuth, d.sun.azimuth)
-        out.append((d, heading, est.azimuth, pr.session_errors(heading, d.yaw)[0]))
+        out.append((d, heading, est.azimuth, ps.session_errors(heading, d.yaw)[0]))
     return out
 
 
@@ -61,7 +62,7 @@ def _learn(decoded, n_harmonics: int, form: str, *, leave_out_day=None):
 def main(argv=None) -> int:
     from bionav import registry
     from bionav.bench._cli import BenchParser, bounded_int
-    from bionav.experiments import pol_recordings as pr
+    from bionav.experiments import pol_recordings_session as ps
     from bionav.polcompass.deviation import corrected_heading
 
     parser = BenchParser(prog="python -m bionav.bench.decoders.deviation",
@@ -78,19 +79,19 @@ def main(argv=None) -> int:
     rc, prepared = _prepared(args.recordings)
     cls = registry.load_plugin("decoder", args.decoder)
     dec = cls(cls.Config())
-    estimates = pr.self_calibrate(prepared, rc) if args.calibration == "auto" else {}
+    estimates = ps.self_calibrate(prepared, rc) if args.calibration == "auto" else {}
     days = sorted({d.session.day for d in prepared})
     before = {g: [] for g in GROUPS}
     after = {g: [] for g in GROUPS}
     uncalibrated = _decoded(prepared, dec)
     for day in days:  # the day's array calibration (auto: of the other days) on every session, the curve of the others
-        decoded = _decoded(prepared, dec, pr.leave_one_day_out(estimates, day)[0]) if estimates else uncalibrated
+        decoded = _decoded(prepared, dec, ps.leave_one_day_out(estimates, day)[0]) if estimates else uncalibrated
         curve = _learn(decoded, args.harmonics, args.form, leave_out_day=day)
         for d, heading, phi, err in decoded:
             if d.session.day == day:
                 before[d.period].append(err)
                 fixed = corrected_heading(heading, phi, curve, scale=_scale(d, args.form))
-                after[d.period].append(pr.session_errors(fixed, d.yaw)[0])
+                after[d.period].append(ps.session_errors(fixed, d.yaw)[0])
     for g in GROUPS:
         if before[g]:
             print(json.dumps({"condition": g, "decoder": args.decoder, "harmonics": args.harmonics, "form": args.form,

@@ -196,7 +196,7 @@ class PolRecordingsConfig:
         like the real ones (covers 0 / 0.02 / 0.05 / 0.1: 3.65 / 3.47 / 3.59 / 4.15 against 2.87 real). ``sim_repeats``: each
         session is simulated that many times (each its own device and cloud draw), errors pooled.
     sim_view_sigma : each photodiode's own smooth departure from the shared sky ring (log counts, world frame;
-        ``pol_recordings.view_field``); 0.1 is *fitted* on the counts, not on heading errors: the self-calibration's
+        ``pol_recordings_session.view_field``); 0.1 is *fitted* on the counts, not on heading errors: the self-calibration's
         ring residual of the 18 daylight sessions has a median of 0.087 (0.081-0.101 leaving one day out), and the
         simulation's residual is about 0.9 ``sim_view_sigma``. ``sim_tilt_sigma_deg``, ``sim_azimuth_sigma_deg``:
         unit pointing tolerances (0: tilts up to 6 degrees gave ring residuals of 0.01-0.08 only).

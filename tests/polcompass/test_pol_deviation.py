@@ -56,6 +56,7 @@ def test_deviation_bench_learns_on_the_other_day(tmp_path):
     from omegaconf import OmegaConf
 
     from bionav.experiments import pol_recordings as pr
+    from bionav.experiments import pol_recordings_session as ps
     from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
     from bionav.polcompass.decoders import heading_from_sun
 
@@ -71,19 +72,19 @@ def test_deviation_bench_learns_on_the_other_day(tmp_path):
     assert daylight["condition"] == "tod_daylight" and len(lines) == 2
     # the same numbers in-process: each session corrected with the curve of the *other* day's session
     rc = pr.recordings_config(OmegaConf.create({"recordings": {"path": str(tmp_path / "rec")}}))
-    prepared, _ = pr._prepared_sessions(rc)
+    prepared, _ = ps.prepared_sessions(rc)
     dec = SkyFit(SkyFitConfig())
     out = []
     for d in prepared:
         phi = dec.decode(d.evectors, d.valid, array=d.array, sun_elevation=float(d.sun.elevation)).azimuth
         heading = heading_from_sun(phi, d.sun.azimuth)
-        out.append((heading, phi, pr.session_errors(heading, d.yaw)[0], d.yaw))
+        out.append((heading, phi, ps.session_errors(heading, d.yaw)[0], d.yaw))
     before = np.concatenate([o[2] for o in out])
     after = []
     for i, (heading, phi, _err, yaw) in enumerate(out):
         other = out[1 - i]
         curve = deviation_from_errors(other[1], other[2], n_harmonics=1)
-        after.append(pr.session_errors(corrected_heading(heading, phi, curve), yaw)[0])
+        after.append(ps.session_errors(corrected_heading(heading, phi, curve), yaw)[0])
     assert daylight["n_samples"] == before.size
     assert daylight["mae_deg"] == pytest.approx(np.degrees(np.mean(np.abs(before))), abs=1e-3)
     assert daylight["mae_deviation_removed_deg"] == pytest.approx(np.degrees(np.mean(np.abs(np.concatenate(after)))),
@@ -139,6 +140,7 @@ def test_pol_recordings_learns_a_mount_tilt_from_the_other_days_and_removes_it(t
     from omegaconf import OmegaConf
 
     from bionav.experiments import pol_recordings as pr
+    from bionav.experiments import pol_recordings_session as ps
     from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
     from bionav.polcompass.decoders import SunEstimate
 
@@ -154,17 +156,17 @@ def test_pol_recordings_learns_a_mount_tilt_from_the_other_days_and_removes_it(t
     _rotation_files(tmp_path, "Thursday_12-05-22", "17-00__Thursday_12-05-22", "2022-05-12")
     _rotation_files(tmp_path, "Saturday_14-05-22", "10-00__Saturday_14-05-22", "2022-05-14")
     rc = pr.recordings_config(OmegaConf.create({"recordings": {"path": str(tmp_path), "calibration_parts": ["tilt"]}}))
-    prepared, bad = pr._prepared_sessions(rc)
+    prepared, bad = ps.prepared_sessions(rc)
     assert not bad and len(prepared) == 3
     dec = Tilted(SkyFitConfig())
     # learned on 12 May only (14 May left out), from the logged yaw: the tilt the decoder was given
-    tilt = pr.mount_tilt(prepared, rc, None, dec, leave_out_day="2022-05-14")
+    tilt = ps.mount_tilt(prepared, rc, None, dec, leave_out_day="2022-05-14")
     np.testing.assert_allclose(np.degrees(tilt), [1.5, -2.0], atol=0.1)
     held_out = next(d for d in prepared if d.session.day == "2022-05-14")
-    before = pr.session_errors(pr.decode_session(dec, held_out)[0], held_out.yaw)[0]
-    after = pr.session_errors(pr.decode_session(dec, held_out, tilt)[0], held_out.yaw)[0]
+    before = ps.session_errors(ps.decode_session(dec, held_out)[0], held_out.yaw)[0]
+    after = ps.session_errors(ps.decode_session(dec, held_out, tilt)[0], held_out.yaw)[0]
     assert np.degrees(np.mean(np.abs(before))) > 1.0 > 10 * np.degrees(np.mean(np.abs(after)))
-    assert pr.mount_tilt(prepared, rc, None, dec, leave_out_day="2022-05-12") is not None
+    assert ps.mount_tilt(prepared, rc, None, dec, leave_out_day="2022-05-12") is not None
 
 
 def test_a_calibration_file_keeps_its_mount_tilt_and_old_files_have_none(tmp_path):
