@@ -61,7 +61,7 @@ class PolCompassSerial(SerialDeviceMixin, SensorPlugin):
 
     def __init__(self, config: PolCompassSerialConfig) -> None:
         super().__init__(config)
-        lines = list(config.lines)  # 1..8, declared on PolCompassSerialConfig.lines
+        lines = config.lines  # 1..8, declared on PolCompassSerialConfig.lines
         self.lines = lines
         self._link = None
         self.calibration = None
