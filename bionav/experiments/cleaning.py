@@ -76,19 +76,15 @@ class CleaningWorld:
 
 
 def plan_from_layout(node: Any) -> LanePlan:
-    """A :class:`LanePlan` from a ``layout`` config node (``bionav/conf/layout/*.yaml``)."""
-    try:
-        return LanePlan(
-            n_lanes=int(node.n_lanes),
-            lane_length=float(node.lane_length),
-            spacing=float(node.spacing),
-            turn=str(node.turn),
-            wall_offset=float(node.wall_offset),
-            unit_width=float(node.get("unit_width", node.spacing)),
-        )
-    except (ValueError, TypeError, AttributeError) as exc:
-        raise UserError(f"bad layout settings: {exc}. Choose layout=long_lanes or layout=short_lanes, or fix "
-                        f"the layout.* overrides.") from None
+    """A :class:`LanePlan` from a ``layout`` config node (``bionav/conf/layout/*.yaml``), typed and checked
+    as :class:`~bionav.experiments.configs.LayoutConfig` (:func:`bionav.validation.typed_config`)."""
+    from bionav.experiments.configs import LayoutConfig
+    from bionav.validation import typed_config
+
+    name = node.get("name", "?") if hasattr(node, "get") else "?"
+    layout = typed_config(node, LayoutConfig, key="layout", what=f"layout={name}")
+    return LanePlan(n_lanes=layout.n_lanes, lane_length=layout.lane_length, spacing=layout.spacing,
+                    turn=layout.turn, wall_offset=layout.wall_offset, unit_width=layout.unit_width)
 
 
 # ---------------------------------------------------------------------------- worlds
@@ -429,7 +425,7 @@ def replay_log(path, *, runs: list[int] | None = None) -> dict[int, Any]:
     if raw is None:
         raise UserError(f"{path} has no attached config.yaml; it was not written by `python -m bionav`.")
     cfg = OmegaConf.create(raw.decode())
-    if str(cfg.experiment.name) != "cleaning":
+    if cfg.experiment.name != "cleaning":
         raise UserError(f"{path} is a log of experiment={cfg.experiment.name}, not of experiment=cleaning.")
     plan = plan_from_layout(cfg.layout)
     logged = load_logged_runs(read_messages(path))

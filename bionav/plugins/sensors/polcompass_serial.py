@@ -61,10 +61,7 @@ class PolCompassSerial(SerialDeviceMixin, SensorPlugin):
 
     def __init__(self, config: PolCompassSerialConfig) -> None:
         super().__init__(config)
-        lines = [int(v) for v in config.lines]
-        bad = [v for v in lines if not 1 <= v <= 8]
-        if bad or not lines:
-            raise UserError(f"sensor.lines={lines} must list DLP-IO8-G analog lines between 1 and 8, e.g. sensor.lines=[1,2,3].")
+        lines = config.lines  # 1..8, declared on PolCompassSerialConfig.lines
         self.lines = lines
         self._link = None
         self.calibration = None

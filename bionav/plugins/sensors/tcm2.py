@@ -18,7 +18,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from bionav.errors import UserError
 from bionav.plugins.sensors.base import SensorPlugin, SerialDeviceMixin
 from bionav.validation import bounded
 
@@ -59,8 +58,6 @@ class TCM2(SerialDeviceMixin, SensorPlugin):
 
     def __init__(self, config: TCM2Config) -> None:
         super().__init__(config)
-        if config.output not in ("standard", "nmea", "keep"):
-            raise UserError(f"sensor.output={config.output!r} is not a TCM2 output format; choose standard, nmea or keep.")
         self._link = None
 
     def _init_device(self) -> None:
