@@ -2,7 +2,7 @@
 
 A *simple, replaceable default*: the outdoor world builder accepts any sky
 callable and any table of per-band albedos (default
-:data:`bionav.light.materials.BAND_ALBEDO`), so the physically based sky of
+:func:`bionav.light.materials.band_albedos`), so the physically based sky of
 :mod:`bionav.light.daylight` and measured reflectances can be plugged in.
 
 Band names follow the thesis' five-channel sensor (chapter 6): ``UV`` (350
