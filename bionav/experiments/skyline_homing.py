@@ -45,7 +45,7 @@ def _conditions(exp):
 
 def render_condition_counts(scene, geometry, world_positions, *, sensor_model, rng, progress=None):
     """Five-channel counts ``(N, H, W, 5)`` and true sky masks ``(N, H, W)`` at world positions."""
-    from bionav.spectral.scene import render_spectral_panorama
+    from bionav.world.worlds.garden import render_spectral_panorama
 
     counts, skies = [], []
     it = world_positions if progress is None else progress(world_positions, desc="render", total=len(world_positions))
@@ -201,7 +201,7 @@ def _render_conditions(exp, ctx, conditions, world_name, geometry, positions, gr
     four positions, metres, when ``square_pos`` is given)."""
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
-    from bionav.spectral.scene import garden_scene
+    from bionav.world.worlds.garden import garden_scene
 
     nx, ny = grid_shape
     seed = int(exp.world_seed)
