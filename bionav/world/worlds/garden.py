@@ -33,8 +33,9 @@ from bionav.world.spectral_shading import spectral_radiance, trace_surfaces
 
 #: Materials lit by the sun in flecks (foliage).
 FOLIAGE = ("shrub", "tree", "conifer")
-#: Segments of the distant tree line (one per degree of azimuth around the scene's origin).
-TREE_LINE_SEGMENTS = 360
+#: Segments of the distant tree line (four per degree of azimuth around the scene's origin): its inner faces
+#: lie within 0.5 mm of the circle and turn by 0.25 deg from one to the next.
+TREE_LINE_SEGMENTS = 1440
 #: Half the side of the ground square (m); the tree line, 120-150 m away, hides its edge.
 GROUND_HALF_M = 400.0
 #: Height (m) of the slab of a ground patch above the one before it (patches are slabs on the ground).
