@@ -269,13 +269,16 @@ def depth_kernel(ox, oy, oz, az, el, pix_angle, prim_kind, prim_idx, spheres, bo
 
 
 @njit(cache=True, parallel=True)
-def surface_kernel(ox, oy, oz, az, dirs, boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
+def surface_kernel(ox, oy, oz, az, dirs, n_bins, boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
                    prim_kind, prim_idx, spheres, shadow_grids, shadow_starts, shadow_items, light_params, light,
                    depth, point, normal, mat, lit):
     """Nearest surface along each ray of a list, and whether a light reaches it (for shading outside numba).
 
     Rays ``dirs`` (N, 3) (unit, world frame) start at ``(ox, oy, oz)``;
-    ``az`` (N,) are their azimuths (``atan2(dy, dx)``). Writes ``depth`` (N,)
+    ``az`` (N,) are their azimuths (``atan2(dy, dx)``, radians). The
+    candidate primitives are listed per azimuth bin (``n_bins`` bins over the
+    full circle, each list widened by half a bin), so the lists cost
+    ``n_bins`` rows whatever the number of rays. Writes ``depth`` (N,)
     hit distance in metres (inf for misses), ``point`` (N, 3) the hit,
     ``normal`` (N, 3) the unit normal facing the ray, ``mat`` (N,) the material
     index (-1 for misses) and ``lit`` (N,) 1.0 where nothing casts a shadow
@@ -283,14 +286,17 @@ def surface_kernel(ox, oy, oz, az, dirs, boxes, box_mats, frusta, frustum_mats, 
     index into ``light_params``; -1: every hit is lit), else 0.0.
     """
     N = dirs.shape[0]
-    cands, counts, el_lo, el_hi, rho_min = _candidates(ox, oy, oz, az, 1e-9, prim_kind, prim_idx,
-                                                       boxes, frusta, ells)
+    width = 2.0 * math.pi / n_bins
+    centres = (np.arange(n_bins) + 0.5) * width
+    cands, counts, el_lo, el_hi, rho_min = _candidates(ox, oy, oz, centres, 0.5 * width + 1e-9, prim_kind,
+                                                       prim_idx, boxes, frusta, ells)
     for n in prange(N):  # rays are independent: the result does not depend on the number of threads
         dx = dirs[n, 0]
         dy = dirs[n, 1]
         dz = dirs[n, 2]
         el = math.asin(min(1.0, max(-1.0, dz)))
-        t, kind, idx, face = _trace(ox, oy, oz, dx, dy, dz, el, cands, n, counts[n], el_lo, el_hi,
+        b = min(int((az[n] % (2.0 * math.pi)) / width), n_bins - 1)
+        t, kind, idx, face = _trace(ox, oy, oz, dx, dy, dz, el, cands, b, counts[b], el_lo, el_hi,
                                     rho_min, prim_kind, prim_idx, boxes, frusta, ells)
         if kind < 0:
             depth[n] = np.inf

@@ -27,13 +27,17 @@ from bionav.geometry import direction_from_angles
 from bionav.light.bands import PEAK_NM, band_integrate
 from bionav.light.daylight import Illumination, SkyState, aerosol_optical_depth, band_sky_radiance, rayleigh_optical_depth
 from bionav.world.kernels import surface_kernel
+from bionav.world.render import _run_threads
 from bionav.world.scene import CompiledScene, Scene
 
 #: Grey albedo of the ground that lights surfaces tilted towards it.
 GROUND_ALBEDO = 0.15
+#: Azimuth bins of the candidate lists of :func:`trace_surfaces` (one per degree).
+AZIMUTH_BINS = 360
 
 
-def trace_surfaces(scene: Scene | CompiledScene, origin, directions, *, light: int = -1) -> dict:
+def trace_surfaces(scene: Scene | CompiledScene, origin, directions, *, light: int = -1,
+                   threads: int | None = 1) -> dict:
     """The nearest surface along each ray, and whether a light reaches it.
 
     Parameters
@@ -46,6 +50,10 @@ def trace_surfaces(scene: Scene | CompiledScene, origin, directions, *, light: i
     light : int
         Index of the light (in ``scene.lights``) whose hard shadows to trace;
         -1: none (every hit counts as lit).
+    threads : int or None
+        Threads of the ray-parallel kernel (``None``: numba's default); one by
+        default, as :func:`bionav.world.render.render_panorama`. Results are
+        identical for any number of threads.
 
     Returns
     -------
@@ -61,10 +69,10 @@ def trace_surfaces(scene: Scene | CompiledScene, origin, directions, *, light: i
     out = {"depth": np.empty(n), "point": np.empty((n, 3)), "normal": np.empty((n, 3)),
            "material": np.empty(n, np.int64), "lit": np.empty(n)}
     ox, oy, oz = (float(v) for v in origin)
-    surface_kernel(ox, oy, oz, az, d, cs.boxes, cs.box_mats, cs.frusta, cs.frustum_mats, cs.ellipsoids,
-                   cs.ellipsoid_mats, cs.prim_kind, cs.prim_idx, cs.spheres, cs.shadow_grids, cs.shadow_starts,
-                   cs.shadow_items, cs.light_params, int(light), out["depth"], out["point"], out["normal"],
-                   out["material"], out["lit"])
+    _run_threads(threads, surface_kernel, ox, oy, oz, az, d, AZIMUTH_BINS, cs.boxes, cs.box_mats, cs.frusta,
+                 cs.frustum_mats, cs.ellipsoids, cs.ellipsoid_mats, cs.prim_kind, cs.prim_idx, cs.spheres,
+                 cs.shadow_grids, cs.shadow_starts, cs.shadow_items, cs.light_params, int(light), out["depth"],
+                 out["point"], out["normal"], out["material"], out["lit"])
     return out
 
 
