@@ -95,7 +95,8 @@ class CaptureLight:
         return {"model": "capture-light-2", "start_utc": self.start_utc, "site_deg": list(self.site_deg),
                 "seconds_per_capture": float(self.seconds_per_capture), "cloud_cover": float(c.cover),
                 "cloud_optical_depth": float(c.optical_depth), "cloud_height_m": float(c.height_m),
-                "cloud_scale_m": float(c.scale_m), "wind_mps": [float(v) for v in c.wind_mps],
+                "cloud_scale_m": float(c.scale_m), "cloud_softness": float(c.softness),
+                "cloud_resolution": float(c.resolution), "wind_mps": [float(v) for v in c.wind_mps],
                 "cloud_brightness": float(c.brightness), "cloud_seed": int(c.seed), "seed": int(self.seed)}
 
     def time_s(self, i: int, j: int) -> float:

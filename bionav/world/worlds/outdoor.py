@@ -49,8 +49,13 @@ CAPTURE_START_UTC = "2006-03-06T10:50:00"
 SECONDS_PER_CAPTURE = 30.0
 #: Fraction of the sky covered by (fair-weather cumulus) clouds.
 CLOUD_COVER = 0.4
-#: Cloud base height (m) and horizontal scale (m) of the cloud layer (:class:`~bionav.light.clouds.CloudLayer`).
-CLOUD_HEIGHT_M, CLOUD_SCALE_M = 1500.0, 1200.0
+#: Cloud base height (m) and horizontal scale (m) of the cloud layer (:class:`~bionav.light.clouds.CloudLayer`:
+#: waves of 300-1200 m wavelength, fair-weather cumulus a few hundred metres across).
+CLOUD_HEIGHT_M, CLOUD_SCALE_M = 1500.0, 600.0
+#: Cloud edge width (standard deviations of the field) and the angular resolution (degrees) at which the
+#: layer is seen: sharper than the sun's disk (0.53 deg), so a cloud covers the sun fully or not at all
+#: but for its edge.
+CLOUD_SOFTNESS, CLOUD_RESOLUTION_DEG = 0.2, 0.1
 #: Wind at the cloud base (east, north) in m/s: 8 m/s from the west (the prevailing westerlies).
 WIND_MPS = (8.0, 0.0)
 #: Radiance of a cloud relative to the clear sky's horizon value (sunlit cumulus are brighter than blue sky).
@@ -89,7 +94,8 @@ def uni_capture_light(cells: np.ndarray, seed: int) -> CaptureLight:
         The world's seed (the cloud layer's and the sky's).
     """
     clouds = CloudLayer(cover=CLOUD_COVER, optical_depth=CLOUD_OPTICAL_DEPTH, seed=int(seed), height_m=CLOUD_HEIGHT_M,
-                        scale_m=CLOUD_SCALE_M, wind_mps=WIND_MPS, brightness=CLOUD_RADIANCE)
+                        scale_m=CLOUD_SCALE_M, wind_mps=WIND_MPS, softness=CLOUD_SOFTNESS,
+                        resolution=float(np.deg2rad(CLOUD_RESOLUTION_DEG)), brightness=CLOUD_RADIANCE)
     return CaptureLight(order=capture_order(cells), clouds=clouds, site_deg=SITE_DEG, start_utc=CAPTURE_START_UTC,
                         seconds_per_capture=SECONDS_PER_CAPTURE, seed=int(seed))
 
