@@ -128,6 +128,10 @@ def _examples():
                                   z(1, dtype=i64), z(1, dtype=i64), z(1, dtype=i64), z(1, 4), z(1, 6), i2, i2,
                                   z(1, dtype=i64), z(1), z(1, 2), z(1, 3), z(1, 3), z(16, dtype=f32), 4, z(1, 6),
                                   z(1, 3), z(3), z(3), True, z(4, 4, 3), z(4, 4), z(4, 4, dtype=np.bool_)))
+    ex["world_surface_kernel"] = (world.surface_kernel,
+                                  (0.0, 0.0, 0.0, z(4), z(4, 3), 360, z(1, 10), i2, z(1, 7), z(1, 3, dtype=i64),
+                                   z(1, 7), z(1, dtype=i64), z(1, dtype=i64), z(1, dtype=i64), z(1, 4), z(1, 6), i2,
+                                   i2, z(1, 6), 0, z(4), z(4, 3), z(4, 3), z(4, dtype=i64), z(4)))
     # cleaning-robot coverage and the return agent (the parameter sweep's batch)
     ex["coverage_sweep"] = (coverage._sweep_kernel, (z(4, 4), 0.0, 0.0, 1.0, 4, 4))
     ex["agent_success"] = (agent._agent_success_kernel,

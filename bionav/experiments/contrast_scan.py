@@ -85,7 +85,7 @@ def run(cfg, ctx) -> dict:
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
     from bionav.spectral.scan import ScanGrid, run_scan
-    from bionav.spectral.scene import backyard_scene
+    from bionav.world.worlds.garden import backyard_scene
 
     exp = experiment_config(cfg, "contrast_scan")
     times = [parse_time(str(t), what="experiment.times entry", naive_utc=False) for t in exp.times]

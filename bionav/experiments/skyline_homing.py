@@ -45,7 +45,7 @@ def _conditions(exp):
 
 def render_condition_counts(scene, geometry, world_positions, *, sensor_model, rng, progress=None):
     """Five-channel counts ``(N, H, W, 5)`` and true sky masks ``(N, H, W)`` at world positions."""
-    from bionav.spectral.scene import render_spectral_panorama
+    from bionav.world.worlds.garden import render_spectral_panorama
 
     counts, skies = [], []
     it = world_positions if progress is None else progress(world_positions, desc="render", total=len(world_positions))
@@ -56,19 +56,12 @@ def render_condition_counts(scene, geometry, world_positions, *, sensor_model, r
     return np.stack(counts), np.stack(skies)
 
 
-#: bionav.spectral material used for each material kind of the campus world (bionav.world.worlds.outdoor).
-CAMPUS_MATERIALS = {
-    "concrete": "concrete", "brick": "brick", "glass": "glass", "foliage": "tree", "bark": "dead_wood",
-    "grass": "grass", "paving": "concrete", "asphalt": "tar", "metal": "metal_bare", "paint": "lacquered_metal",
-    "wood": "dead_wood", "soil": "soil",
-}
-
-
 def campus_world(sky, *, seed: int):
     """The outdoor campus of :mod:`bionav.world.worlds.outdoor` in five bands under a spectral sky.
 
-    Per-kind albedos come from :data:`bionav.light.materials.MATERIALS` (via
-    :data:`CAMPUS_MATERIALS`), the sun and the hemispherical ambient light from
+    Per-kind albedos are the campus' default five-band albedos
+    (:func:`bionav.light.materials.band_albedos`: the reflectances of the
+    kinds' materials), the sun and the hemispherical ambient light from
     :func:`bionav.light.daylight.illumination` (``E/pi``, so that pixel values are
     band radiances in the unit of the sensor model), rays that hit nothing from
     :func:`bionav.light.daylight.band_sky_radiance`.
@@ -80,13 +73,10 @@ def campus_world(sky, *, seed: int):
                         "which this installation lacks; use experiment.world=garden.") from None
     from bionav.light.bands import CHANNELS, band_integrate
     from bionav.light.daylight import band_sky_radiance, illumination
-    from bionav.light.materials import MATERIALS
-
     ill = illumination(sky)
     e_dir = band_integrate(ill.direct_normal) / np.pi
     e_dif = band_integrate(ill.diffuse_horizontal) / np.pi
-    albedos = {k: np.asarray(MATERIALS[m].reflectance) for k, m in CAMPUS_MATERIALS.items()}
-    world = build_campus(seed, channels=CHANNELS, albedos=albedos, sky=lambda d: band_sky_radiance(sky, d),
+    world = build_campus(seed, channels=CHANNELS, sky=lambda d: band_sky_radiance(sky, d),
                          sun_elevation=float(sky.sun_elevation), sun_azimuth=float(sky.sun_azimuth),
                          sun_irradiance=e_dir, sky_irradiance=e_dif, exposure=1.0)
     return world
@@ -209,7 +199,7 @@ def _render_conditions(exp, ctx, conditions, world_name, geometry, positions, gr
     four positions, metres, when ``square_pos`` is given)."""
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState
-    from bionav.spectral.scene import garden_scene
+    from bionav.world.worlds.garden import garden_scene
 
     nx, ny = grid_shape
     seed = exp.world_seed

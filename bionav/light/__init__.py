@@ -9,9 +9,11 @@ Modules
   polarization for the polarized-light compass (thesis chapter 4; Lambrinos
   et al. 2000, doi:10.1016/S0921-8890(99)00064-0; Berry et al. 2004,
   doi:10.1088/1367-2630/6/1/162).
-* :mod:`~bionav.light.clouds` -- :class:`CloudMap` (cloudiness on the sky
-  hemisphere, chapter 4) and :class:`CloudLayer` (a drifting cloud layer of
-  given optical depth, chapter 6).
+* :mod:`~bionav.light.clouds` -- :class:`CloudLayer` (the one drifting cloud
+  layer: cover, optical depth, direct-sun transmittance, polarization) and
+  :class:`CloudMap` (the compass recordings' sampled sky map, chapter 4).
+* :mod:`~bionav.light.capture` -- :class:`~bionav.light.capture.CaptureLight`,
+  the light at each image of a capture that took a while (sun, clouds, sky).
 * :mod:`~bionav.light.daylight` -- spectral sun, sky and cloud radiance and
   the irradiance they give on the ground (chapter 6).
 * :mod:`~bionav.light.measured_spectra` -- the measured spectra shipped in

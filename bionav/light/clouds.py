@@ -1,11 +1,17 @@
-"""Clouds, in two models for two uses.
+"""Clouds: the one cloud layer, and the compass' sampled sky map.
 
-* :class:`CloudMap` (polarized-light compass, thesis chapter 4): cloudiness
-  and e-vector noise on a map of the sky hemisphere, drawn by
-  :func:`random_cloud_map`.
-* :class:`CloudLayer` (spectral daylight, thesis chapter 6): optical depth of a
-  drifting cloud layer at a given height, seen along any line of sight
-  (parallax, wind, anti-aliasing), used by :mod:`bionav.light.daylight`.
+* :class:`CloudLayer`: a drifting cloud layer at a given height, seen along
+  any line of sight (parallax, wind, anti-aliasing). Its views: the cover
+  (:meth:`CloudLayer.density_at`), the optical depth and the direct-sun
+  transmittance (:meth:`CloudLayer.transmittance_at`; spectral daylight of
+  :mod:`bionav.light.daylight`, the uni capture light of
+  :mod:`bionav.light.capture`) and the polarization (cloudiness, e-vector
+  noise; :class:`~bionav.light.polarized_sky.SkyModel` takes a layer as its
+  ``clouds``).
+* :class:`CloudMap` (polarized-light compass recordings, thesis chapter 4):
+  cloudiness and e-vector noise sampled on a map of the sky hemisphere, drawn
+  from a ``Generator`` by :func:`random_cloud_map` (a snapshot without height
+  or wind; the compass experiments' draws and numbers depend on it).
 
 Cloud map
 ---------
@@ -171,6 +177,23 @@ class CloudLayer:
         Angular resolution (radians) of a line of sight; cloud detail finer than
         its footprint on the layer is averaged (no aliasing near the horizon,
         where distant clouds merge into a uniform cover).
+    brightness : float
+        Radiance of full cloud relative to the clear sky's reference radiance
+        (the clear zenith of :class:`~bionav.light.polarized_sky.SkyModel`, the
+        clear horizon of :class:`~bionav.light.simple_sky.SimpleSky`); the
+        spectral daylight of :mod:`bionav.light.daylight` computes the cloud's
+        radiance from ``optical_depth`` instead.
+    depolarization : float
+        Fraction by which full cloud lowers the sky's degree of polarization.
+    angle_noise_sigma : float
+        E-vector angle noise (radians, one standard deviation) under full cloud.
+
+    Notes
+    -----
+    One layer, three views: :meth:`density_at` (cover),
+    :meth:`transmittance_at` (shade of the direct sun) and
+    :meth:`cloudiness_at` / :meth:`angle_noise_at` (polarization). Frame:
+    east-north-up; the field drifts with ``wind_mps`` (frozen turbulence).
     """
 
     cover: float = 0.0
@@ -182,18 +205,15 @@ class CloudLayer:
     softness: float = 0.15
     n_waves: int = 24
     resolution: float = float(np.deg2rad(1.0))
+    brightness: float = 1.5
+    depolarization: float = 0.9
+    angle_noise_sigma: float = float(np.deg2rad(20.0))
 
     def _waves(self):
-        r = np.random.default_rng(self.seed)
-        ang = r.uniform(0, 2 * np.pi, self.n_waves)
-        k = 2 * np.pi / (self.scale_m * r.uniform(0.5, 2.0, self.n_waves))
-        kvec = np.c_[k * np.cos(ang), k * np.sin(ang)]
-        phase = r.uniform(0, 2 * np.pi, self.n_waves)
-        amp = r.uniform(0.5, 1.0, self.n_waves)
-        return kvec, phase, amp / np.sqrt(0.5 * np.sum(amp**2))
+        return _plane_waves(np.random.default_rng(self.seed), self.n_waves, self.scale_m)
 
-    def optical_depth_at(self, directions, *, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
-        """Cloud optical depth along each viewing direction.
+    def density_at(self, directions, *, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
+        """Cloud fraction of each line of sight's footprint on the layer (the *cover* view), in [0, 1].
 
         Parameters
         ----------
@@ -207,13 +227,16 @@ class CloudLayer:
         Returns
         -------
         ndarray, shape (...)
-            0 where the line of sight misses clouds (or looks below 2 degrees).
+            Probability that the footprint is cloud: 0 where the line of sight
+            misses clouds, 1 inside a cloud; anti-aliased (distant, oblique
+            footprints average many clouds and tend to ``cover``). Lines of
+            sight below 1 degree see the layer at 1 degree (the horizon's cover).
         """
         d = np.asarray(directions, dtype=float)
         if self.cover <= 0:
             return np.zeros(d.shape[:-1])
         if self.cover >= 1:
-            return np.full(d.shape[:-1], float(self.optical_depth))
+            return np.ones(d.shape[:-1])
         dz = np.maximum(d[..., 2], np.sin(np.deg2rad(1.0)))
         reach = self.height_m / dz
         px = origin_m[0] + d[..., 0] * reach - self.wind_mps[0] * time_s
@@ -228,5 +251,72 @@ class CloudLayer:
         lost = np.clip(1.0 - 0.5 * np.sum(a**2, axis=-1), 0.0, 1.0)  # variance no longer resolved
         thr = ndtri(1.0 - self.cover)
         # probability that the resolved field plus unresolved detail exceeds the threshold
-        density = ndtr((f - thr) / np.sqrt(self.softness**2 + lost))
-        return self.optical_depth * density
+        return ndtr((f - thr) / np.sqrt(self.softness**2 + lost))
+
+    def optical_depth_at(self, directions, *, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
+        """Cloud optical depth along each viewing direction: ``optical_depth * density_at(...)``, shape ``(...)``.
+
+        Arguments as :meth:`density_at`; 0 where the line of sight misses clouds.
+        """
+        return self.optical_depth * self.density_at(directions, time_s=time_s, origin_m=origin_m)
+
+    def transmittance_at(self, directions, *, air_mass, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
+        """Direct-beam transmittance of the layer along each direction (the *shade* view), shape ``(...)``.
+
+        A footprint of cloud fraction ``f`` (:meth:`density_at`) passes
+        ``(1 - f) + f exp(-tau m)``: the clear part unattenuated, the clouds'
+        part through their full optical depth ``tau`` along the air mass ``m``
+        (not through the footprint's mean depth, which would hide a low sun
+        behind a 10 % cover: ``1 - exp(-x)`` is concave).
+
+        Parameters
+        ----------
+        directions : array_like, shape (..., 3)
+            Unit directions towards the source (east-north-up), e.g. the sun.
+        air_mass : float or array_like, shape (...)
+            Relative air mass of the path (``1 / sin(elevation)`` for a plane
+            layer; :func:`bionav.light.daylight.relative_air_mass` near the horizon).
+        time_s, origin_m
+            As :meth:`density_at`.
+        """
+        f = self.density_at(directions, time_s=time_s, origin_m=origin_m)
+        return (1.0 - f) + f * np.exp(-float(self.optical_depth) * np.asarray(air_mass, dtype=float))
+
+    def cloudiness_at(self, view, *, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
+        """Cloudiness in ``[0, 1]`` at unit viewing directions ``(..., 3)`` (the *polarization* view).
+
+        The same field as :meth:`density_at`; with :attr:`depolarization` and
+        :attr:`angle_noise_sigma` it answers what :class:`~bionav.light.polarized_sky.SkyModel`
+        asks of its ``clouds``, so a layer that shades the sun also depolarizes the sky.
+        """
+        return self.density_at(view, time_s=time_s, origin_m=origin_m)
+
+    def angle_noise_at(self, view, *, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> np.ndarray:
+        """E-vector rotation (radians) at the viewing directions: cloudiness x ``angle_noise_sigma`` x field.
+
+        The field is a second, independent plane-wave field of the layer (seeded
+        from ``seed``), drifting with it, about standard normal.
+        """
+        d = np.asarray(view, dtype=float)
+        c = self.cloudiness_at(d, time_s=time_s, origin_m=origin_m)
+        dz = np.maximum(d[..., 2], np.sin(np.deg2rad(1.0)))
+        reach = self.height_m / dz
+        px = origin_m[0] + d[..., 0] * reach - self.wind_mps[0] * time_s
+        py = origin_m[1] + d[..., 1] * reach - self.wind_mps[1] * time_s
+        kvec, phase, amp = _plane_waves(np.random.default_rng([int(self.seed) & 0xFFFFFFFF, 1]), self.n_waves,
+                                        self.scale_m)
+        field = np.sum(amp * np.cos(px[..., None] * kvec[:, 0] + py[..., None] * kvec[:, 1] + phase), axis=-1)
+        return c * self.angle_noise_sigma * field
+
+
+def _plane_waves(r: np.random.Generator, n: int, scale_m: float):
+    """``n`` random plane waves of wavelength ``scale_m * U(0.5, 2)``: wave vectors (1/m), phases, amplitudes.
+
+    Amplitudes are normalised so that the sum of the waves has unit variance.
+    """
+    ang = r.uniform(0, 2 * np.pi, n)
+    k = 2 * np.pi / (scale_m * r.uniform(0.5, 2.0, n))
+    kvec = np.c_[k * np.cos(ang), k * np.sin(ang)]
+    phase = r.uniform(0, 2 * np.pi, n)
+    amp = r.uniform(0.5, 1.0, n)
+    return kvec, phase, amp / np.sqrt(0.5 * np.sum(amp**2))

@@ -381,10 +381,8 @@ def clear_sky_radiance(state: SkyState, directions, wavelengths_nm=WAVELENGTHS_N
 def cloud_fraction(state: SkyState, directions, *, origin_m=(0.0, 0.0)) -> np.ndarray:
     """Fraction of each line of sight's footprint on the cloud layer that is cloud, shape ``(...)``, in [0, 1].
 
-    :meth:`bionav.light.clouds.CloudLayer.optical_depth_at` returns the layer's
-    optical depth times the cloud density of the footprint (anti-aliased:
-    distant, oblique footprints average many clouds and tend to the cover
-    fraction); this is that density. Zero for a layer of zero optical depth.
+    :meth:`bionav.light.clouds.CloudLayer.density_at` of the state's layer at
+    its ``time_s``; zero for a layer of zero optical depth (no clouds to see).
 
     Parameters
     ----------
@@ -400,12 +398,10 @@ def cloud_fraction(state: SkyState, directions, *, origin_m=(0.0, 0.0)) -> np.nd
     ndarray, shape (...)
         Cloud fraction in [0, 1].
     """
-    depth = float(state.clouds.optical_depth)
     d = np.asarray(directions, dtype=float)
-    if state.clouds.cover <= 0 or depth <= 0:
+    if state.clouds.optical_depth <= 0:
         return np.zeros(d.shape[:-1])
-    tau = state.clouds.optical_depth_at(d, time_s=state.time_s, origin_m=origin_m)
-    return np.clip(tau / depth, 0.0, 1.0)
+    return state.clouds.density_at(d, time_s=state.time_s, origin_m=origin_m)
 
 
 def _cloud_transmittance(tau_c):
@@ -516,9 +512,8 @@ def illumination(state: SkyState, wavelengths_nm=WAVELENGTHS_NM, *, origin_m=(0.
     d_omega = np.cos(ee) * (np.pi / 2 / n_elevation) * (2 * np.pi / n_azimuth)
     weight = (np.sin(ee) * d_omega)[..., None]
     diffuse = np.sum(rad * weight, axis=(0, 1))
-    m_s = float(relative_air_mass(state.sun_elevation))
-    f_sun = float(cloud_fraction(state, state.sun_direction, origin_m=origin_m))
-    t_cloud = (1.0 - f_sun) + f_sun * np.exp(-float(state.clouds.optical_depth) * m_s)
+    t_cloud = float(state.clouds.transmittance_at(state.sun_direction, air_mass=relative_air_mass(state.sun_elevation),
+                                                  time_s=state.time_s, origin_m=origin_m))
     direct = solar_spectrum(wl) * _sun_transmittance(state, wl) * t_cloud
     return Illumination(direct, diffuse, state.sun_direction)
 

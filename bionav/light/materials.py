@@ -3,10 +3,9 @@
 * :data:`MATERIALS`: five-band reflectance spectra with sample-to-sample
   variability of natural and artificial materials (thesis chapter 6 sample
   sets and spectral scenes).
-* :data:`BAND_ALBEDO`: the coarse per-band albedos of the *rendered* outdoor
-  worlds (``sim_uni``), including a ``grey`` channel (see the end of this
-  module). They are kept as they are because every rendered stand-in
-  database's pixels depend on them.
+* :func:`band_albedos`: the per-band albedos of the *rendered* worlds' surface
+  kinds (:data:`RENDER_KINDS`): in the five bands the reflectances of
+  :data:`MATERIALS`, in a monochrome ``grey`` channel :data:`GREY_ALBEDO`.
 
 Spectral reflectances
 ---------------------
@@ -42,7 +41,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from bionav.light.bands import PEAK_NM, WAVELENGTHS_NM, band_integrate
+from bionav.light.bands import CHANNELS, PEAK_NM, WAVELENGTHS_NM, band_integrate
 
 
 @dataclass(frozen=True)
@@ -270,31 +269,46 @@ def mean_spectra_table() -> tuple[list[str], np.ndarray]:
     return names, np.array([MATERIALS[n].mean_spectrum() for n in names])
 
 
-#: Relative reflectance of material kinds, per band. Rough textbook shapes
-#: (vegetation: red edge and low UV; concrete/stone: flat and slightly rising;
-#: glass: low; sky-facing metal: flat). Assumption: UV reflectance of most
-#: terrestrial materials is low (0.03-0.1), which is what makes UV a good sky
-#: separator in the thesis.
-BAND_ALBEDO: dict[str, dict[str, float]] = {
-    "grey": {"concrete": 0.45, "brick": 0.3, "glass": 0.15, "foliage": 0.3, "bark": 0.25, "grass": 0.3,
-             "paving": 0.4, "asphalt": 0.15, "metal": 0.5, "paint": 0.6, "wood": 0.35, "soil": 0.2},
-    "UV": {"concrete": 0.08, "brick": 0.05, "glass": 0.06, "foliage": 0.03, "bark": 0.04, "grass": 0.03,
-           "paving": 0.07, "asphalt": 0.04, "metal": 0.2, "paint": 0.1, "wood": 0.04, "soil": 0.04},
-    "B": {"concrete": 0.25, "brick": 0.12, "glass": 0.1, "foliage": 0.05, "bark": 0.08, "grass": 0.05,
-          "paving": 0.22, "asphalt": 0.08, "metal": 0.4, "paint": 0.5, "wood": 0.12, "soil": 0.08},
-    "G": {"concrete": 0.3, "brick": 0.18, "glass": 0.12, "foliage": 0.14, "bark": 0.12, "grass": 0.15,
-          "paving": 0.27, "asphalt": 0.09, "metal": 0.45, "paint": 0.55, "wood": 0.2, "soil": 0.12},
-    "R": {"concrete": 0.36, "brick": 0.38, "glass": 0.12, "foliage": 0.06, "bark": 0.2, "grass": 0.07,
-          "paving": 0.32, "asphalt": 0.1, "metal": 0.45, "paint": 0.6, "wood": 0.35, "soil": 0.2},
-    "IR": {"concrete": 0.42, "brick": 0.45, "glass": 0.12, "foliage": 0.5, "bark": 0.35, "grass": 0.45,
-           "paving": 0.38, "asphalt": 0.12, "metal": 0.45, "paint": 0.6, "wood": 0.45, "soil": 0.28},
+#: The material of :data:`MATERIALS` that each surface kind of the rendered worlds is made of
+#: (the ``kind`` of a :class:`bionav.world.scene.RenderMaterial`, e.g. the campus of
+#: :mod:`bionav.world.worlds.outdoor`): the five-band albedos of a rendered world are these
+#: materials' reflectances.
+RENDER_KINDS: dict[str, str] = {
+    "concrete": "concrete", "brick": "brick", "glass": "glass", "foliage": "tree", "bark": "dead_wood",
+    "grass": "grass", "paving": "concrete", "asphalt": "tar", "metal": "metal_bare", "paint": "lacquered_metal",
+    "wood": "dead_wood", "soil": "soil",
+}
+
+#: Albedo of each surface kind for a monochrome (``grey``) camera (the grey campus of the *uni* stand-in,
+#: ``sim_uni``): rough textbook values, not derived from the spectra (the grey camera's band is none of the
+#: five channels); kept as they are because every rendered sim_uni pixel depends on them.
+GREY_ALBEDO: dict[str, float] = {
+    "concrete": 0.45, "brick": 0.3, "glass": 0.15, "foliage": 0.3, "bark": 0.25, "grass": 0.3, "paving": 0.4,
+    "asphalt": 0.15, "metal": 0.5, "paint": 0.6, "wood": 0.35, "soil": 0.2,
 }
 
 
 def band_albedos(channels: tuple[str, ...]) -> dict[str, np.ndarray]:
-    """Albedo per material kind as arrays of shape ``(C,)`` for the given band names."""
-    unknown = [c for c in channels if c not in BAND_ALBEDO]
+    """Albedo of every surface kind of the rendered worlds, per band.
+
+    Parameters
+    ----------
+    channels : tuple of str
+        Band names: ``UV``, ``B``, ``G``, ``R``, ``IR`` (the five sensor
+        channels, :data:`~bionav.light.bands.CHANNELS`) or ``grey``.
+
+    Returns
+    -------
+    dict
+        Kind (:data:`RENDER_KINDS`) -> albedo, shape ``(C,)``: in the five
+        bands the band reflectance of the kind's material (``Material.reflectance``:
+        channel means of the measured spectra, or the five-band table);
+        in ``grey`` :data:`GREY_ALBEDO`.
+    """
+    unknown = [c for c in channels if c != "grey" and c not in CHANNELS]
     if unknown:
         raise ValueError(f"no default albedos for bands {unknown}; pass albedos explicitly")
-    kinds = BAND_ALBEDO["grey"].keys()
-    return {k: np.array([BAND_ALBEDO[c][k] for c in channels]) for k in kinds}
+    index = {c: i for i, c in enumerate(CHANNELS)}
+    return {kind: np.array([GREY_ALBEDO[kind] if c == "grey" else MATERIALS[name].reflectance[index[c]]
+                            for c in channels])
+            for kind, name in RENDER_KINDS.items()}

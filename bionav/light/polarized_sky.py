@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.geometry import direction_from_angles
-from bionav.light.clouds import CloudMap
+from bionav.light.clouds import CloudLayer, CloudMap
 from bionav.light.neutral_points import berry_polarization
 from bionav.light.radiance import cie_relative_radiance
 from bionav.light.rayleigh import perpendicular, rayleigh_polarization
@@ -56,14 +56,16 @@ class SkyModel:
     neutral_point_separation : float
         ``0`` selects the Rayleigh model; a positive angle (radians) the
         Berry et al. (2004) model with that Babinet-Brewster separation.
-    clouds : CloudMap or None
-        Optional clouds (lower the degree, add e-vector angle noise, brighten).
+    clouds : CloudLayer, CloudMap or None
+        Optional clouds (lower the degree, add e-vector angle noise, brighten):
+        a :class:`~bionav.light.clouds.CloudLayer` (its polarization view at
+        time 0) or a sampled :class:`~bionav.light.clouds.CloudMap`.
     """
 
     sun: SunPosition
     max_degree: float = 0.76
     neutral_point_separation: float = 0.0
-    clouds: CloudMap | None = None
+    clouds: CloudLayer | CloudMap | None = None
 
     def light(self, view) -> SkyLight:
         """Radiance, degree and e-vector for unit viewing directions ``(..., 3)``."""

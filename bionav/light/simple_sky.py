@@ -2,7 +2,7 @@
 
 A *simple, replaceable default*: the outdoor world builder accepts any sky
 callable and any table of per-band albedos (default
-:data:`bionav.light.materials.BAND_ALBEDO`), so the physically based sky of
+:func:`bionav.light.materials.band_albedos`), so the physically based sky of
 :mod:`bionav.light.daylight` and measured reflectances can be plugged in.
 
 Band names follow the thesis' five-channel sensor (chapter 6): ``UV`` (350
@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from bionav.light.clouds import CloudLayer
 
 #: Relative sky radiance per band (blue sky: strong at short wavelengths).
 SKY_GAIN = {"grey": 1.0, "UV": 1.4, "B": 1.3, "G": 1.0, "R": 0.6, "IR": 0.4}
@@ -29,7 +31,10 @@ class SimpleSky:
     ``radiance(d) = gain_c * (zenith + (horizon - zenith) * (1 - sin(el))**2
     + glow * exp(-angle_to_sun / 0.15)) * (1 - clouds * (...))``; below the
     horizon the sky is not visible (ground covers it) but returns the horizon
-    value.
+    value. Behind a cloud ``layer`` (:class:`~bionav.light.clouds.CloudLayer`)
+    the radiance is ``(1 - c) L(d) + c * layer.brightness * L(horizon)`` with
+    the layer's cloudiness ``c`` at ``time_s`` (sunlit cumulus are brighter
+    than the blue sky they hide).
 
     Parameters
     ----------
@@ -43,6 +48,11 @@ class SimpleSky:
         Cloud cover in [0, 1] (brightness modulation by a fixed noise field).
     seed : int
         Seed of the cloud pattern.
+    layer : CloudLayer, optional
+        A drifting cloud layer in front of the sky (e.g. the uni capture's,
+        :mod:`bionav.light.capture`); ``None``: none.
+    time_s : float
+        Seconds since the layer's epoch (its drift).
     """
 
     sun_direction: tuple[float, float, float]
@@ -52,9 +62,20 @@ class SimpleSky:
     glow: float = 1.2
     clouds: float = 0.3
     seed: int = 0
+    layer: CloudLayer | None = None
+    time_s: float = 0.0
 
     def __call__(self, directions: np.ndarray) -> np.ndarray:
         d = np.asarray(directions, float).reshape(-1, 3)
+        if self.layer is not None:
+            clear = self._clear(d)
+            horizon = self._clear(np.array([[1.0, 0.0, 0.0]]))  # (1, C)
+            c = self.layer.cloudiness_at(d, time_s=self.time_s)[:, None]
+            return (1.0 - c) * clear + c * (self.layer.brightness * horizon)
+        return self._clear(d)
+
+    def _clear(self, d: np.ndarray) -> np.ndarray:
+        """The sky without the layer, ``(N, C)`` for unit directions ``(N, 3)``."""
         el = np.arcsin(np.clip(d[:, 2], -1.0, 1.0))
         s = np.asarray(self.sun_direction, float)
         ang = np.arccos(np.clip(d @ s, -1.0, 1.0))

@@ -6,6 +6,7 @@ The light itself (channels, daylight, clouds, materials) lives in
 :mod:`~bionav.spectral.sensor_model` (log amplifier, ADC),
 :mod:`~bionav.spectral.samples` (simulated sample sets),
 :mod:`~bionav.spectral.csv_io` (CSV sample sets),
-:mod:`~bionav.spectral.protocol` (the ADuC812 serial line protocol),
-:mod:`~bionav.spectral.scene` (scanned outdoor scenes).
+:mod:`~bionav.spectral.protocol` (the ADuC812 serial line protocol).
+The scanned outdoor scenes (garden, backyard) are rendered worlds:
+:mod:`bionav.world.worlds.garden`.
 """

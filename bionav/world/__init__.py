@@ -11,7 +11,9 @@
 * World builders (:mod:`bionav.world.worlds`): the laboratory and its seven
   variants, the hall, the living rooms, the outdoor campus and the apartment
   of the cleaning-robot experiments; each returns a :class:`World` (scene plus
-  grid placement) generated from a seed.
+  grid placement) generated from a seed; the five-band garden and backyard of
+  the spectral experiments (:mod:`bionav.world.worlds.garden`), shaded under
+  spectral daylight by :mod:`bionav.world.spectral_shading`.
 """
 
 from bionav.world.render import RENDERER_VERSION, render_depth, render_panorama

@@ -80,6 +80,16 @@ def _surface(kind, idx, face, t, ox, oy, oz, dx, dy, dz, boxes, frusta, ells):
     return hx, hy, hz, nx, ny, nz, u, v, eu, ev
 
 
+@njit(cache=True, inline="always")
+def _material(kind, idx, face, box_mats, frustum_mats, ell_mats):
+    """Material index of face ``face`` of primitive ``idx`` of ``kind`` (0 box, 1 frustum, 2 ellipsoid)."""
+    if kind == 0:
+        return box_mats[idx, face]
+    if kind == 1:
+        return frustum_mats[idx, face]
+    return ell_mats[idx]
+
+
 @njit(cache=True)
 def _bilinear(tex, base, size, uu, vv):
     x = uu * size - 0.5
@@ -168,12 +178,7 @@ def render_kernel(ox, oy, oz, az, el, pix_angle,
             depth[r, j] = t
             hx, hy, hz, nx, ny, nz, u, v, eu, ev = _surface(kind, idx, face, t, ox, oy, oz, dx, dy, dz,
                                                             boxes, frusta, ells)
-            if kind == 0:
-                m = box_mats[idx, face]
-            elif kind == 1:
-                m = frustum_mats[idx, face]
-            else:
-                m = ell_mats[idx]
+            m = _material(kind, idx, face, box_mats, frustum_mats, ell_mats)
             if mat_fit[m] > 0.5:
                 su = eu
                 sv = ev
@@ -261,3 +266,61 @@ def depth_kernel(ox, oy, oz, az, el, pix_angle, prim_kind, prim_idx, spheres, bo
             kind_out[r, j] = kind
             index_out[r, j] = idx
 
+
+
+@njit(cache=True, parallel=True)
+def surface_kernel(ox, oy, oz, az, dirs, n_bins, boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
+                   prim_kind, prim_idx, spheres, shadow_grids, shadow_starts, shadow_items, light_params, light,
+                   depth, point, normal, mat, lit):
+    """Nearest surface along each ray of a list, and whether a light reaches it (for shading outside numba).
+
+    Rays ``dirs`` (N, 3) (unit, world frame) start at ``(ox, oy, oz)``;
+    ``az`` (N,) are their azimuths (``atan2(dy, dx)``, radians). The
+    candidate primitives are listed per azimuth bin (``n_bins`` bins over the
+    full circle, each list widened by half a bin), so the lists cost
+    ``n_bins`` rows whatever the number of rays. Writes ``depth`` (N,)
+    hit distance in metres (inf for misses), ``point`` (N, 3) the hit,
+    ``normal`` (N, 3) the unit normal facing the ray, ``mat`` (N,) the material
+    index (-1 for misses) and ``lit`` (N,) 1.0 where nothing casts a shadow
+    between the hit (lifted 1 mm along the normal) and light ``light`` (an
+    index into ``light_params``; -1: every hit is lit), else 0.0.
+    """
+    N = dirs.shape[0]
+    width = 2.0 * math.pi / n_bins
+    centres = (np.arange(n_bins) + 0.5) * width
+    cands, counts, el_lo, el_hi, rho_min = _candidates(ox, oy, oz, centres, 0.5 * width + 1e-9, prim_kind,
+                                                       prim_idx, boxes, frusta, ells)
+    for n in prange(N):  # rays are independent: the result does not depend on the number of threads
+        dx = dirs[n, 0]
+        dy = dirs[n, 1]
+        dz = dirs[n, 2]
+        el = math.asin(min(1.0, max(-1.0, dz)))
+        b = min(int((az[n] % (2.0 * math.pi)) / width), n_bins - 1)
+        t, kind, idx, face = _trace(ox, oy, oz, dx, dy, dz, el, cands, b, counts[b], el_lo, el_hi,
+                                    rho_min, prim_kind, prim_idx, boxes, frusta, ells)
+        if kind < 0:
+            depth[n] = np.inf
+            for a in range(3):
+                point[n, a] = 0.0
+                normal[n, a] = 0.0
+            mat[n] = -1
+            lit[n] = 0.0
+            continue
+        hx, hy, hz, nx, ny, nz, _, _, _, _ = _surface(kind, idx, face, t, ox, oy, oz, dx, dy, dz,
+                                                      boxes, frusta, ells)
+        m = _material(kind, idx, face, box_mats, frustum_mats, ell_mats)
+        shaded = False
+        if light >= 0:
+            shaded = _occluded(light, hx + 1e-3 * nx, hy + 1e-3 * ny, hz + 1e-3 * nz, light_params[light, 1],
+                               light_params[light, 2], light_params[light, 3], INF, light_params,
+                               shadow_grids, shadow_starts, shadow_items, prim_kind, prim_idx, spheres,
+                               boxes, frusta, ells)
+        depth[n] = t
+        point[n, 0] = hx
+        point[n, 1] = hy
+        point[n, 2] = hz
+        normal[n, 0] = nx
+        normal[n, 1] = ny
+        normal[n, 2] = nz
+        mat[n] = m
+        lit[n] = 0.0 if shaded else 1.0

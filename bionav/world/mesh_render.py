@@ -36,16 +36,15 @@ SAND_RGB = (229 / 255.0, 183 / 255.0, 90 / 255.0)
 
 
 def _band_albedo(grey: np.ndarray, channels: tuple[str, ...], material: str) -> np.ndarray:
-    """Per-band albedo ``(N, C)`` from grey values, scaled by the default band ratios of ``material``."""
-    from bionav.light.materials import BAND_ALBEDO
+    """Per-band albedo ``(N, C)`` from grey values, scaled by the band-to-grey ratios of surface kind ``material``.
 
-    cols = []
-    for c in channels:
-        if c == "grey":
-            cols.append(grey)
-        else:
-            cols.append(grey * BAND_ALBEDO[c][material] / BAND_ALBEDO["grey"][material])
-    return np.stack(cols, axis=-1)
+    The ratios are those of :func:`bionav.light.materials.band_albedos` (the kind's measured or tabulated
+    reflectance in each band over its grey albedo).
+    """
+    from bionav.light.materials import band_albedos
+
+    ratio = band_albedos(tuple(channels))[material] / band_albedos(("grey",))[material]
+    return np.asarray(grey, float)[..., None] * ratio
 
 
 @dataclass
@@ -68,7 +67,7 @@ class MeshWorld:
         RGB of the ground plane (default :data:`SAND_RGB`).
     channels : {"grey", "spectral"}
         One grey channel, or the five bands ``UV B G R IR`` (albedos scaled by
-        :data:`bionav.light.materials.BAND_ALBEDO` of ``foliage`` for the mesh and
+        :func:`bionav.light.materials.band_albedos` of ``foliage`` for the mesh and
         ``soil`` for the ground).
     shading : {"flat", "lambert"}
         ``flat``: a triangle shows its colour (the MATLAB renderer);

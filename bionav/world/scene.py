@@ -39,8 +39,8 @@ frame), radiance ``(N, C)`` for rays that hit nothing."""
 
 
 @dataclass(frozen=True)
-class Material:
-    """Surface reflectance of one material.
+class RenderMaterial:
+    """How the renderer shades one surface: texture, albedo, emission (its physics: ``kind``).
 
     Parameters
     ----------
@@ -55,8 +55,10 @@ class Material:
     fit : bool
         Stretch the texture once over each face instead of tiling.
     kind : str
-        Physical kind (``"foliage"``, ``"concrete"`` ...), used to look up
-        per-band albedos in multi-band worlds.
+        Physical kind (``"foliage"``, ``"concrete"`` ...), the surface kinds of
+        :data:`bionav.light.materials.RENDER_KINDS` whose reflectance spectra
+        give the per-band albedos of multi-band worlds
+        (:func:`bionav.light.materials.band_albedos`).
     """
 
     texture: int
@@ -173,7 +175,7 @@ class Scene:
     exposure: float = 1.0
     name: str = ""
     textures: list[np.ndarray] = field(default_factory=list)
-    materials: list[Material] = field(default_factory=list)
+    materials: list[RenderMaterial] = field(default_factory=list)
     boxes: list[tuple] = field(default_factory=list)
     frusta: list[tuple] = field(default_factory=list)
     ellipsoids: list[tuple] = field(default_factory=list)
@@ -222,7 +224,7 @@ class Scene:
         c = self.n_channels
         alb = np.broadcast_to(np.asarray(albedo, np.float64).reshape(-1), (c,)).copy()
         em = np.broadcast_to(np.asarray(emission, np.float64).reshape(-1), (c,)).copy()
-        self.materials.append(Material(int(texture), alb, em, sc, bool(fit), kind))
+        self.materials.append(RenderMaterial(int(texture), alb, em, sc, bool(fit), kind))
         return len(self.materials) - 1
 
     def _plain_texture(self) -> int:

@@ -200,11 +200,11 @@ def test_apartment_free_area_is_free():
 
 
 def test_campus_renders_five_bands_with_caller_albedos_and_sky():
-    from bionav.light.materials import BAND_ALBEDO
+    from bionav.light.materials import band_albedos
     from bionav.world.worlds.outdoor import build_campus
 
     bands = ("UV", "B", "G", "R", "IR")
-    albedos = {k: [BAND_ALBEDO[b][k] for b in bands] for k in BAND_ALBEDO["grey"]}
+    albedos = {k: list(v) for k, v in band_albedos(bands).items()}
     albedos["foliage"] = [0.0, 0.0, 0.0, 0.0, 0.9]  # leaves visible in IR only
     seen = []
 

@@ -21,8 +21,8 @@ from bionav.light.daylight import SkyState
 from bionav.spectral.lda_analysis import learn_discriminants
 from bionav.spectral.samples import sim_natural
 from bionav.spectral.scan import ScanGrid, separation_images
-from bionav.spectral.scene import backyard_scene
 from bionav.spectral.sensor_model import LogSensorModel
+from bionav.world.worlds.garden import backyard_scene
 
 DUALS = ("UV-B", "UV-G", "UV-R", "UV-IR", "B-G", "B-R", "B-IR", "G-R", "G-IR", "R-IR")
 

@@ -136,3 +136,19 @@ def test_log_contrast_of_two_known_spectra_by_hand():
     # scaling the light by 1000 moves every channel by 3 decades and no contrast
     c1000 = sensor.ideal_counts(band_integrate(1000 * a))
     np.testing.assert_allclose(c1000 - ca, 3 * 819.2)
+
+
+def test_rendered_worlds_take_their_band_albedos_from_the_material_table():
+    """One material table: a rendered surface kind's five-band albedo is its material's band reflectance."""
+    from bionav.light.materials import GREY_ALBEDO, MATERIALS, RENDER_KINDS, band_albedos
+
+    table = band_albedos(("UV", "B", "G", "R", "IR", "grey"))
+    assert set(table) == set(RENDER_KINDS) == set(GREY_ALBEDO)
+    # grass is the measured green leaf (bumbleview) x 0.9: dark in UV, brightest beyond the red edge (IR)
+    np.testing.assert_array_equal(table["grass"][:5], MATERIALS["grass"].reflectance)
+    assert table["grass"][0] < 0.1 and np.argmax(table["grass"][:5]) == 4
+    np.testing.assert_array_equal(table["asphalt"][:5], MATERIALS["tar"].reflectance)
+    assert table["concrete"][5] == GREY_ALBEDO["concrete"] == 0.45
+    np.testing.assert_array_equal(band_albedos(("G", "UV"))["brick"], [0.100, 0.050])  # the table's brick, reordered
+    with pytest.raises(ValueError, match="no default albedos for bands"):
+        band_albedos(("UV", "X"))

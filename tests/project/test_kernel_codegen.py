@@ -42,7 +42,7 @@ SIFT_SCANS = ["sift_scan_core", "sift_scan_edge"]
 #: kernels whose loops are scalar by nature (ray casting, agent trials, gathers): compiled, no masked stores
 SCALAR = ["minwarp_scores_at[u8]", "minwarp_scores_at[f32]", "minwarp_scores_runs[u8]", "minwarp_scores_runs[f32]",
           "swap_roles[u8]", "swap_roles[f32]", "mesh_cast_kernel", "mesh_fill_grid", "world_candidates",
-          "world_depth_kernel", "world_render_kernel", "coverage_sweep", "agent_success"]
+          "world_depth_kernel", "world_render_kernel", "world_surface_kernel", "coverage_sweep", "agent_success"]
 #: kernels that must have no AVX-512 masked store either (their rewrite is the point: plain packed stores)
 NO_K_MASK = [k for k in list(PACKED) + SIFT_SCANS if k != "warping1d_scores"] + [
     k for k in SCALAR if k.startswith(("minwarp", "swap_roles", "world_candidates"))]

@@ -10,9 +10,9 @@ from bionav.light.daylight import SkyState
 from bionav.plugins.sensors.fakes.spectral5 import FakeSpectral5
 from bionav.plugins.sensors.spectral5 import Spectral5Serial, Spectral5Sim
 from bionav.spectral.scan import DirectPanTilt, ScanGrid, feature_images, run_scan, stability_series
-from bionav.spectral.scene import backyard_scene
 from bionav.spectral.sensor_model import LogSensorModel
 from bionav.spectral.stability import stability_measures
+from bionav.world.worlds.garden import backyard_scene
 
 
 def test_stability_measures_hand_computed():

@@ -230,7 +230,7 @@ class Spectral5Sim(_Spectral5Base):
 
     The sensor reads its *scene*: any object with ``band_radiance() -> (5,)``
     (the band radiance along the current optical axis) and ``set_pose(pan,
-    tilt)`` (radians), such as :class:`bionav.spectral.scene.OutdoorScene`. An
+    tilt)`` (radians), such as :class:`bionav.world.worlds.garden.OutdoorScene`. An
     experiment hands its scene over with :meth:`attach_simulation` (a
     simulated pan-tilt unit aims it); without one, the sensor looks into an
     open field under a clear sky with the sun at 45 degrees (sky above the

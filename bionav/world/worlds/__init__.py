@@ -8,4 +8,8 @@
 * :func:`~bionav.world.worlds.outdoor.build_campus` -- outdoors (*uni*), with
   pluggable bands, albedos and sky.
 * :func:`~bionav.world.worlds.apartment.build_apartment` -- the cleaning-robot room.
+* :func:`~bionav.world.worlds.garden.garden_scene`,
+  :func:`~bionav.world.worlds.garden.backyard_scene` -- the five-band outdoor
+  scenes of thesis chapter 6 (:class:`~bionav.world.worlds.garden.OutdoorScene`,
+  rendered with spectral daylight; not a :class:`World`).
 """

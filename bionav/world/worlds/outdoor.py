@@ -12,12 +12,13 @@ callable to render multi-band (e.g. UV, B, G, R, IR) images; the defaults of
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
 from bionav.geometry import direction_from_angles
+from bionav.light.capture import CaptureLight
+from bionav.light.clouds import CloudLayer
 from bionav.light.materials import band_albedos
 from bionav.light.simple_sky import SKY_GAIN, SUN_GAIN, SimpleSky
 from bionav.world import textures as tx
@@ -48,12 +49,20 @@ CAPTURE_START_UTC = "2006-03-06T10:50:00"
 SECONDS_PER_CAPTURE = 30.0
 #: Fraction of the sky covered by (fair-weather cumulus) clouds.
 CLOUD_COVER = 0.4
-#: Cloud base height (m), wind speed (m/s) at that height, and horizontal scale (m) of the cloud field.
-CLOUD_HEIGHT_M, WIND_M_S, CLOUD_SCALE_M = 1500.0, 8.0, 1200.0
+#: Cloud base height (m) and horizontal scale (m) of the cloud layer (:class:`~bionav.light.clouds.CloudLayer`:
+#: waves of 300-1200 m wavelength, fair-weather cumulus a few hundred metres across).
+CLOUD_HEIGHT_M, CLOUD_SCALE_M = 1500.0, 600.0
+#: Cloud edge width (standard deviations of the field) and the angular resolution (degrees) at which the
+#: layer is seen: sharper than the sun's disk (0.53 deg), so a cloud covers the sun fully or not at all
+#: but for its edge.
+CLOUD_SOFTNESS, CLOUD_RESOLUTION_DEG = 0.2, 0.1
+#: Wind at the cloud base (east, north) in m/s: 8 m/s from the west (the prevailing westerlies).
+WIND_MPS = (8.0, 0.0)
 #: Radiance of a cloud relative to the clear sky's horizon value (sunlit cumulus are brighter than blue sky).
 CLOUD_RADIANCE = 1.25
-#: Fraction of the direct sunlight a cloud in front of the sun lets through.
-CLOUD_SUN_TRANSMITTANCE = 0.15
+#: Optical depth of a cloud for the direct sun: with the sun 31-33 deg high (air mass 1.9) a cloud in front of
+#: it lets exp(-1.9) = 15 % of the direct sunlight through.
+CLOUD_OPTICAL_DEPTH = 1.0
 
 
 def capture_order(cells: np.ndarray) -> np.ndarray:
@@ -74,145 +83,30 @@ def capture_order(cells: np.ndarray) -> np.ndarray:
     return order
 
 
-@dataclass(frozen=True)
-class CloudField:
-    """A layer of broken clouds drifting with the wind (smooth random field on a horizontal plane).
+def uni_capture_light(cells: np.ndarray, seed: int) -> CaptureLight:
+    """The light of the uni capture (:class:`~bionav.light.capture.CaptureLight`) with this module's assumptions.
 
-    ``coverage(d, t)`` in [0, 1] is the cloud density seen in direction ``d``
-    at ``t`` seconds: the direction meets the layer at ``h / d_z * d_xy``; the
-    field there, shifted by ``-wind * t``, is thresholded so that a fraction
-    ``cover`` of the layer is cloud (soft edges).
+    Parameters
+    ----------
+    cells : ndarray, shape (10, 17), bool
+        The grid cells that exist (their :func:`capture_order`).
+    seed : int
+        The world's seed (the cloud layer's and the sky's).
     """
-
-    seed: int
-    cover: float = CLOUD_COVER
-    height_m: float = CLOUD_HEIGHT_M
-    wind_m_s: float = WIND_M_S
-    scale_m: float = CLOUD_SCALE_M
-
-    def _waves(self):
-        r = np.random.default_rng(np.random.SeedSequence([int(self.seed) & 0xFFFFFFFF, 0x636C6F75]))
-        n = 16
-        angles = r.uniform(0, 2 * np.pi, n)
-        k = (2 * np.pi / self.scale_m) * np.geomspace(1.0, 6.0, n)
-        kvec = np.stack([k * np.cos(angles), k * np.sin(angles)], axis=1)
-        phase = r.uniform(0, 2 * np.pi, n)
-        amp = 1.0 / np.geomspace(1.0, 4.0, n)
-        wind_dir = r.uniform(0, 2 * np.pi)
-        return kvec, phase, amp / np.sqrt(0.5 * (amp ** 2).sum()), np.array([np.cos(wind_dir), np.sin(wind_dir)])
-
-    def coverage(self, directions: np.ndarray, t: float) -> np.ndarray:
-        """Cloud density in [0, 1] towards unit ``directions`` (N, 3) at time ``t`` (s); 0 below 2 deg."""
-        from scipy.stats import norm
-
-        d = np.asarray(directions, float).reshape(-1, 3)
-        kvec, phase, amp, wind = self._waves()
-        dz = np.maximum(d[:, 2], np.sin(np.deg2rad(2.0)))
-        p = d[:, :2] * (self.height_m / dz)[:, None] - wind[None, :] * (self.wind_m_s * float(t))
-        f = (amp[None, :] * np.sin(p @ kvec.T + phase[None, :])).sum(axis=1)  # about N(0, 1)
-        threshold = norm.ppf(1.0 - float(self.cover))
-        cov = np.clip((f - threshold) / 0.5 + 0.5, 0.0, 1.0)
-        return np.where(d[:, 2] > 0.0, cov, 0.0)
+    clouds = CloudLayer(cover=CLOUD_COVER, optical_depth=CLOUD_OPTICAL_DEPTH, seed=int(seed), height_m=CLOUD_HEIGHT_M,
+                        scale_m=CLOUD_SCALE_M, wind_mps=WIND_MPS, softness=CLOUD_SOFTNESS,
+                        resolution=float(np.deg2rad(CLOUD_RESOLUTION_DEG)), brightness=CLOUD_RADIANCE)
+    return CaptureLight(order=capture_order(cells), clouds=clouds, site_deg=SITE_DEG, start_utc=CAPTURE_START_UTC,
+                        seconds_per_capture=SECONDS_PER_CAPTURE, seed=int(seed))
 
 
-@dataclass(frozen=True)
-class CloudySky:
-    """The clear sky of :class:`~bionav.light.simple_sky.SimpleSky` behind a drifting cloud layer.
-
-    ``L(d) = (1 - c) * L_clear(d) + c * CLOUD_RADIANCE * L_clear(horizon)``, with
-    ``c = clouds.coverage(d, t)``.
-    """
-
-    clear: SimpleSky
-    clouds: CloudField
-    t: float
-
-    def __call__(self, directions: np.ndarray) -> np.ndarray:
-        d = np.asarray(directions, float).reshape(-1, 3)
-        clear = self.clear(d)
-        horizon = self.clear(np.array([[1.0, 0.0, 0.0]]))  # (1, C), no glow towards +x at midday
-        c = self.clouds.coverage(d, self.t)[:, None]
-        return (1.0 - c) * clear + c * (CLOUD_RADIANCE * horizon)
-
-
-def _hemisphere_directions(n: int = 1024) -> tuple[np.ndarray, np.ndarray]:
-    """Fibonacci directions over the upper hemisphere and their cosine weights (sum 1)."""
-    k = np.arange(n) + 0.5
-    z = 1.0 - k / n
-    phi = np.pi * (3.0 - np.sqrt(5.0)) * k
-    rho = np.sqrt(1.0 - z ** 2)
-    d = np.stack([rho * np.cos(phi), rho * np.sin(phi), z], axis=1)
-    return d, z / z.sum()
-
-
-@dataclass(frozen=True)
-class CaptureLight:
-    """The light of the uni capture at each grid cell's capture time (thesis 3.1; docs/databases.md).
-
-    Cell ``(i, j)`` is captured ``SECONDS_PER_CAPTURE * capture_order[i, j]``
-    seconds after ``start_utc``. At that time the sun stands where
-    :func:`bionav.light.sun.sun_position` puts it over ``SITE_DEG`` (shadows of
-    buildings and trees move with it), a cloud layer (:class:`CloudField`)
-    drifts across the sky (the sky's radiance changes, and the direct sunlight
-    drops to ``CLOUD_SUN_TRANSMITTANCE`` while a cloud covers the sun), and the
-    diffuse light on the ground follows the cosine-weighted sky radiance. The
-    camera's automatic exposure then follows the scene's brightness.
-    """
-
-    order: np.ndarray
-    seed: int
-    start_utc: str = CAPTURE_START_UTC
-    seconds_per_capture: float = SECONDS_PER_CAPTURE
-    sun_irradiance: float = 2.2
-    sky_irradiance: float = 1.2
-    channels: tuple[str, ...] = ("grey",)
-
-    def describe(self) -> dict:
-        """The model's parameters (JSON; part of the render cache key)."""
-        clouds = CloudField(self.seed)
-        return {"model": "uni-capture-light-1", "start_utc": self.start_utc, "site_deg": list(SITE_DEG),
-                "seconds_per_capture": self.seconds_per_capture, "cloud_cover": clouds.cover,
-                "cloud_height_m": clouds.height_m, "wind_m_s": clouds.wind_m_s, "cloud_scale_m": clouds.scale_m,
-                "cloud_radiance": CLOUD_RADIANCE, "cloud_sun_transmittance": CLOUD_SUN_TRANSMITTANCE,
-                "seed": int(self.seed)}
-
-    def time_s(self, i: int, j: int) -> float:
-        """Seconds after the start at which cell ``(i, j)`` was captured."""
-        k = int(self.order[int(i), int(j)])
-        if k < 0:
-            raise ValueError(f"cell ({i}, {j}) was not captured")
-        return k * float(self.seconds_per_capture)
-
-    def sun_direction(self, t: float) -> np.ndarray:
-        """Unit vector towards the sun (world frame: x east, y north, z up) ``t`` seconds after the start."""
-        import datetime as dt
-
-        from bionav.light.sun import parse_time, sun_position
-
-        when = parse_time(self.start_utc) + dt.timedelta(seconds=float(t))
-        return np.asarray(sun_position(when, latitude_deg=SITE_DEG[0], longitude_deg=SITE_DEG[1]).direction, float)
-
-    def conditions(self, i: int, j: int) -> dict:
-        """Sun direction, direct-sun transmittance, sky and diffuse irradiance at cell ``(i, j)``'s capture."""
-        t = self.time_s(i, j)
-        sun = self.sun_direction(t)
-        clouds = CloudField(self.seed)
-        transmittance = 1.0 - (1.0 - CLOUD_SUN_TRANSMITTANCE) * float(clouds.coverage(sun[None, :], t)[0])
-        clear = SimpleSky(sun_direction=tuple(sun), channels=self.channels, clouds=0.0, seed=int(self.seed))
-        sky = CloudySky(clear, clouds, t)
-        dirs, w = _hemisphere_directions()
-        ratio = float((sky(dirs)[:, 0] * w).sum() / (clear(dirs)[:, 0] * w).sum())
-        return {"t_s": t, "sun": sun, "sun_transmittance": transmittance, "sky": sky, "diffuse_ratio": ratio}
-
-    def scene_at(self, scene: Scene, i: int, j: int) -> Scene:
-        """``scene`` relit as at cell ``(i, j)``'s capture time (:meth:`Scene.relit`)."""
-        cond = self.conditions(i, j)
-        c = len(self.channels)
-        sun_e = [self.sun_irradiance * SUN_GAIN.get(ch, 1.0) * cond["sun_transmittance"] for ch in self.channels]
-        up = np.broadcast_to(np.asarray([self.sky_irradiance * SKY_GAIN.get(ch, 1.0) * cond["diffuse_ratio"]
-                                         for ch in self.channels], float), (c,))
-        return scene.relit(lights=[DirectionalLight(tuple(float(v) for v in cond["sun"]), tuple(sun_e))],
-                           ambient=Ambient(up=tuple(up), down=tuple(0.4 * up)), sky=cond["sky"])
+def relit_at(scene: Scene, light: CaptureLight, i: int, j: int) -> Scene:
+    """``scene`` relit as at cell ``(i, j)``'s capture (:meth:`Scene.relit`; ambient below 0.4 of above)."""
+    cond = light.conditions(i, j)
+    up = np.asarray(cond["sky_irradiance"], float)
+    return scene.relit(lights=[DirectionalLight(tuple(float(v) for v in cond["sun"]),
+                                                tuple(float(v) for v in cond["sun_irradiance"]))],
+                       ambient=Ambient(up=tuple(up), down=tuple(0.4 * up)), sky=cond["sky"])
 
 
 def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
@@ -395,13 +289,13 @@ def build_uni(seed: int = 0) -> World:
     """The *uni* stand-in: :func:`build_campus` (grey) plus the light changing while the grid was captured.
 
     ``World.capture_scene(i, j)`` gives the scene as lit at cell ``(i, j)``'s
-    capture time (:class:`CaptureLight`); the camera model
+    capture time (:func:`uni_capture_light`, :func:`relit_at`); the camera model
     (``db.realism=camera``) renders each capture with it. ``world.scene``
     itself (used by ``db.realism=ideal``) is the campus of :func:`build_campus`
     unchanged.
     """
     world = build_campus(seed)
-    light = CaptureLight(order=capture_order(world.cells), seed=int(seed))
-    world.capture_scene = lambda i, j: light.scene_at(world.scene, i, j)
+    light = uni_capture_light(world.cells, seed)
+    world.capture_scene = lambda i, j: relit_at(world.scene, light, i, j)
     world.info["capture_light"] = light.describe()
     return world

@@ -47,7 +47,7 @@ def _spectral_fakes(args) -> dict:
     from bionav.plugins.sensors.fakes.ptu46 import FakePTU46
     from bionav.plugins.sensors.fakes.spectral5 import FakeSpectral5
     from bionav.plugins.sensors.spectral5 import Spectral5Sim
-    from bionav.spectral.scene import backyard_scene
+    from bionav.world.worlds.garden import backyard_scene
 
     clouds = CloudLayer(cover=args.cloud_cover, optical_depth=args.cloud_optical_depth, seed=args.seed)
     scene = backyard_scene(SkyState.from_time(args.time, clouds=clouds), seed=args.seed)

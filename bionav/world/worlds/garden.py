@@ -1,26 +1,21 @@
-"""A small outdoor scene seen by the five-channel sensor: geometry, materials, daylight.
+"""Small outdoor scenes seen by the five-channel sensor: a backyard and a garden (thesis chapter 6).
 
-:class:`OutdoorScene` ray-casts viewing directions against a handful of
-analytic primitives (ground plane, yawed boxes, ellipsoids, vertical
-cylinders, a distant tree line) and shades the hits with the spectral daylight
-of :mod:`bionav.light.daylight`:
-
-``L_b = tex * int S_b rho (sunlit * cos_i * E_dir + (1 + n_z)/2 * E_diff + (1 - n_z)/2 * a_g * E_glob) dlambda / pi``
-
-attenuated towards the sensor by the air (extinction per band) plus airlight
-(horizon sky radiance); lines of sight that hit nothing get the sky radiance
-with clouds. ``rho(lambda)`` is the material's mean reflectance spectrum from
-:data:`bionav.light.materials.MATERIALS` (measured leaf and petal spectra for
-vegetation and flowers), ``S_b`` the channel sensitivity, ``tex`` is a smooth multiplicative
-texture (log-normal, per material), shadows are cast by every primitive except
-the ground, foliage is lit in patches (sun flecks).
+:class:`OutdoorScene` holds a handful of analytic primitives (ground with
+patches, yawed boxes, ellipsoids, vertical cylinders, a distant tree line),
+builds them into a :class:`bionav.world.scene.Scene` and renders them through
+the renderer's kernels with the spectral shading of
+:mod:`bionav.world.spectral_shading` (spectral daylight of
+:mod:`bionav.light.daylight`, reflectance spectra of
+:data:`bionav.light.materials.MATERIALS`, hard shadows of the sun, a smooth
+log-normal texture per material, sun flecks on foliage).
 
 The scene also serves as the "simulation" object of the pan-tilt experiment:
-:meth:`set_pose` (called by a simulated pan-tilt unit) aims the sensor and
-:meth:`band_radiance` returns what it sees. Conventions: east-north-up frame,
-metres; pan = azimuth in radians counter-clockwise, offset by
-``pan_zero_azimuth`` (radians CCW from east); tilt = elevation in radians
-(the spectral sensor is mounted looking horizontally at tilt 0).
+:meth:`OutdoorScene.set_pose` (called by a simulated pan-tilt unit) aims the
+sensor and :meth:`OutdoorScene.band_radiance` returns what it sees.
+Conventions: east-north-up frame, metres; pan = azimuth in radians
+counter-clockwise, offset by ``pan_zero_azimuth`` (radians CCW from east);
+tilt = elevation in radians (the spectral sensor is mounted looking
+horizontally at tilt 0).
 """
 
 from __future__ import annotations
@@ -30,17 +25,21 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from bionav.geometry import direction_from_angles
-from bionav.light.bands import PEAK_NM, band_integrate
-from bionav.light.daylight import (
-    SkyState,
-    aerosol_optical_depth,
-    band_sky_radiance,
-    illumination,
-    rayleigh_optical_depth,
-)
+from bionav.light.daylight import SkyState, illumination
 from bionav.light.materials import MATERIALS
+from bionav.world.lights import DirectionalLight
+from bionav.world.scene import Scene
+from bionav.world.spectral_shading import spectral_radiance, trace_surfaces
 
-_MISS = np.inf
+#: Materials lit by the sun in flecks (foliage).
+FOLIAGE = ("shrub", "tree", "conifer")
+#: Segments of the distant tree line (four per degree of azimuth around the scene's origin): its inner faces
+#: lie within 0.5 mm of the circle and turn by 0.25 deg from one to the next.
+TREE_LINE_SEGMENTS = 1440
+#: Half the side of the ground square (m); the tree line, 120-150 m away, hides its edge.
+GROUND_HALF_M = 400.0
+#: Height (m) of the slab of a ground patch above the one before it (patches are slabs on the ground).
+PATCH_LIFT_M = 1e-5
 
 
 @dataclass(frozen=True)
@@ -83,7 +82,11 @@ class Cylinder:
 @dataclass(frozen=True)
 class TreeLine:
     """Distant vegetation: the inside of a cylinder of ``radius`` around the origin whose top height
-    varies smoothly with azimuth between ``height_min`` and ``height_max`` (seeded)."""
+    varies smoothly with azimuth between ``height_min`` and ``height_max`` (seeded).
+
+    Rendered as :data:`TREE_LINE_SEGMENTS` upright slabs (2 m deep) whose inner
+    faces form a regular polygon circumscribed about the circle, each as high
+    as :meth:`height` at its centre azimuth (radians CCW from east)."""
 
     radius: float = 150.0
     height_min: float = 8.0
@@ -160,6 +163,7 @@ class OutdoorScene:
         r = np.random.default_rng(self.seed)
         self._tex_k = r.normal(0, 1, (12, 3)) * np.array([1.5, 1.5, 1.5])
         self._tex_p = r.uniform(0, 2 * np.pi, 12)
+        self._geometry, self._surface = self._build()
 
     # -- simulation hooks -------------------------------------------------------------
     def set_pose(self, pan: float, tilt: float) -> None:
@@ -179,102 +183,50 @@ class OutdoorScene:
         return direction_from_angles(self.pan_zero_azimuth + np.asarray(pan), tilt)
 
     # -- geometry ------------------------------------------------------------------------
-    def _intersect(self, o, d, *, shadow=False):
-        n = d.shape[0]
-        t = np.full(n, _MISS)
-        normal = np.zeros((n, 3))
-        mat = np.full(n, -1, dtype=np.int64)
-        foliage = np.zeros(n, dtype=bool)
+    def _build(self) -> tuple[Scene, np.ndarray]:
+        """The primitives as a renderer :class:`Scene` (one material per name, ``kind`` the name) and the
+        row of :attr:`_spectra` of each of its materials."""
+        scene = Scene(channels=("grey",), name="spectral-outdoor")
+        ids: dict[str, int] = {}
 
-        def take(tt, nn, mm, fol=False):
-            hit = tt < t
-            t[hit] = tt[hit]
-            normal[hit] = nn[hit] if nn.ndim == 2 else nn
-            mat[hit] = mm[hit] if np.ndim(mm) else mm
-            foliage[hit] = fol
+        def mat(name: str) -> int:
+            if name not in ids:
+                ids[name] = scene.material(kind=name)
+            return ids[name]
 
-        if not shadow:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tg = np.where(d[:, 2] < -1e-9, -o[..., 2] / d[:, 2], _MISS)
-            tg = np.where(tg > 1e-6, tg, _MISS)
-            p = o + np.where(np.isfinite(tg), tg, 0.0)[:, None] * d
-            gm = np.full(n, self._mat_index[self.ground])
-            for patch in self.patches:
-                inside = (p[:, 0] >= patch.x0) & (p[:, 0] <= patch.x1) & (p[:, 1] >= patch.y0) & (p[:, 1] <= patch.y1)
-                gm[inside] = self._mat_index[patch.material]
-            take(tg, np.array([0.0, 0.0, 1.0]), gm)
+        g = GROUND_HALF_M
+        scene.box((-g, -g, -1.0), (g, g, 0.0), mat(self.ground), shadow=False)
+        for k, patch in enumerate(self.patches):  # later patches lie on top of earlier ones
+            scene.box((patch.x0, patch.y0, 0.0), (patch.x1, patch.y1, PATCH_LIFT_M * (k + 1)), mat(patch.material),
+                      shadow=False)
         for b in self.boxes:
-            c, s = np.cos(b.yaw), np.sin(b.yaw)
-            rot = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])  # world -> box frame
-            ol = (o - np.array([b.centre[0], b.centre[1], 0.0])) @ rot.T
-            dl = d @ rot.T
-            lo = np.array([-b.size[0] / 2, -b.size[1] / 2, b.z0])
-            hi = np.array([b.size[0] / 2, b.size[1] / 2, b.z1])
-            with np.errstate(divide="ignore", invalid="ignore"):
-                inv = 1.0 / dl
-                t1 = (lo - ol) * inv
-                t2 = (hi - ol) * inv
-            tmin = np.nanmax(np.minimum(t1, t2), axis=1)
-            tmax = np.nanmin(np.maximum(t1, t2), axis=1)
-            ok = (tmax >= tmin) & (tmax > 1e-6)
-            th = np.where(ok, np.where(tmin > 1e-6, tmin, tmax), _MISS)
-            axis = np.argmax(np.where(np.isfinite(t1) | np.isfinite(t2), np.minimum(t1, t2), -np.inf), axis=1)
-            sign = -np.sign(dl[np.arange(n), axis])
-            nl = np.zeros((n, 3))
-            nl[np.arange(n), axis] = sign
-            nw = nl @ rot  # back to world
-            m = np.where(axis == 2, self._mat_index[b.top], self._mat_index[b.wall])
-            take(th, nw, m, fol=b.wall in ("shrub", "tree", "conifer"))
+            lo = (b.centre[0] - b.size[0] / 2, b.centre[1] - b.size[1] / 2, b.z0)
+            hi = (b.centre[0] + b.size[0] / 2, b.centre[1] + b.size[1] / 2, b.z1)
+            scene.box(lo, hi, [mat(b.wall)] * 4 + [mat(b.top)] * 2, yaw=b.yaw)
         for e in self.ellipsoids:
-            r = np.asarray(e.radii, dtype=float)
-            oc = (o - np.asarray(e.centre)) / r
-            dc = d / r
-            a = np.sum(dc * dc, axis=1)
-            bq = 2 * np.sum(oc * dc, axis=1)
-            cq = np.sum(oc * oc, axis=-1) - 1
-            disc = bq * bq - 4 * a * cq
-            sq = np.sqrt(np.maximum(disc, 0))
-            ta = (-bq - sq) / (2 * a)
-            tb = (-bq + sq) / (2 * a)
-            th = np.where(disc > 0, np.where(ta > 1e-6, ta, np.where(tb > 1e-6, tb, _MISS)), _MISS)
-            p = o + np.where(np.isfinite(th), th, 0)[:, None] * d
-            nn = (p - np.asarray(e.centre)) / r**2
-            nn /= np.linalg.norm(nn, axis=1, keepdims=True) + 1e-12
-            take(th, nn, np.full(n, self._mat_index[e.material]), fol=e.material in ("shrub", "tree", "conifer"))
+            scene.ellipsoid(e.centre, e.radii, material=mat(e.material))
         for cyl in self.cylinders:
-            oc = o[..., :2] - np.asarray(cyl.centre)
-            dxy = d[:, :2]
-            a = np.sum(dxy * dxy, axis=1)
-            bq = 2 * np.sum(oc * dxy, axis=-1)
-            cq = np.sum(oc * oc, axis=-1) - cyl.radius**2
-            disc = bq * bq - 4 * a * cq
-            sq = np.sqrt(np.maximum(disc, 0))
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ta = (-bq - sq) / (2 * a)
-            z = o[..., 2] + ta * d[:, 2]
-            ok = (disc > 0) & (ta > 1e-6) & (z >= cyl.z0) & (z <= cyl.z1)
-            th = np.where(ok, ta, _MISS)
-            p = o + np.where(ok, ta, 0)[:, None] * d
-            nn = np.zeros((n, 3))
-            nn[:, :2] = (p[:, :2] - np.asarray(cyl.centre)) / cyl.radius
-            take(th, nn, np.full(n, self._mat_index[cyl.material]))
+            scene.cylinder(cyl.centre, cyl.z0, cyl.z1, cyl.radius, material=mat(cyl.material))
         if self.tree_line is not None:
             tl = self.tree_line
-            oxy = o[..., :2] * np.ones((n, 1))
-            dxy = d[:, :2]
-            a = np.sum(dxy * dxy, axis=1)
-            bq = 2 * np.sum(oxy * dxy, axis=1)
-            cq = np.sum(oxy * oxy, axis=1) - tl.radius**2
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tt = (-bq + np.sqrt(np.maximum(bq * bq - 4 * a * cq, 0))) / (2 * a)
-            p = oxy + np.where(np.isfinite(tt), tt, 0)[:, None] * dxy
-            z = o[..., 2] + tt * d[:, 2]
-            h = tl.height(np.arctan2(p[:, 1], p[:, 0]))
-            ok = np.isfinite(tt) & (tt > 0) & (z >= 0) & (z <= h)
-            nn = np.zeros((n, 3))
-            nn[:, :2] = -p / tl.radius
-            take(np.where(ok, tt, _MISS), nn, np.full(n, self._mat_index[tl.material]), fol=True)
-        return t, normal, mat, foliage
+            n = TREE_LINE_SEGMENTS
+            az = 2 * np.pi * (np.arange(n) + 0.5) / n
+            half = tl.radius * np.tan(np.pi / n) * 1.01  # inner faces meet (1 % overlap)
+            for a, h in zip(az, tl.height(az)):
+                c = (tl.radius + 1.0) * np.cos(a), (tl.radius + 1.0) * np.sin(a)
+                scene.box((c[0] - 1.0, c[1] - half, 0.0), (c[0] + 1.0, c[1] + half, float(h)), mat(tl.material),
+                          yaw=float(a))
+        surface = np.array([self._mat_index[m.kind] for m in scene.materials], np.int64)
+        return scene, surface
+
+    def _lit_geometry(self) -> Scene:
+        """The geometry with the sun as its one light (for its shadows)."""
+        sun = tuple(float(v) for v in self.sky.sun_direction)
+        cached = self._ill_cache.get("geometry")
+        if cached is None or cached[0] != sun:
+            cached = (sun, self._geometry.relit(lights=[DirectionalLight(sun, 1.0)]))
+            self._ill_cache["geometry"] = cached
+        return cached[1]
 
     def _texture(self, p, mat):
         phase = p @ self._tex_k.T + self._tex_p + mat[:, None] * 1.7
@@ -282,11 +234,11 @@ class OutdoorScene:
         return np.exp(self.texture_sd * f)
 
     def _illumination(self):
-        key = self.sky
-        if key not in self._ill_cache:
-            self._ill_cache.clear()
-            self._ill_cache[key] = illumination(self.sky, origin_m=self.position)
-        return self._ill_cache[key]
+        cached = self._ill_cache.get("illumination")
+        if cached is None or cached[0] != self.sky:
+            cached = (self.sky, illumination(self.sky, origin_m=self.position))
+            self._ill_cache["illumination"] = cached
+        return cached[1]
 
     # -- rendering -----------------------------------------------------------------------
     def render(self, directions, *, position=None):
@@ -310,41 +262,16 @@ class OutdoorScene:
         shape = d.shape[:-1]
         d = d.reshape(-1, 3)
         o = self.origin(position)
-        t, normal, mat, foliage = self._intersect(o, d)
-        sky = ~np.isfinite(t)
-        out = np.zeros((d.shape[0], 5))
-        origin_xy = tuple(o[:2])
-        if np.any(sky):
-            out[sky] = band_sky_radiance(self.sky, d[sky], origin_m=origin_xy)
-        hit = ~sky
-        if np.any(hit):
-            ill = self._illumination()
-            # per material and channel: int S_b rho_m E dlambda of each light component, shape (M, 5)
-            e_dir = band_integrate(self._spectra * ill.direct_normal)
-            e_dif = band_integrate(self._spectra * ill.diffuse_horizontal)
-            e_glob = band_integrate(self._spectra * ill.global_horizontal)
-            p = o + t[hit, None] * d[hit]
-            n = normal[hit]
-            sun = self.sky.sun_direction
-            cos_i = np.clip(n @ sun, 0, None)
-            lit = np.ones(p.shape[0])
-            if sun[2] > 0:
-                ts, _, _, _ = self._intersect(p + 1e-3 * n, np.broadcast_to(sun, p.shape).copy(), shadow=True)
-                lit = np.where(np.isfinite(ts), 0.0, 1.0)
-            fol = foliage[hit]
-            fleck = 0.5 + 0.5 * np.sin(p @ np.array([3.1, 2.3, 4.7]) + np.sin(p @ np.array([1.3, -2.9, 0.7])) * 2)
-            lit = np.where(fol, lit * fleck, lit)
-            sky_view = (1 + n[:, 2:3]) / 2
-            m = mat[hit]
-            refl_irr = lit[:, None] * cos_i[:, None] * e_dir[m] + sky_view * e_dif[m] + (1 - sky_view) * 0.15 * e_glob[m]
-            rad = self._texture(p, m)[:, None] * refl_irr / np.pi
-            beta = (rayleigh_optical_depth(np.asarray(PEAK_NM)) / 8000.0
-                    + aerosol_optical_depth(np.asarray(PEAK_NM), beta=self.sky.turbidity) / 1200.0)
-            trans = np.exp(-beta * t[hit, None])
-            az = np.arctan2(d[hit, 1], d[hit, 0])
-            horizon = band_sky_radiance(self.sky, direction_from_angles(az, np.deg2rad(2.0)), origin_m=origin_xy)
-            out[hit] = rad * trans + horizon * (1 - trans)
-        return out.reshape(shape + (5,)), sky.reshape(shape)
+        sun_up = self.sky.sun_direction[2] > 0
+        hits = trace_surfaces(self._lit_geometry(), o, d, light=0 if sun_up else -1)
+        surface = self._surface[np.maximum(hits["material"], 0)]
+        hit = np.isfinite(hits["depth"])
+        texture = np.ones(d.shape[0])
+        texture[hit] = self._texture(hits["point"][hit], surface[hit])
+        foliage = np.isin(surface, [self._mat_index[m] for m in FOLIAGE]) & hit
+        out = spectral_radiance(hits, d, spectra=self._spectra, surface=surface, texture=texture, foliage=foliage,
+                                sky=self.sky, illumination=self._illumination(), origin_m=tuple(o[:2]))
+        return out.reshape(shape + (5,)), (~hit).reshape(shape)
 
     def _bundle(self, pan, tilt, aperture):
         off = np.array([-1.0, 0.0, 1.0]) * aperture
