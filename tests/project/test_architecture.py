@@ -282,3 +282,38 @@ def test_the_concept_check_catches_a_second_definition(tmp_path):
     assert found == ["sun position: sun_position is defined a second time, in spectral/sky.py (its home: light/sun.py)",
                      "materials: 2 homes (light/materials.py, world/scene.py) and no note saying why",
                      "clouds: CloudLayer is not defined in light/clouds.py"]
+
+
+#: names that are a protocol several modules implement, not one concept: an experiment's or tool's
+#: ``run``, a ``__main__``'s ``main``, a split experiment's ``merge`` and an entry point's ``register``
+PROTOCOL_NAMES = {"run", "main", "merge", "register"}
+
+
+def public_definitions(package_root: Path) -> dict[str, list[str]]:
+    """Public module-level ``def``/``class`` name -> the modules of ``package_root`` that define it."""
+    found: dict[str, list[str]] = {}
+    for path in sorted(package_root.rglob("*.py")):
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and not node.name.startswith("_"):
+                found.setdefault(node.name, []).append(str(path.relative_to(package_root.parent)))
+    return found
+
+
+def names_defined_twice(package_root: Path) -> dict[str, list[str]]:
+    return {name: homes for name, homes in public_definitions(package_root).items()
+            if len(homes) > 1 and name not in PROTOCOL_NAMES}
+
+
+def test_each_public_name_means_one_thing():
+    twice = names_defined_twice(ROOT / "bionav")
+    assert not twice, "public names defined in more than one module (rename one, or fold them): " + "; ".join(
+        f"{name}: {', '.join(homes)}" for name, homes in sorted(twice.items()))
+
+
+def test_a_public_name_defined_twice_is_found(tmp_path):
+    package = tmp_path / "pkg"
+    (package / "a").mkdir(parents=True)
+    (package / "a" / "x.py").write_text("def solve():\n    pass\n\ndef run():\n    pass\n")
+    (package / "y.py").write_text("class Solve:\n    pass\n\ndef solve():\n    pass\n\ndef run():\n    pass\n\ndef _private():\n    pass\n")
+    (package / "z.py").write_text("def _private():\n    pass\n")
+    assert names_defined_twice(package) == {"solve": ["pkg/a/x.py", "pkg/y.py"]}
