@@ -140,6 +140,52 @@ def _sample_texture(tex, tex_id, size, uu, vv, lod):
     return v0 * (1.0 - fr) + v1 * fr
 
 
+@njit(cache=True, inline="always")
+def _texture_value(m, t, u, v, eu, ev, cosi, pix_angle, mat_tex, mat_fit, mat_scale, tex, tex_size):
+    """Texture value of material ``m`` at surface coordinates ``(u, v)`` (metres) seen at distance ``t``
+    under incidence cosine ``cosi``: the mip level follows the pixel's footprint (``cosi`` floored at 0.2);
+    a fitted material spans its face (``eu``, ``ev``), else it repeats every ``mat_scale`` metres."""
+    if mat_fit[m] > 0.5:
+        su = eu
+        sv = ev
+    else:
+        su = mat_scale[m, 0]
+        sv = mat_scale[m, 1]
+    if cosi < 0.2:
+        cosi = 0.2
+    foot = t * pix_angle / cosi
+    texel = foot * tex_size / min(su, sv)
+    lod = math.log2(texel) if texel > 1e-9 else 0.0
+    return _sample_texture(tex, mat_tex[m], tex_size, u / su, v / sv, lod)
+
+
+@njit(cache=True, inline="always")
+def _light_at(k, light_params, hx, hy, hz, nx, ny, nz):
+    """Light ``k`` at surface point ``h`` with normal ``n``: unit direction to the light, the shadow ray's
+    length (inf for the sun) and the irradiance factor (cosine, a spot's downward lobe, 1/d^2 for point lights)."""
+    if light_params[k, 0] < 0.5:
+        lx = light_params[k, 1] - hx
+        ly = light_params[k, 2] - hy
+        lz = light_params[k, 3] - hz
+        d2 = lx * lx + ly * ly + lz * lz
+        dist = math.sqrt(d2)
+        lx /= dist
+        ly /= dist
+        lz /= dist
+        tmax = dist - 1e-3
+        fac = nx * lx + ny * ly + nz * lz
+        if light_params[k, 4] > 0.5:
+            fac *= lz if lz > 0.0 else 0.0
+        fac /= max(d2, 1e-4)
+    else:
+        lx = light_params[k, 1]
+        ly = light_params[k, 2]
+        lz = light_params[k, 3]
+        tmax = INF
+        fac = nx * lx + ny * ly + nz * lz
+    return lx, ly, lz, tmax, fac
+
+
 @njit(cache=True, parallel=True)
 def render_kernel(ox, oy, oz, az, el, pix_angle,
                   boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
@@ -179,19 +225,8 @@ def render_kernel(ox, oy, oz, az, el, pix_angle,
             hx, hy, hz, nx, ny, nz, u, v, eu, ev = _surface(kind, idx, face, t, ox, oy, oz, dx, dy, dz,
                                                             boxes, frusta, ells)
             m = _material(kind, idx, face, box_mats, frustum_mats, ell_mats)
-            if mat_fit[m] > 0.5:
-                su = eu
-                sv = ev
-            else:
-                su = mat_scale[m, 0]
-                sv = mat_scale[m, 1]
-            cosi = abs(nx * dx + ny * dy + nz * dz)
-            if cosi < 0.2:
-                cosi = 0.2
-            foot = t * pix_angle / cosi
-            texel = foot * tex_size / min(su, sv)
-            lod = math.log2(texel) if texel > 1e-9 else 0.0
-            tv = _sample_texture(tex, mat_tex[m], tex_size, u / su, v / sv, lod)
+            tv = _texture_value(m, t, u, v, eu, ev, abs(nx * dx + ny * dy + nz * dz), pix_angle,
+                                mat_tex, mat_fit, mat_scale, tex, tex_size)
             wup = 0.5 * (1.0 + nz)
             for c in range(C):
                 E[c] = amb_down[c] + (amb_up[c] - amb_down[c]) * wup
@@ -209,26 +244,7 @@ def render_kernel(ox, oy, oz, az, el, pix_angle,
                 best_k = -1
                 bx = by = bz = bt = 0.0
                 while k < nl and light_params[k, 5] == grp:
-                    if light_params[k, 0] < 0.5:
-                        lx = light_params[k, 1] - hx
-                        ly = light_params[k, 2] - hy
-                        lz = light_params[k, 3] - hz
-                        d2 = lx * lx + ly * ly + lz * lz
-                        dist = math.sqrt(d2)
-                        lx /= dist
-                        ly /= dist
-                        lz /= dist
-                        tmax = dist - 1e-3
-                        fac = nx * lx + ny * ly + nz * lz
-                        if light_params[k, 4] > 0.5:
-                            fac *= lz if lz > 0.0 else 0.0
-                        fac /= max(d2, 1e-4)
-                    else:
-                        lx = light_params[k, 1]
-                        ly = light_params[k, 2]
-                        lz = light_params[k, 3]
-                        tmax = INF
-                        fac = nx * lx + ny * ly + nz * lz
+                    lx, ly, lz, tmax, fac = _light_at(k, light_params, hx, hy, hz, nx, ny, nz)
                     if fac > 0.0:
                         for c in range(C):
                             Eg[c] += light_power[k, c] * fac
