@@ -317,3 +317,56 @@ def test_a_public_name_defined_twice_is_found(tmp_path):
     (package / "y.py").write_text("class Solve:\n    pass\n\ndef solve():\n    pass\n\ndef run():\n    pass\n\ndef _private():\n    pass\n")
     (package / "z.py").write_text("def _private():\n    pass\n")
     assert names_defined_twice(package) == {"solve": ["pkg/a/x.py", "pkg/y.py"]}
+
+
+MAX_MODULE_LINES = 600
+MAX_FUNCTION_CODE_LINES = 80
+
+
+def code_lines(source: str, node: ast.AST) -> int:
+    """Lines of a function that hold code: not blank, not only a comment, not its docstring."""
+    import io
+    import tokenize
+
+    body = getattr(node, "body", [])
+    doc = None
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
+            and isinstance(body[0].value.value, str):
+        doc = range(body[0].lineno, body[0].end_lineno + 1)
+    text = "\n".join(source.splitlines()[node.lineno - 1:node.end_lineno]) + "\n"
+    skip = (tokenize.COMMENT, tokenize.NL, tokenize.NEWLINE, tokenize.INDENT, tokenize.DEDENT, tokenize.ENDMARKER)
+    lines = set()
+    for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+        if tok.type in skip:
+            continue
+        lines.update(n + node.lineno - 1 for n in range(tok.start[0], tok.end[0] + 1))
+    return len([n for n in lines if doc is None or n not in doc])
+
+
+def oversized(package_root: Path) -> list[str]:
+    """Modules over :data:`MAX_MODULE_LINES` lines and functions over :data:`MAX_FUNCTION_CODE_LINES` lines of code."""
+    found = []
+    for path in sorted(package_root.rglob("*.py")):
+        source = path.read_text(encoding="utf-8")
+        where = path.relative_to(package_root.parent)
+        if len(source.splitlines()) > MAX_MODULE_LINES:
+            found.append(f"{where}: {len(source.splitlines())} lines")
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                n = code_lines(source, node)
+                if n > MAX_FUNCTION_CODE_LINES:
+                    found.append(f"{where}:{node.lineno} {node.name}: {n} lines of code")
+    return found
+
+
+def test_modules_and_functions_stay_small():
+    assert oversized(ROOT / "bionav") == []
+
+
+def test_an_oversized_function_is_found(tmp_path):
+    package = tmp_path / "pkg"
+    package.mkdir()
+    long_body = "".join(f"    x{i} = {i}  # a comment\n\n" for i in range(81))
+    (package / "a.py").write_text(f'def f():\n    """Doc\n\n    string."""\n{long_body}    return 0\n')
+    (package / "b.py").write_text('def g():\n    """Doc."""\n' + "    # only comments\n" * 200 + "    return 0\n")
+    assert oversized(package) == ["pkg/a.py:1 f: 83 lines of code"]  # def + 81 assignments + return
