@@ -314,7 +314,8 @@ def test_a_public_name_defined_twice_is_found(tmp_path):
     package = tmp_path / "pkg"
     (package / "a").mkdir(parents=True)
     (package / "a" / "x.py").write_text("def solve():\n    pass\n\ndef run():\n    pass\n")
-    (package / "y.py").write_text("class Solve:\n    pass\n\ndef solve():\n    pass\n\ndef run():\n    pass\n\ndef _private():\n    pass\n")
+    (package / "y.py").write_text("class Solve:\n    pass\n\ndef solve():\n    pass\n\n"
+                                  "def run():\n    pass\n\ndef _private():\n    pass\n")
     (package / "z.py").write_text("def _private():\n    pass\n")
     assert names_defined_twice(package) == {"solve": ["pkg/a/x.py", "pkg/y.py"]}
 
