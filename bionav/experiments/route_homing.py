@@ -79,13 +79,11 @@ PATH_SCHEMA = {
 
 
 def route_homing_config(cfg: DictConfig) -> RouteHomingConfig:
-    """The typed, range-checked ``experiment`` node (:class:`~bionav.experiments.configs.RouteHomingConfig`)."""
+    """The typed, range-checked ``experiment`` node (:class:`~bionav.experiments.configs.RouteHomingConfig`,
+    ``offsets_m`` with 0 checked by its ``validate``), ``agent_step_m`` defaulting to the protocol's."""
     exp = OmegaConf.to_object(experiment_config(cfg, "route_homing"))
     if exp.agent_step_m is None:
         exp.agent_step_m = PROTOCOL_STEP_M[exp.protocol]
-    if 0.0 not in exp.offsets_m:
-        raise UserError(f"experiment.offsets_m={exp.offsets_m} must include 0 (the route itself), "
-                        "e.g. experiment.offsets_m=[-0.2,0.0,0.2].")
     return exp
 
 
