@@ -31,6 +31,10 @@ Plugin configs (:func:`bionav.config.plugin_config`), the ``db`` node
 (:func:`bionav.experiments.configs.experiment_config`) and the other typed
 groups all go through it; the command line runs all of them before a run
 directory is created, and nothing downstream re-checks or re-casts a value.
+A class that also accepts instances from Python code (``HomingMethod(config,
+...)``) checks them with :func:`checked_config`, which skips an instance
+:func:`typed_config` has already checked (unless its values changed since), so
+each value is checked once on either door.
 
 :func:`check_allocation` bounds an array allocation against the memory of
 the machine before it is made.
@@ -267,6 +271,53 @@ def check_config(config: Any, *, prefix: str) -> Any:
     return config
 
 
+#: attribute :func:`typed_config` leaves on the instances it checked: their values then (``dataclasses.astuple``)
+_CHECKED_VALUES = "_bionav_checked_values"
+
+
+def _mark_checked(config: Any) -> None:
+    """Remember that ``config`` (and every nested config in it) passed :func:`typed_config` with these values."""
+    for field in dataclasses.fields(config):
+        value = getattr(config, field.name, None)
+        if dataclasses.is_dataclass(value) and not isinstance(value, type):
+            _mark_checked(value)
+    try:
+        object.__setattr__(config, _CHECKED_VALUES, dataclasses.astuple(config))
+    except (AttributeError, TypeError):  # a dataclass with __slots__: checked again where it is used
+        pass
+
+
+def checked_config(config: Any, *, prefix: str) -> Any:
+    """``config`` with its declared ranges checked, once: the check of classes that also take Python instances.
+
+    An instance that :func:`typed_config` returned (the command line, a
+    config file) and whose values have not changed since is handed back as it
+    is; any other instance (built in Python, or changed after it was checked)
+    goes through :func:`check_config`.
+
+    Parameters
+    ----------
+    config : dataclass instance
+        The config.
+    prefix : str
+        The key of the config as the user types it (``homing``), named in messages.
+
+    Returns
+    -------
+    The same ``config``.
+
+    Raises
+    ------
+    UserError
+        As :func:`check_config`.
+    """
+    if dataclasses.is_dataclass(config) and not isinstance(config, type):
+        seen = getattr(config, _CHECKED_VALUES, None)
+        if seen is not None and seen == dataclasses.astuple(config):
+            return config
+    return check_config(config, prefix=prefix)
+
+
 def unknown_key_message(node: str, bad: str, valid: Sequence[str], *, what: str | None = None) -> str:
     """One paragraph for a misspelt key: the key, the valid keys of its node, the closest one.
 
@@ -413,6 +464,8 @@ def typed_config(node: Any, schema: type, *, key: str, what: str | None = None, 
     validate = getattr(instance, "validate", None)
     if callable(validate):
         validate()
+    if dataclasses.is_dataclass(instance):
+        _mark_checked(instance)
     return instance
 
 

@@ -441,7 +441,7 @@ def _camera_configs(spec: SyntheticSpec, camera, pose_error, geometry: PanoramaG
     """Validated camera and pose-error configs of ``realism="camera"`` (defaults: the stand-in's own)."""
     from bionav.db.camera import camera_config_for, pose_error_config_for
     from bionav.db.config import CameraConfig, PoseErrorConfig
-    from bionav.validation import check_config
+    from bionav.validation import checked_config
 
     if camera is None:
         camera = camera_config_for(spec.mirror)
@@ -451,8 +451,8 @@ def _camera_configs(spec: SyntheticSpec, camera, pose_error, geometry: PanoramaG
         pose_error = pose_error_config_for(spec.positions_from)
     elif not isinstance(pose_error, PoseErrorConfig):
         pose_error = PoseErrorConfig(**dict(pose_error))
-    check_config(camera, prefix="db.camera")
-    check_config(pose_error, prefix="db.pose_error")
+    checked_config(camera, prefix="db.camera")  # built here or in Python; a typed db node's were checked once
+    checked_config(pose_error, prefix="db.pose_error")
     xi, rim = float(camera.mirror_xi), float(camera.rim_elevation_deg)
     if not np.sin(np.radians(rim)) < xi:
         raise UserError(f"db.camera.mirror_xi={xi:g} must exceed sin(db.camera.rim_elevation_deg)="

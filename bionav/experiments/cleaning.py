@@ -402,7 +402,8 @@ def make_vision_homing(cfg: DictConfig, world: CleaningWorld):
 def replay_log(path, *, runs: list[int] | None = None) -> dict[int, Any]:
     """Replay the runs of a cleaning ``run.mcap`` through freshly built controllers.
 
-    The resolved config attached to the log rebuilds the layout, the world
+    The resolved config attached to the log (keys of earlier versions read as
+    today's: :func:`~bionav.experiments.configs.config_from_recorded`) rebuilds the layout, the world
     (its camera re-creates images that were not logged), the homing method
     and the controller; :func:`bionav.robot.recording.replay_episode` then
     checks every command.
@@ -418,13 +419,16 @@ def replay_log(path, *, runs: list[int] | None = None) -> dict[int, Any]:
         At the first difference.
     """
     from bionav.config import plugin_config
-    from bionav.logs.reader import read_attachment, read_messages
+    from bionav.experiments.configs import config_from_recorded
+    from bionav.logs.reader import read_attachment, read_messages, read_metadata
     from bionav.robot.recording import load_logged_runs, replay_episode
 
     raw = read_attachment(path, "config.yaml")
     if raw is None:
         raise UserError(f"{path} has no attached config.yaml; it was not written by `python -m bionav`.")
-    cfg = OmegaConf.create(raw.decode())
+    recorded_by = read_metadata(path).get("plugins", {}).get("bionav")
+    cfg = config_from_recorded(OmegaConf.create(raw.decode()), source=str(path),
+                               recorded_by=recorded_by and f"bionav {recorded_by}")
     if cfg.experiment.name != "cleaning":
         raise UserError(f"{path} is a log of experiment={cfg.experiment.name}, not of experiment=cleaning.")
     plan = plan_from_layout(cfg.layout)

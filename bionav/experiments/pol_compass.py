@@ -56,8 +56,6 @@ from bionav.files import write_csv_atomic
 from bionav.polcompass.compass import evector_from_compass_counts
 from bionav.polcompass.headings import pose_headings
 
-MODES = ("filter_test", "rotation", "vs_em_compass", "evector_scan", "partial_sky")
-
 
 # ---------------------------------------------------------------------------
 # processing shared by simulated, real and replayed sessions (after the ADC)
@@ -92,7 +90,7 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir, fixed=None):
     from bionav.polcompass import UnitCalibration, calibrate_from_rotation
 
     nominal = UnitCalibration.nominal(unit_angles)
-    how = str(exp.calibration)
+    how = exp.calibration
     if fixed is not None:  # sensor.calibration=FILE (or a replay of such a run) replaces experiment.calibration
         if fixed.get("kind") != "units" or not fixed.get("calibration"):
             raise UserError(f"The compass calibration {fixed.get('source')!r} is not a per-unit calibration of the "
@@ -111,12 +109,10 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir, fixed=None):
         cal = nominal
     elif how == "rotation":
         cal = calibrate_from_rotation(volts, pans, nominal=nominal)
-    elif how == "file":
+    else:  # "file" (experiment.calibration's declared choices)
         if not exp.calibration_path:
             raise UserError("experiment.calibration=file needs experiment.calibration_path=<calibration.json of a rotation run>.")
         cal = UnitCalibration.load(exp.calibration_path)
-    else:
-        raise UserError(f"experiment.calibration={how!r} is unknown; choose auto, rotation, nominal or file.")
     if out_dir is not None:
         cal.save(out_dir / "calibration.json")
     return cal, how
@@ -126,7 +122,7 @@ def _pan_grid(session: CompassSession, exp, step_deg: float):
     lo, hi, tlo, thi = session.pantilt.limits()
     rng = exp.pan_range_deg
     if rng is not None:
-        lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
+        lo, hi = max(lo, np.deg2rad(rng[0])), min(hi, np.deg2rad(rng[1]))
     step = np.deg2rad(step_deg)
     n = int(np.floor((hi - lo) / step + 1e-9)) + 1
     return lo + step * np.arange(n), (tlo, thi)
@@ -167,20 +163,20 @@ def rotation_mode(session: CompassSession, exp, *, unit_angles, plots=None, out_
     from bionav.experiments import pol_compass_plots as plots_mod
     from bionav.polcompass import CompassOptics, EvectorPredictor, counts_to_volts, heading_errors
 
-    tilt = 0.0 if filter_test else np.deg2rad(float(exp.tilt_deg))
-    pans_cmd, tilt_limits = _pan_grid(session, exp, float(exp.step_deg))
+    tilt = 0.0 if filter_test else np.deg2rad(exp.tilt_deg)
+    pans_cmd, tilt_limits = _pan_grid(session, exp, exp.step_deg)
     _check_tilt(tilt, tilt_limits)
     pans, tilts, readings, _, index = _scan(
-        session, [(p, tilt) for p in pans_cmd], int(exp.samples_per_step), desc="filter test" if filter_test else "rotation"
+        session, [(p, tilt) for p in pans_cmd], exp.samples_per_step, desc="filter test" if filter_test else "rotation"
     )
     counts = counts_of(readings)
     volts = counts_to_volts(counts)
     cal, how = _calibration(exp, volts, pans, tilts, unit_angles=unit_angles, out_dir=out_dir,
                             fixed=session.fixed_calibration)
-    angle, degree, x = evector_from_compass_counts(counts, cal, solver=str(exp.solver))
+    angle, degree, x = evector_from_compass_counts(counts, cal, solver=exp.solver)
     predictor = EvectorPredictor(sky_model(exp.sky, session.sun), CompassOptics(unit_angles=tuple(cal.unit_angles)))
     heading, resolved = pose_headings(
-        angle, x, tilts, sun=session.sun, predictor=predictor, unit_angles=cal.unit_angles, margin=float(exp.ambiguity_margin)
+        angle, x, tilts, sun=session.sun, predictor=predictor, unit_angles=cal.unit_angles, margin=exp.ambiguity_margin
     )
     axial = bool(filter_test or not np.all(resolved))
     errors = heading_errors(heading, pans, axial=axial)
@@ -213,15 +209,15 @@ def vs_em_mode(session: CompassSession, exp, *, unit_angles, plots=None, out_dir
     lo, hi, tlo, thi = session.pantilt.limits()
     rng = exp.pan_range_deg
     if rng is not None:
-        lo, hi = max(lo, np.deg2rad(float(rng[0]))), min(hi, np.deg2rad(float(rng[1])))
-    positions = np.linspace(lo, hi, int(exp.vs_em.positions))
+        lo, hi = max(lo, np.deg2rad(rng[0])), min(hi, np.deg2rad(rng[1]))
+    positions = np.linspace(lo, hi, exp.vs_em.positions)
     pans, tilts, readings, refs, index = _scan(
-        session, [(p, 0.0) for p in positions], int(exp.vs_em.samples), desc="vs TCM2", with_reference=True
+        session, [(p, 0.0) for p in positions], exp.vs_em.samples, desc="vs TCM2", with_reference=True
     )
     counts = counts_of(readings)
     cal, how = _calibration(exp, counts_to_volts(counts), pans, tilts, unit_angles=unit_angles, out_dir=out_dir,
                             fixed=session.fixed_calibration)
-    angle, _, _ = evector_from_compass_counts(counts, cal, solver=str(exp.solver))
+    angle, _, _ = evector_from_compass_counts(counts, cal, solver=exp.solver)
     pol = np.asarray(zenith_heading(angle, sun_azimuth=session.sun.azimuth))
     tcm2 = np.asarray(compass_to_azimuth(np.deg2rad([r["heading_deg"] for r in refs])))
     errors = heading_errors(pol, tcm2, axial=True)
@@ -247,7 +243,7 @@ def _scan_poses(session: CompassSession, node, *, pan_step_deg: float):
     lo, hi, tlo, thi = session.pantilt.limits()
     step = np.deg2rad(pan_step_deg)
     pans = lo + step * np.arange(int(np.floor((hi - lo) / step + 1e-9)) + 1)
-    tilts = np.deg2rad(np.asarray(list(node.tilts_deg), float))
+    tilts = np.deg2rad(np.asarray(node.tilts_deg, float))
     for t in tilts:
         _check_tilt(t, (tlo, thi))
     return [(p, t) for t in tilts for p in pans]
@@ -259,12 +255,12 @@ def evector_scan_mode(session: CompassSession, exp, *, unit_angles, plots=None, 
     from bionav.geometry import wrap_axial
     from bionav.polcompass import CompassOptics, EvectorPredictor, fit_scan_heading
 
-    poses = _scan_poses(session, exp.scan, pan_step_deg=float(exp.scan.pan_step_deg))
+    poses = _scan_poses(session, exp.scan, pan_step_deg=exp.scan.pan_step_deg)
     cal = _rotation_calibration(session, exp, unit_angles=unit_angles, out_dir=out_dir)
-    pans, tilts, readings, _, index = _scan(session, poses, int(exp.scan.samples), desc="e-vector scan")
-    angle, degree, _ = evector_from_compass_counts(counts_of(readings), cal, solver=str(exp.solver))
+    pans, tilts, readings, _, index = _scan(session, poses, exp.scan.samples, desc="e-vector scan")
+    angle, degree, _ = evector_from_compass_counts(counts_of(readings), cal, solver=exp.solver)
     predictor = EvectorPredictor(sky_model(exp.sky, session.sun), CompassOptics(unit_angles=tuple(cal.unit_angles)))
-    fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=float(exp.min_degree))
+    fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=exp.min_degree)
     model_angle, model_degree = predictor.at(fit.heading + pans, tilts)
     residual = wrap_axial(angle - model_angle)
     rmse = float(np.degrees(np.sqrt(np.mean(residual**2))))
@@ -306,7 +302,7 @@ def _rotation_calibration(session: CompassSession, exp, *, unit_angles, out_dir)
     """
     from bionav.polcompass import UnitCalibration, counts_to_volts
 
-    how = str(exp.calibration)
+    how = exp.calibration
     if session.fixed_calibration is not None:
         return _calibration(exp, None, None, None, unit_angles=unit_angles, out_dir=out_dir,
                             fixed=session.fixed_calibration)[0]
@@ -314,7 +310,7 @@ def _rotation_calibration(session: CompassSession, exp, *, unit_angles, out_dir)
         return UnitCalibration.nominal(unit_angles)
     if how == "file":
         return _calibration(exp, None, None, None, unit_angles=unit_angles, out_dir=out_dir)[0]
-    pans_cmd, _ = _pan_grid(session, exp, float(exp.step_deg))
+    pans_cmd, _ = _pan_grid(session, exp, exp.step_deg)
     pans, tilts, readings, _, _ = _scan(session, [(p, 0.0) for p in pans_cmd], 1, desc=None)
     return _calibration(exp, counts_to_volts(counts_of(readings)), pans, tilts, unit_angles=unit_angles, out_dir=out_dir)[0]
 
@@ -332,24 +328,24 @@ def partial_sky_mode(session: CompassSession, exp, *, unit_angles, rng_scene, pl
             "(or sensor=replay pantilt=replay with the log of such a run)."
         )
     node = exp.partial
-    poses = _scan_poses(session, node, pan_step_deg=float(node.pan_step_deg))
+    poses = _scan_poses(session, node, pan_step_deg=node.pan_step_deg)
     session.scene.source = sky_model(exp.sky, session.sun)  # calibrate under the configured (clear) sky
     cal = _rotation_calibration(session, exp, unit_angles=unit_angles, out_dir=out_dir)
     optics = CompassOptics(unit_angles=tuple(cal.unit_angles))
     rows = []
-    conditions = [(float(e), float(c)) for e in node.sun_elevations_deg for c in node.cloud_covers]
-    trials = int(node.trials)
+    conditions = [(e, c) for e in node.sun_elevations_deg for c in node.cloud_covers]
+    trials = node.trials
     for elevation_deg, cover in session.progress(conditions, desc="partial sky", total=len(conditions)):
-        sun = SunPosition(np.deg2rad(float(exp.sky.sun_azimuth_deg)), np.deg2rad(elevation_deg))
+        sun = SunPosition(np.deg2rad(exp.sky.sun_azimuth_deg), np.deg2rad(elevation_deg))
         predictor = EvectorPredictor(sky_model(exp.sky, sun), optics)
         for trial in range(trials):
             clouds = cloud_field(exp.sky, rng_scene, cover=cover)
             session.scene.source = sky_model(exp.sky, sun, clouds=clouds)
             session.scene.mount_heading = float(rng_scene.uniform(-np.pi, np.pi))
             clear = 1.0 if clouds is None else clouds.clear_fraction()
-            pans, tilts, readings, _, _ = _scan(session, poses, int(node.samples), desc=None)
-            angle, degree, _ = evector_from_compass_counts(counts_of(readings), cal, solver=str(exp.solver))
-            fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=float(exp.min_degree))
+            pans, tilts, readings, _, _ = _scan(session, poses, node.samples, desc=None)
+            angle, degree, _ = evector_from_compass_counts(counts_of(readings), cal, solver=exp.solver)
+            fit = fit_scan_heading(angle, degree, pans, tilts, predictor=predictor, min_degree=exp.min_degree)
             zen = np.abs(tilts) < 1e-12
             zen_heading = zenith_heading(angle[zen], sun_azimuth=sun.azimuth) - pans[zen]
             zen_err = np.abs(wrap_axial(zen_heading - session.scene.mount_heading))
@@ -411,9 +407,7 @@ def run_session(exp, devices: dict, *, write, rng, scene=None, plots=None, out_d
     """
     if not (isinstance(exp, DictConfig) and OmegaConf.get_type(exp) is not dict):  # defaults and ranges
         exp = experiment_config(OmegaConf.create({"experiment": exp}), "pol_compass")
-    mode = str(exp.mode)
-    if mode not in MODES:
-        raise UserError(f"mode {mode!r} is unknown; choose one of {', '.join(MODES)} (mode=<name>).")
+    mode = exp.mode
     sensor = devices["sensor"]
     recorded = None
     if hasattr(sensor, "recorded"):
@@ -449,12 +443,12 @@ def simulation_parameters(exp, sensor) -> dict:
     from bionav.experiments.pol_compass_session import FITTED_MAX_DEGREE
 
     sky = exp.sky
-    how = str(sky.get("parameters", "fitted"))
+    how = sky.parameters
     max_degree = sky.get("max_degree")
     if max_degree is None:
         from bionav.light import max_degree_from_turbidity
 
-        max_degree = FITTED_MAX_DEGREE if how == "fitted" else max_degree_from_turbidity(float(sky.turbidity))
+        max_degree = FITTED_MAX_DEGREE if how == "fitted" else max_degree_from_turbidity(sky.turbidity)
     info = {"sim_parameters": how, "sim_max_degree": float(max_degree)}
     config = getattr(sensor, "config", None)
     for key in ("angle_sigma_deg", "sensitivity_sigma", "gain_sigma", "noise_v"):
@@ -473,12 +467,12 @@ def _run_mode(session, exp, devices, mode, *, scene, rng, plots, out_dir) -> dic
             raise UserError(f"recorded array counts support mode=rotation only, not mode={mode}.")
         return recorded_rotation_mode(session, exp, sensor_config=devices["array_config"], decoder=devices["decoder"],
                                       plots=plots)
-    unit_angles = np.deg2rad(np.asarray(list(exp.unit_angles_deg), float))
+    unit_angles = np.deg2rad(np.asarray(exp.unit_angles_deg, float))
     if scene is not None and mode != "partial_sky":
         from bionav.light import PolarizerLamp
 
         if mode == "filter_test":
-            scene.source = PolarizerLamp(np.deg2rad(float(exp.filter.axis_deg)), float(exp.filter.efficiency))
+            scene.source = PolarizerLamp(np.deg2rad(exp.filter.axis_deg), exp.filter.efficiency)
         else:
             scene.source = sky_model(exp.sky, sun, clouds=cloud_field(exp.sky, rng))
     kwargs = {"unit_angles": unit_angles, "plots": plots, "out_dir": out_dir}
@@ -523,7 +517,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     nodes = {
         "sensor": _node_dict(cfg.sensor),
         "pantilt": _node_dict(cfg.get("pantilt")) if cfg.get("pantilt") and cfg.pantilt.get("name") else None,
-        "reference": _node_dict(exp.reference) if str(exp.mode) == "vs_em_compass" else None,
+        "reference": _node_dict(exp.reference) if exp.mode == "vs_em_compass" else None,
     }
     rng_scene, rng_sensor, rng_reference, rng_fakes = ctx.rng.spawn(4)
     from bionav import registry
@@ -534,16 +528,16 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
 
     classes = {role: registry.load_plugin("sensor", node["name"]) for role, node in nodes.items() if node is not None}
     simulated = any(getattr(c, "simulated", False) for c in classes.values())
-    fake_devices = bool(exp.fake_devices)
-    needs_scene = simulated or fake_devices or str(exp.mode) == "partial_sky"
+    fake_devices = exp.fake_devices
+    needs_scene = simulated or fake_devices or exp.mode == "partial_sky"
     scene = None
     if needs_scene:
         from bionav.light import SkyModel, SunPosition
 
         scene = CompassScene(
             SkyModel(SunPosition(0.0, np.pi / 4)),  # replaced by the mode's source
-            mount_heading=np.deg2rad(float(exp.sky.mount_heading_deg)),
-            magnetic_declination=np.deg2rad(float(exp.sky.magnetic_declination_deg)),
+            mount_heading=np.deg2rad(exp.sky.mount_heading_deg),
+            magnetic_declination=np.deg2rad(exp.sky.magnetic_declination_deg),
         )
     with ExitStack() as stack:
         if fake_devices:

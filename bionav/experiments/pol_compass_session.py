@@ -146,37 +146,38 @@ def resolve_sun(sky, *, recorded_session: dict | None):
         ), recorded_session.get("time_utc")
     time = sky.get("time")
     if time is None:
-        return SunPosition(np.deg2rad(float(sky.sun_azimuth_deg)), np.deg2rad(float(sky.sun_elevation_deg))), None
-    when = _dt.datetime.now(_dt.timezone.utc) if str(time) == "now" else str(time)
-    sun = sun_position(when, latitude_deg=float(sky.latitude_deg), longitude_deg=float(sky.longitude_deg))
+        return SunPosition(np.deg2rad(sky.sun_azimuth_deg), np.deg2rad(sky.sun_elevation_deg)), None
+    when = _dt.datetime.now(_dt.timezone.utc) if time == "now" else time
+    sun = sun_position(when, latitude_deg=sky.latitude_deg, longitude_deg=sky.longitude_deg)
 
     return sun, parse_time(when).astimezone(_dt.timezone.utc).isoformat()
 
 
 def sky_model(sky, sun, *, clouds=None):
-    """The :class:`~bionav.light.SkyModel` the ``experiment.sky`` node describes."""
+    """The :class:`~bionav.light.SkyModel` the typed ``experiment.sky`` node
+    (:class:`~bionav.experiments.configs.PolSkyConfig`) describes."""
     from bionav.light import SkyModel, max_degree_from_turbidity
 
     max_degree = sky.get("max_degree")
     if max_degree is None:
-        fitted = str(sky.get("parameters", "fitted")) == "fitted"
-        max_degree = FITTED_MAX_DEGREE if fitted else max_degree_from_turbidity(float(sky.turbidity))
+        fitted = sky.parameters == "fitted"
+        max_degree = FITTED_MAX_DEGREE if fitted else max_degree_from_turbidity(sky.turbidity)
     return SkyModel(
         sun,
         max_degree=float(max_degree),
-        neutral_point_separation=np.deg2rad(float(sky.neutral_point_separation_deg)),
+        neutral_point_separation=np.deg2rad(sky.neutral_point_separation_deg),
         clouds=clouds,
     )
 
 
 def cloud_field(sky, rng, *, cover: float | None = None):
-    """A cloud field for ``experiment.sky`` (None for a clear sky)."""
+    """A cloud field for the typed ``experiment.sky`` node (None for a clear sky)."""
     from bionav.light import random_cloud_map
 
-    cover = float(sky.cloud_cover) if cover is None else float(cover)
+    cover = sky.cloud_cover if cover is None else float(cover)
     if cover <= 0.0:
         return None
-    return random_cloud_map(rng, cover=cover, correlation_length=np.deg2rad(float(sky.cloud_correlation_deg)))
+    return random_cloud_map(rng, cover=cover, correlation_length=np.deg2rad(sky.cloud_correlation_deg))
 
 
 def start_fakes(stack: ExitStack, nodes: dict, scene, rng) -> dict:

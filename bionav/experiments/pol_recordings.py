@@ -148,7 +148,7 @@ def _decoders(cfg, ctx, exp) -> tuple[str, dict]:
             "experiment=pol_recordings needs a decoder; choose one with decoder=<name> (python -m bionav.plugins lists them)."
         )
     chosen = str(cfg.decoder.name)
-    names = [chosen] + [str(n) for n in exp.compare if str(n) != chosen]
+    names = [chosen] + [n for n in exp.compare if n != chosen]
     return chosen, {n: _decoder(ctx, cfg, n) for n in names}
 
 
@@ -161,7 +161,7 @@ def _calibration_for(prepared, rc, ctx, decoder):
     """
     from dataclasses import replace
 
-    how = str(rc.calibration)
+    how = rc.calibration
     tilt = "tilt" in rc.calibration_parts
     if how == "auto":
         estimates = self_calibrate(prepared, rc, progress=ctx.progress)
@@ -338,10 +338,10 @@ def _condition_metrics(tally: _Tally, pooled_rows, chosen) -> dict:
 
 def _sim_metrics(exp, tally: _Tally) -> dict:
     """The simulation's parameters and ``sim_<condition>_mae_deg``."""
-    metrics = {"sim_repeats": int(exp.sim_repeats)}
+    metrics = {"sim_repeats": exp.sim_repeats}
     for key in ("sim_gain_sigma", "sim_angle_sigma_deg", "sim_noise", "sim_canopy_cover", "sim_max_degree",
                 "sim_view_sigma", "sim_tilt_sigma_deg", "sim_azimuth_sigma_deg"):
-        metrics[key] = float(getattr(exp, key))
+        metrics[key] = getattr(exp, key)
     for g in GROUPS:
         if tally.sim_err[g]:
             metrics[f"sim_{g}_mae_deg"] = error_stats(np.concatenate(tally.sim_err[g]))["mae_deg"]
@@ -350,7 +350,7 @@ def _sim_metrics(exp, tally: _Tally) -> dict:
 
 def _metrics(rc, exp, tally: _Tally, pooled_rows, chosen, n_bad: int) -> dict[str, Any]:
     stats = error_stats(np.concatenate(tally.chosen_err))
-    how = str(rc.calibration)
+    how = rc.calibration
     metrics: dict[str, Any] = {
         "decoder": chosen,
         "heading_mae_deg": stats["mae_deg"],
@@ -363,7 +363,7 @@ def _metrics(rc, exp, tally: _Tally, pooled_rows, chosen, n_bad: int) -> dict[st
         "decode_ms_per_session_max": float(1000.0 * max(tally.decode_times)),
         "n_bad_files": n_bad,
         "calibration": how if how in ("auto", "none") else "file",
-        "calibration_parts": list(rc.calibration_parts),
+        "calibration_parts": rc.calibration_parts,
     }
     metrics.update(_condition_metrics(tally, pooled_rows, chosen))
     if exp.simulate:

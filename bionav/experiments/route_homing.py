@@ -79,13 +79,11 @@ PATH_SCHEMA = {
 
 
 def route_homing_config(cfg: DictConfig) -> RouteHomingConfig:
-    """The typed, range-checked ``experiment`` node (:class:`~bionav.experiments.configs.RouteHomingConfig`)."""
+    """The typed, range-checked ``experiment`` node (:class:`~bionav.experiments.configs.RouteHomingConfig`,
+    ``offsets_m`` with 0 checked by its ``validate``), ``agent_step_m`` defaulting to the protocol's."""
     exp = OmegaConf.to_object(experiment_config(cfg, "route_homing"))
     if exp.agent_step_m is None:
         exp.agent_step_m = PROTOCOL_STEP_M[exp.protocol]
-    if not any(float(v) == 0.0 for v in exp.offsets_m):
-        raise UserError(f"experiment.offsets_m={list(exp.offsets_m)} must include 0 (the route itself), "
-                        "e.g. experiment.offsets_m=[-0.2,0.0,0.2].")
     return exp
 
 
@@ -263,7 +261,7 @@ def _setup_route(cfg: DictConfig, name: str) -> _RouteSetup:
     dbc = as_database_config(node)
     spec = MeshDatabaseSpec.from_config(dbc, grid=False)
     dense = load_route(name, dbc.routes_path).xy
-    _check_step_counts(name, dense, float(dbc.step_m))
+    _check_step_counts(name, dense, dbc.step_m)
     db = route_database(dbc, cache_dir=str(cfg.cache_dir))
     world = world_from_spec(spec)
     return _RouteSetup(name, world, db, np.asarray(db.meta["world_xy"]), np.asarray(db.headings), dense,
@@ -297,7 +295,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         from bionav.experiments.route_homing_ardin2016 import run_ardin2016
 
         return run_ardin2016(cfg, ctx, exp)
-    routes = list(exp.routes) or [str(cfg.db.route)]
+    routes = exp.routes or [str(cfg.db.route)]
     if exp.closed_loop:  # open-loop runs take no agent steps
         check_step_budget(routes, exp, _routes_path(cfg))
     rows = []
@@ -318,7 +316,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
             width = catchment_width(np.asarray(exp.offsets_m), err, threshold=np.deg2rad(exp.error_threshold_deg))
             row = {"route": name, "method": method, "n_snapshots": len(setup.xy),
                    "heading_error": float(np.nanmean(err)) if np.isfinite(err).any() else float("nan"),
-                   "heading_error_on_route": float(np.nanmean(err[:, list(exp.offsets_m).index(0.0)])),
+                   "heading_error_on_route": float(np.nanmean(err[:, exp.offsets_m.index(0.0)])),
                    "catchment_width_m": float(width.mean()), "invalid": int(np.isnan(err).sum())}
             res = {"stations": stations, "err": err, "est": est}
             if exp.closed_loop:

@@ -76,7 +76,7 @@ def _check_agent_params(exp: RouteHomingConfig, kinds: dict[str, str]) -> None:
     for name, params in exp.agent_params.items():
         if name not in kinds:
             raise UserError(f"experiment.agent_params names {name!r}, which is not in experiment.agents="
-                            f"{list(exp.agents)}; add it there or drop its parameters.")
+                            f"{exp.agents}; add it there or drop its parameters.")
         if not isinstance(params, dict):
             raise UserError(f"experiment.agent_params.{name} must be a mapping of parameters, e.g. "
                             "+experiment.agent_params.mushroom_body.n_kc=5000.")
@@ -115,8 +115,8 @@ def scan_geometry(exp: RouteHomingConfig):
     """
     from bionav.geometry import PanoramaGeometry
 
-    col = float(exp.scan_step_deg)
-    s = int(exp.supersample)
+    col = float(exp.scan_step_deg)  # an int of degrees (1, 2 or 4); the geometry takes a float
+    s = exp.supersample
     if s == 1:
         return PanoramaGeometry(int(round(360.0 / col)), 19, 14.5, math.radians(4.0)), col, 0.0
     fine = 4.0 / s
@@ -159,8 +159,8 @@ def _scan_renderer(setup: _RouteSetup, exp: RouteHomingConfig, rng: np.random.Ge
         if exp.supersample > 1:
             img = box_panorama(img, supersample=exp.supersample, column_deg=col)
         img = quantise(img, noise=setup.noise, rng=rng).astype(np.float32) / np.float32(255.0)
-        return scan_views(img, column_deg=col, scan_half_deg=half, scan_step_deg=float(exp.scan_step_deg),
-                          size=list(exp.view_size))
+        return scan_views(img, column_deg=col, scan_half_deg=half, scan_step_deg=col,
+                          size=exp.view_size)
 
     return views
 
@@ -170,10 +170,6 @@ def travel_headings(xy: np.ndarray) -> np.ndarray:
     d = np.diff(np.asarray(xy, np.float64), axis=0)
     h = np.arctan2(d[:, 1], d[:, 0])
     return np.append(h, h[-1]) if len(h) else np.zeros(len(xy))
-
-
-def _rng(seed: int, *parts: str) -> np.random.Generator:
-    return np.random.default_rng(np.random.SeedSequence([int(seed), *(zlib.crc32(p.encode()) for p in parts)]))
 
 
 def _rng(seed: int, *parts: str) -> np.random.Generator:
@@ -203,8 +199,8 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
     """``experiment.protocol=ardin2016``: the published route-following test for every agent, route and seed."""
     from bionav.evaluation.route import follow_route
 
-    routes = list(exp.routes) or list(ARDIN_ROUTES)
-    kinds = _agent_kinds(list(exp.agents))
+    routes = exp.routes or list(ARDIN_ROUTES)
+    kinds = _agent_kinds(exp.agents)
     _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, _routes_path(cfg))
     rows, paths, setups = [], {}, []
@@ -229,7 +225,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
                 timing[agent_name][0] += wall
                 timing[agent_name][1] += cpu
                 rows.append({"route": name, "agent": agent_name, "seed": int(seed),
-                             "position_jitter_m": float(exp.position_jitter_m), "errors": int(res.errors),
+                             "position_jitter_m": exp.position_jitter_m, "errors": int(res.errors),
                              "error_free": int(res.errors == 0), "reached_nest": int(res.reached_nest),
                              "steps": int(res.steps), "n_views": len(setup.xy), "cpu_s": cpu})
                 if seed == exp.seeds[0]:
@@ -242,9 +238,9 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
         from bionav.experiments.route_plots import plot_world_routes
 
         plot_world_routes(ctx.plots / "world_routes.png", setups[0].world, setups, paths)
-    return ardin_metrics(rows, routes=routes, agents=list(exp.agents), seeds=list(exp.seeds), timing=timing,
+    return ardin_metrics(rows, routes=routes, agents=exp.agents, seeds=exp.seeds, timing=timing,
                          extra={"db": str(cfg.db.name), "protocol": "ardin2016",
-                                "position_jitter_m": float(exp.position_jitter_m), "step_m": float(exp.agent_step_m)})
+                                "position_jitter_m": exp.position_jitter_m, "step_m": exp.agent_step_m})
 
 
 def ardin_metrics(rows: list[dict], *, routes: list[str], agents: list[str], seeds: list[int],

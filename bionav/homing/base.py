@@ -65,9 +65,10 @@ class HomingMethod:
     uses_test_steps: ClassVar[bool] = False
 
     def __init__(self, config: Any, *, geometry: PanoramaGeometry) -> None:
-        from bionav.validation import check_config
+        from bionav.validation import checked_config
 
-        self.config = check_config(config, prefix="homing")
+        # the Python API's check; a config from the command line (typed_config) was checked there, not again
+        self.config = checked_config(config, prefix="homing")
         self.geometry = geometry
 
     def prepare(self, image: np.ndarray) -> Any:

@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.errors import UserError
 from bionav.geometry import wrap_angle, wrap_axial
 
 
@@ -249,7 +248,8 @@ def evector_from_compass_counts(counts, calibration, *, solver: str = "least_squ
         10-bit counts (``V = count * 5 / 1023``).
     calibration : UnitCalibration
     solver : {'least_squares', 'two_unit'}
-        Three-unit least squares, or eqs. 4.4-4.5 on the first two units.
+        Three-unit least squares, or eqs. 4.4-4.5 on the first two units
+        (another value: ``ValueError``).
 
     Returns
     -------
@@ -266,6 +266,6 @@ def evector_from_compass_counts(counts, calibration, *, solver: str = "least_squ
         angle, degree = least_squares_evector(x, calibration.unit_angles)
     elif solver == "two_unit":
         angle, degree = two_unit_evector(x[:, 0], x[:, 1], calibration.unit_angles[0], calibration.unit_angles[1])
-    else:
-        raise UserError(f"experiment.solver={solver!r} is unknown; choose least_squares or two_unit.")
+    else:  # a Python caller's argument (experiment.solver is checked against its declared choices on the way in)
+        raise ValueError(f"solver must be 'least_squares' or 'two_unit', got {solver!r}")
     return angle, degree, x

@@ -97,3 +97,10 @@ def test_bad_zernike_options():
         Zernike({"mode": "edges"})
     with pytest.raises(UserError, match="signature.threshold"):
         Zernike({"threshold": 2.0})
+
+
+def test_zernike_indices_refuses_an_order_outside_0_to_60():
+    """The function's own argument check (signature.order is checked against its declared 1..40 on the way in)."""
+    assert len(zernike_indices(60)) == 61 * 62 // 2 - sum((n + 1) // 2 for n in range(61))
+    with pytest.raises(ValueError, match=r"order must lie in 0\.\.60 .*, got 61"):
+        zernike_indices(61)

@@ -58,3 +58,15 @@ def test_unknown_mode_and_missing_port_are_clean_errors(tmp_path):
     )
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert "/dev/no-such-compass does not exist" in proc.stderr and "sensor.port" in proc.stderr
+
+
+@pytest.mark.slow
+def test_a_bad_solver_or_calibration_is_refused_by_the_declared_choices(tmp_path):
+    """experiment.solver and experiment.calibration are checked once, where the config enters (issue 28)."""
+    from helpers import assert_fails_cleanly
+
+    for key, choices in (("solver", "least_squares, two_unit"), ("calibration", "auto, rotation, nominal, file")):
+        proc = run_bionav("experiment=pol_compass", f"experiment.{key}=bad", f"hydra.run.dir={tmp_path / key}",
+                          cwd=tmp_path)
+        assert_fails_cleanly(proc, f"experiment.{key}=bad", choices, code=2)
+        assert not (tmp_path / key / "metrics.json").exists()  # refused before the run started

@@ -182,3 +182,16 @@ def test_scan_fit_recovers_mount_heading_and_resolves_ambiguity():
     assert fit.resolved
     assert fit.n_used == np.sum(degrees >= 0.05)  # the points next to the sun are dropped
     assert fit.n_used >= pans.size - 3
+
+
+def test_evector_from_compass_counts_refuses_an_unknown_solver():
+    """The Python API's own argument check (the config path checks experiment.solver's declared choices)."""
+    from bionav.polcompass import evector_from_compass_counts
+
+    counts = np.full((2, 3), 512.0)
+    cal = UnitCalibration.nominal()
+    angle_ls, _, _ = evector_from_compass_counts(counts, cal, solver="least_squares")
+    angle_2u, _, _ = evector_from_compass_counts(counts, cal, solver="two_unit")
+    assert angle_ls.shape == angle_2u.shape == (2,)
+    with pytest.raises(ValueError, match="solver must be 'least_squares' or 'two_unit', got 'bad'"):
+        evector_from_compass_counts(counts, cal, solver="bad")

@@ -17,3 +17,13 @@ def test_a_tiny_step_is_refused_before_rendering(tmp_path, override, needles):
                       cwd=tmp_path, timeout=300)
     assert_fails_cleanly(proc, *needles, code=2, max_seconds=120)
     assert not (tmp_path / "cache").exists() or not any((tmp_path / "cache").rglob("*.npz"))  # nothing rendered
+
+
+@pytest.mark.slow
+def test_offsets_without_the_route_itself_are_refused_before_the_run(tmp_path):
+    """experiment.offsets_m must include 0: RouteHomingConfig.validate, checked where the config enters."""
+    proc = run_bionav("experiment=route_homing", "experiment.offsets_m=[-0.2,0.2]", f"hydra.run.dir={tmp_path / 'run'}",
+                      cwd=tmp_path)
+    assert_fails_cleanly(proc, "experiment.offsets_m=[-0.2, 0.2] must include 0 (the route itself)",
+                         "experiment.offsets_m=[-0.2,0.0,0.2]", code=2)
+    assert not (tmp_path / "run").exists() or not any((tmp_path / "run").iterdir())  # no run directory written

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 from pathlib import Path
 
@@ -17,6 +18,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("log", help="run.mcap of an experiment=cleaning run, or its run directory")
     parser.add_argument("--run", type=int, action="append", help="only this run (repeatable)")
     args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(levelname)s: %(message)s")  # e.g. legacy keys read as today's
     path = Path(args.log)
     if path.is_dir():
         path = path / "run.mcap"

@@ -19,10 +19,12 @@ import path of the experiments and of plugin authors
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 from omegaconf import DictConfig, OmegaConf
 
+from bionav.errors import UserError
 from bionav.experiments.configs.cleaning import (
     CleaningCameraConfig,
     CleaningConfig,
@@ -57,9 +59,17 @@ __all__ = [
     "DataConfig", "GridHomingConfig", "LayoutConfig", "LearnSamplesConfig", "ParamSweepConfig",
     "PolCompassConfig", "PolFilterConfig", "PolPartialConfig", "PolRecordingsConfig", "PolScanConfig",
     "PolSkyConfig", "PolVsEmConfig", "RecordingsConfig", "RouteHomingConfig", "RunSettings",
-    "SkyConditionConfig", "SkylineHomingConfig", "check_group_nodes", "check_run_settings",
-    "experiment_config", "register",
+    "SkyConditionConfig", "SkylineHomingConfig", "LEGACY_KEYS", "check_group_nodes", "check_run_settings",
+    "config_from_recorded", "experiment_config", "register",
 ]
+
+log = logging.getLogger(__name__)
+
+#: keys of configs recorded by earlier bionav versions -> the one setting that replaced each (issue 28)
+LEGACY_KEYS: dict[str, str] = {
+    # the controllers' own belief of the wheel distance, before the robot's track width was the one setting
+    "controller.track_width": "experiment.track_width",
+}
 
 
 #: other option groups with a typed schema: group -> dataclass (checked by :func:`check_group_nodes`)
@@ -87,6 +97,60 @@ def check_run_settings(cfg: DictConfig) -> RunSettings:
     values = {f: cfg.get(f) for f in ("seed", "workers")} if isinstance(cfg, DictConfig) else {}
     return typed_config({f: v for f, v in values.items() if v is not None}, RunSettings, key="",
                         what="the run settings")
+
+
+def config_from_recorded(cfg: DictConfig, *, source: str, recorded_by: str | None = None) -> DictConfig:
+    """A config recorded by an earlier bionav (a log's attached ``config.yaml``) in today's keys.
+
+    Every :data:`LEGACY_KEYS` key the config sets moves to the one setting that
+    replaced it (``controller.track_width`` -> ``experiment.track_width``), and
+    one info line says so; a config without legacy keys comes back unchanged.
+
+    Parameters
+    ----------
+    cfg : DictConfig
+        The recorded config (resolved, as :mod:`bionav.experiments.runner`
+        attaches it); not modified.
+    source : str
+        Where it was read (the log's path), named in messages.
+    recorded_by : str, optional
+        The bionav version that recorded it (the log's ``plugins`` metadata),
+        named in the error.
+
+    Returns
+    -------
+    DictConfig
+        A copy with the legacy keys replaced.
+
+    Raises
+    ------
+    UserError
+        A legacy key and the setting that replaced it both set, to different
+        values: the run used two values that bionav no longer distinguishes.
+    """
+    moved = []
+    for old, new in LEGACY_KEYS.items():
+        value = OmegaConf.select(cfg, old, default=None)
+        if value is None:
+            continue
+        if not moved:
+            cfg = OmegaConf.create(OmegaConf.to_container(cfg, resolve=True))
+        current = OmegaConf.select(cfg, new, default=None)
+        if current is not None and current != value:
+            by = f" ({recorded_by})" if recorded_by else ""
+            raise UserError(
+                f"{source} was recorded with {old}={value} and {new}={current}, two values that are one setting "
+                f"today ({new}); this bionav cannot reproduce that run. Replay it with the bionav version that "
+                f"recorded it{by}."
+            )
+        parent, _, leaf = old.rpartition(".")
+        node = OmegaConf.select(cfg, parent) if parent else cfg
+        del node[leaf]
+        OmegaConf.update(cfg, new, value, force_add=True)
+        moved.append(f"{old}={value} -> {new}")
+    if moved:
+        log.info("%s: recorded with legacy keys, read as today's: %s", source, "; ".join(moved))
+    return cfg
 
 
 #: experiment name -> its config dataclass

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
+from bionav.errors import UserError
 from bionav.validation import Range, bounded
 
 ROUTE_METHODS = ("perfect_memory", "windowed", "zernike", "homing")
@@ -85,3 +86,9 @@ class RouteHomingConfig:
     view_size: list[int] = bounded([36, 10], length=2, item=Range(ge=2, le=74))
     training_heading: str = bounded("travel", choices=("travel", "recorded"))
     supersample: int = bounded(4, choices=(1, 2, 4))
+
+    def validate(self) -> None:
+        """``offsets_m`` includes 0, the route itself (called by :func:`bionav.validation.typed_config`)."""
+        if 0.0 not in self.offsets_m:
+            raise UserError(f"experiment.offsets_m={self.offsets_m} must include 0 (the route itself), "
+                            "e.g. experiment.offsets_m=[-0.2,0.0,0.2].")

@@ -38,8 +38,8 @@ from bionav.geometry import TWO_PI
 def zernike_indices(order: int) -> np.ndarray:
     """``(n, m)`` pairs with ``0 <= m <= n <= order`` and ``n - m`` even, shape ``(K, 2)``."""
     order = int(order)
-    if not 0 <= order <= 60:
-        raise UserError(f"signature.order={order} must lie in 0..60 (the paper's range is up to about 20).")
+    if not 0 <= order <= 60:  # a Python caller's argument (signature.order is checked against its declared range)
+        raise ValueError(f"order must lie in 0..60 (the paper's range is up to about 20), got {order}")
     return np.array([(n, m) for n in range(order + 1) for m in range(n % 2, n + 1, 2)], dtype=np.int64)
 
 
