@@ -168,3 +168,18 @@ def test_the_supervisor_is_seen_where_he_stands_and_nowhere_else():
     assert _radiance_towards(seen, eye, beside) == pytest.approx(_radiance_towards(world.scene, eye, beside))
     assert capture_scenes(World(scene=world.scene, grid_origin=(2.0, 2.0), spacing=0.1, grid_shape=(1, 1),
                                 camera_height=0.6), np.array([[0, 0]]), seed=0) is None
+
+
+def test_one_capture_light_outdoors_and_through_windows_agree():
+    """The uni capture's light (ephemeris, drifting layer) seen through windows gives the whole-sky view's sun."""
+    from bionav.world.worlds.outdoor import build_uni, uni_capture_light
+
+    world = build_uni(0)
+    light = uni_capture_light(world.cells, 0)
+    cells = np.argwhere(world.cells)[[0, 40, 100, -1]]
+    through = light.session_conditions(cells, rng=np.random.default_rng(0))
+    for k, (i, j) in enumerate(cells):
+        whole = light.conditions(i, j)
+        np.testing.assert_allclose(through["sun_dir"][k], whole["sun"], atol=1e-12)
+        assert through["transmission"][k] == pytest.approx(whole["sun_transmittance"], abs=1e-12)
+    np.testing.assert_allclose(through["fraction"], light.order[cells[:, 0], cells[:, 1]] / (light.n_captures - 1))
