@@ -355,7 +355,7 @@ def session_seed(seed: int, db_seed: int = 0) -> int:
 
     A recording session is one draw of everything that happened while the
     database was taken: the pose errors, the clouds
-    (:class:`bionav.world.worlds.common.Daylight`) and where the supervisor
+    (:class:`bionav.light.capture.CaptureLight`) and where the supervisor
     stood (:class:`bionav.world.worlds.common.Supervisor`) share
     ``db.pose_error.seed`` (and ``db.seed``).
     """
@@ -367,7 +367,7 @@ def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0)
     """``scene_at(k)``: the compiled scene at capture ``k`` of a recording session, or None if the world is static.
 
     Adds what changes while a database is recorded (``world.daylight``: the
-    sun and the clouds; ``world.supervisor``: the person following the robot)
+    sun and the clouds, entering through ``world.windows``; ``world.supervisor``: the person following the robot)
     to a copy of the world's scene, compiled once; each capture then only
     moves lights and the person in the compiled arrays.
 
@@ -396,10 +396,12 @@ def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0)
         raise ValueError("recording-session changes (daylight, supervisor) are modelled for indoor worlds only "
                          "(a compiled scene renders without the world's sky)")
     from bionav.world.render import _compiled
-    from bionav.world.worlds.common import Supervisor
+    from bionav.world.worlds.common import Supervisor, stream
 
     sseed = session_seed(seed, db_seed)
-    scene = daylight.session_scene(world.scene) if daylight is not None else copy.deepcopy(world.scene)
+    windows = world.windows
+    scene = (windows.session_scene(world.scene, sun_irradiance=daylight.sun_irradiance) if daylight is not None
+             else copy.deepcopy(world.scene))
     scene.info.pop("_compiled", None)
     parts = supervisor.add_to(scene, seed=sseed) if supervisor is not None else None
     session = _compiled(scene)
@@ -407,12 +409,12 @@ def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0)
         kinds = session.light_params[:, 0]
         sun = int(np.flatnonzero(kinds == 1)[-1])
         sky = []
-        for idx in daylight.sky_lights:
+        for idx in windows.sky_lights:
             pos = np.asarray(world.scene.lights[idx].position, float)
             hit = np.flatnonzero((kinds == 0) & np.all(np.isclose(session.light_params[:, 1:4], pos), axis=1))
             sky.append(int(hit[0]))
         sky = np.asarray(sky, np.int64)
-        cond = daylight.conditions(positions, world.grid_shape, seed=sseed)
+        cond = daylight.session_conditions(positions, rng=stream(sseed, "daylight/clouds"))
     if supervisor is not None:
         xy = np.array([world.cell_position(i, j)[:2] for i, j in positions], float).reshape(-1, 2)
         feet, yaw = supervisor.stances(positions, xy, seed=sseed)
@@ -420,9 +422,9 @@ def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0)
     def scene_at(k: int):
         kw = {}
         if daylight is not None:
-            kw.update(daylight.capture_lighting(session, sun_index=sun, sky_index=sky, sun_dir=cond["sun_dir"][k],
-                                                transmission=float(cond["transmission"][k]),
-                                                sky=float(cond["sky"][k])))
+            kw.update(windows.capture_lighting(session, sun_index=sun, sky_index=sky, sun_dir=cond["sun_dir"][k],
+                                               transmission=float(cond["transmission"][k]),
+                                               sky=float(cond["sky"][k])))
         if supervisor is not None:
             boxes, ell = Supervisor.place(session.boxes, session.ellipsoids, parts, feet[k], float(yaw[k]))
             kw.update(boxes=boxes, ellipsoids=ell, prim_kind=None, prim_idx=None, spheres=None, casters=None)

@@ -354,9 +354,11 @@ def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
         del pose_key["heading_drift_deg"]
     params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
                   pose_error=pose_key, native_size=list(spec.native_size))
-    for what in ("daylight", "supervisor"):  # the recording session (bionav.db.camera.capture_scenes)
-        if getattr(world, what, None) is not None:
-            params[what] = dataclasses.asdict(getattr(world, what))
+    if getattr(world, "daylight", None) is not None:  # the recording session (bionav.db.camera.capture_scenes)
+        params["daylight"] = world.daylight.describe()
+        params["windows"] = dataclasses.asdict(world.windows)
+    if getattr(world, "supervisor", None) is not None:
+        params["supervisor"] = dataclasses.asdict(world.supervisor)
     if getattr(world, "light_level", 1.0) != 1.0:  # a dim scene; 1 keeps the key of the other worlds
         params["light_level"] = float(world.light_level)
     if "capture_light" in world.info:  # light changing during the capture (sim_uni)

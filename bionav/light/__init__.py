@@ -13,7 +13,8 @@ Modules
   layer: cover, optical depth, direct-sun transmittance, polarization) and
   :class:`CloudMap` (the compass recordings' sampled sky map, chapter 4).
 * :mod:`~bionav.light.capture` -- :class:`~bionav.light.capture.CaptureLight`,
-  the light at each image of a capture that took a while (sun, clouds, sky).
+  the light at each image of a capture that took a while (sun, clouds, sky),
+  outdoors and through a room's windows.
 * :mod:`~bionav.light.daylight` -- spectral sun, sky and cloud radiance and
   the irradiance they give on the ground (chapter 6).
 * :mod:`~bionav.light.measured_spectra` -- the measured spectra shipped in

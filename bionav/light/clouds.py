@@ -9,20 +9,23 @@
   noise; :class:`~bionav.light.polarized_sky.SkyModel` takes a layer as its
   ``clouds``).
 * :class:`CloudMap` (polarized-light compass recordings, thesis chapter 4):
-  cloudiness and e-vector noise sampled on a map of the sky hemisphere, drawn
-  from a ``Generator`` by :func:`random_cloud_map` (a snapshot without height
-  or wind; the compass experiments' draws and numbers depend on it).
+  a snapshot of a layer over the sky hemisphere (:meth:`CloudLayer.hemisphere_map`):
+  its cloudiness and e-vector noise field sampled on a map, so that a
+  compass simulation looks the sky up by interpolation instead of summing
+  the layer's waves per ray. :func:`random_cloud_map` draws a layer from a
+  ``Generator`` and returns its snapshot.
 
 Cloud map
 ---------
-A cloud map is a smooth Gaussian random field on a square grid covering the
-azimuthal-equidistant projection of the upper hemisphere (zenith at the
-centre, the horizon on the unit circle: ``r = zenith_angle / (pi / 2)``),
-thresholded at the quantile that gives the requested cloud cover. Its value,
-the *cloudiness* in ``[0, 1]``, ramps from 0 (clear) to 1 (overcast) over a
-soft edge. A second independent field supplies the e-vector angle noise that
-scattering in and under clouds adds. All randomness comes from the numpy
-``Generator`` passed in.
+The map is a square grid covering the azimuthal-equidistant projection of
+the upper hemisphere (zenith at the centre, the horizon on the unit circle:
+``r = zenith_angle / (pi / 2)``; grid points outside the disk hold the
+horizon at their azimuth). Its *cloudiness* in ``[0, 1]`` is the layer's
+:meth:`~CloudLayer.density_at` (0 clear, 1 overcast, a soft edge between,
+anti-aliased at the map's pixel size); the second field is the layer's
+e-vector noise field (:meth:`~CloudLayer.angle_noise_at` divided by
+cloudiness and ``angle_noise_sigma``). All randomness comes from the layer's
+seed, drawn from the numpy ``Generator`` passed to :func:`random_cloud_map`.
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ from scipy.special import ndtr, ndtri
 
 @dataclass(frozen=True)
 class CloudMap:
-    """A sampled cloud field.
+    """A cloud layer sampled over the sky hemisphere (:meth:`CloudLayer.hemisphere_map`).
 
     Attributes
     ----------
@@ -93,6 +96,13 @@ class CloudMap:
         return float(np.sum(weight * (self.cloudiness < 0.5)) / np.sum(weight))
 
 
+#: Layer wavelength scale per (height x angular correlation length): the plane waves' correlation
+#: J0(k d) falls to 1/e at k d ~ 1.75, and the mean wavenumber of wavelengths ``scale_m * U(0.5, 2)``
+#: is ``2 pi ln(4) / (1.5 scale_m)``; a Gaussian-smoothed field of kernel sigma falls to 1/e at 2 sigma.
+#: Equal 1/e distances at the zenith give ``scale_m = 6.6 height_m sigma``.
+SCALE_PER_CORRELATION = 2.0 * 2.0 * np.pi * np.log(4.0) / 1.5 / 1.75
+
+
 def random_cloud_map(
     rng: np.random.Generator,
     *,
@@ -103,53 +113,51 @@ def random_cloud_map(
     angle_noise_sigma: float = np.deg2rad(20.0),
     depolarization: float = 0.9,
     brightness: float = 1.5,
+    height_m: float = 1500.0,
 ) -> CloudMap:
-    """Draw a cloud field with a given cloud cover.
+    """Draw a cloud layer with a given cover and return its snapshot over the hemisphere.
+
+    The layer (:class:`CloudLayer`, seeded from ``rng``) lies at
+    ``height_m``; its wave scale makes its clouds at the zenith as wide as
+    a Gaussian-smoothed field of angular standard deviation
+    ``correlation_length`` (:data:`SCALE_PER_CORRELATION`); towards the
+    horizon they shrink and merge by perspective. Its map is
+    :meth:`CloudLayer.hemisphere_map` at time 0 over the origin.
 
     Parameters
     ----------
     rng : numpy.random.Generator
-        Source of randomness.
+        Source of randomness (one draw: the layer's seed).
     cover : float
-        Fraction of the projection disk (approximately of the sky) covered by
-        cloud, ``0`` (clear) to ``1`` (overcast).
+        Fraction of the layer covered by cloud, ``0`` (clear) to ``1``
+        (overcast); about the fraction of the sky.
     correlation_length : float, optional
-        Standard deviation of the Gaussian smoothing kernel, as an angle on the
-        sky (radians); sets the size of cloud patches.
+        Angular size of the cloud patches at the zenith (radians; the
+        standard deviation of a Gaussian smoothing kernel of equal
+        correlation length).
     edge : float, optional
-        Width of the clear-to-cloud ramp in standard deviations of the field.
+        Width of the clear-to-cloud ramp in standard deviations of the field
+        (the slope at the edge; the layer's ``softness`` is
+        ``edge / sqrt(2 pi)``).
     resolution : int, optional
-        Grid size ``N``.
+        Grid size ``N`` (the layer is anti-aliased at the grid's pixel angle).
     angle_noise_sigma, depolarization, brightness : float, optional
         See :class:`CloudMap`.
+    height_m : float, optional
+        Height of the layer, metres.
 
     Returns
     -------
     CloudMap
     """
-    from scipy.ndimage import gaussian_filter
-
     if not 0.0 <= cover <= 1.0:
         raise ValueError(f"cloud cover must be in [0, 1], got {cover}")
-    sigma_px = correlation_length / (np.pi / 2.0) * (resolution - 1) / 2.0
-    u = np.linspace(-1.0, 1.0, resolution)
-    x, y = np.meshgrid(u, u)
-    disk = np.hypot(x, y) <= 1.0
-
-    def smooth_field():
-        f = gaussian_filter(rng.standard_normal((resolution, resolution)), sigma_px, mode="wrap")
-        return (f - f[disk].mean()) / f[disk].std()
-
-    field = smooth_field()
-    noise = smooth_field()
-    if cover <= 0.0:
-        cloudiness = np.zeros_like(field)
-    elif cover >= 1.0:
-        cloudiness = np.ones_like(field)
-    else:
-        threshold = np.quantile(field[disk], 1.0 - cover)
-        cloudiness = np.clip(0.5 + (field - threshold) / edge, 0.0, 1.0)
-    return CloudMap(cloudiness, noise, angle_noise_sigma, depolarization, brightness)
+    layer = CloudLayer(cover=float(cover), seed=int(rng.integers(2**32)), height_m=float(height_m),
+                       scale_m=float(SCALE_PER_CORRELATION * height_m * correlation_length),
+                       softness=float(edge / np.sqrt(2.0 * np.pi)), resolution=float(np.pi / (resolution - 1)),
+                       brightness=float(brightness), depolarization=float(depolarization),
+                       angle_noise_sigma=float(angle_noise_sigma))
+    return layer.hemisphere_map(resolution=resolution)
 
 
 @dataclass(frozen=True)
@@ -299,14 +307,47 @@ class CloudLayer:
         """
         d = np.asarray(view, dtype=float)
         c = self.cloudiness_at(d, time_s=time_s, origin_m=origin_m)
+        return c * self.angle_noise_sigma * self._noise_field(d, time_s=time_s, origin_m=origin_m)
+
+    def _noise_field(self, d: np.ndarray, *, time_s: float, origin_m) -> np.ndarray:
+        """The layer's second plane-wave field (about standard normal) along directions ``d`` ``(..., 3)``."""
         dz = np.maximum(d[..., 2], np.sin(np.deg2rad(1.0)))
         reach = self.height_m / dz
         px = origin_m[0] + d[..., 0] * reach - self.wind_mps[0] * time_s
         py = origin_m[1] + d[..., 1] * reach - self.wind_mps[1] * time_s
         kvec, phase, amp = _plane_waves(np.random.default_rng([int(self.seed) & 0xFFFFFFFF, 1]), self.n_waves,
                                         self.scale_m)
-        field = np.sum(amp * np.cos(px[..., None] * kvec[:, 0] + py[..., None] * kvec[:, 1] + phase), axis=-1)
-        return c * self.angle_noise_sigma * field
+        return np.sum(amp * np.cos(px[..., None] * kvec[:, 0] + py[..., None] * kvec[:, 1] + phase), axis=-1)
+
+    def hemisphere_map(self, *, resolution: int = 96, time_s: float = 0.0, origin_m=(0.0, 0.0)) -> CloudMap:
+        """The layer seen from ``origin_m`` at ``time_s``, sampled over the hemisphere (the *map* view).
+
+        Parameters
+        ----------
+        resolution : int
+            Grid size ``N`` of the azimuthal-equidistant map (see the module
+            notes; points outside the disk hold the horizon at their azimuth).
+        time_s, origin_m
+            As :meth:`density_at`.
+
+        Returns
+        -------
+        CloudMap
+            ``cloudiness`` = :meth:`cloudiness_at` and ``angle_noise`` = the
+            layer's noise field on the grid, ``(N, N)``, with this layer's
+            ``angle_noise_sigma``, ``depolarization`` and ``brightness``.
+        """
+        n = int(resolution)
+        if n < 2:
+            raise ValueError(f"a cloud map needs a resolution of at least 2, got {resolution}")
+        u = np.linspace(-1.0, 1.0, n)
+        x, y = np.meshgrid(u, u)
+        zen = np.minimum(np.hypot(x, y), 1.0) * (np.pi / 2.0)
+        az = np.arctan2(y, x)
+        d = np.stack([np.sin(zen) * np.cos(az), np.sin(zen) * np.sin(az), np.cos(zen)], axis=-1)
+        return CloudMap(self.cloudiness_at(d, time_s=time_s, origin_m=origin_m),
+                        self._noise_field(d, time_s=time_s, origin_m=origin_m),
+                        float(self.angle_noise_sigma), float(self.depolarization), float(self.brightness))
 
 
 def _plane_waves(r: np.random.Generator, n: int, scale_m: float):

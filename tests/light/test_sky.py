@@ -5,6 +5,7 @@ import pytest
 
 from bionav.geometry import direction_from_angles
 from bionav.light import (
+    CloudLayer,
     PolarizerLamp,
     SkyModel,
     SunPosition,
@@ -126,10 +127,17 @@ def test_cloud_field_cover_and_reproducibility():
     a = random_cloud_map(np.random.default_rng(5), cover=0.4)
     b = random_cloud_map(np.random.default_rng(5), cover=0.4)
     np.testing.assert_array_equal(a.cloudiness, b.cloudiness)
+    assert not np.array_equal(a.cloudiness, random_cloud_map(np.random.default_rng(6), cover=0.4).cloudiness)
+    # the map is a perspective snapshot of a layer of that cover: its solid-angle-weighted mean
+    # cloudiness over the sky is the cover on average over layers (one map: +-0.04, 40 maps: +-0.007)
     n = a.cloudiness.shape[0]
     u = np.linspace(-1, 1, n)
-    disk = np.hypot(*np.meshgrid(u, u)) <= 1
-    assert np.mean(a.cloudiness[disk] >= 0.5) == pytest.approx(0.4, abs=0.02)
+    r = np.hypot(*np.meshgrid(u, u))
+    weight = np.where(r <= 1, np.sinc(r / 2), 0.0)  # sin(zenith) / zenith of the equidistant projection
+    for cover in (0.2, 0.7):
+        means = [np.sum(weight * random_cloud_map(np.random.default_rng(s), cover=cover).cloudiness) / weight.sum()
+                 for s in range(40)]
+        assert np.mean(means) == pytest.approx(cover, abs=0.03)
     clear = random_cloud_map(np.random.default_rng(1), cover=0.0)
     assert clear.clear_fraction() == 1.0
     overcast = random_cloud_map(np.random.default_rng(1), cover=1.0)
@@ -141,6 +149,25 @@ def test_cloud_field_cover_and_reproducibility():
     cloudy = SkyModel(sun, clouds=overcast).light(views)
     np.testing.assert_allclose(cloudy.degree, clear_light.degree * (1 - overcast.depolarization), atol=1e-12)
     np.testing.assert_allclose(np.sum(cloudy.evector * views, -1), 0.0, atol=1e-12)
+
+
+def test_a_cloud_map_is_a_snapshot_of_its_layer():
+    layer = CloudLayer(cover=0.5, seed=3, height_m=1200.0, scale_m=3000.0, angle_noise_sigma=np.deg2rad(15.0),
+                       depolarization=0.8, brightness=1.3)
+    snap = layer.hemisphere_map(resolution=65, time_s=40.0, origin_m=(10.0, -5.0))
+    assert (snap.angle_noise_sigma, snap.depolarization, snap.brightness) == (np.deg2rad(15.0), 0.8, 1.3)
+    # at the map's nodes (zenith, and along the grid's axes) the map gives what the layer gives
+    zen = np.array([0.0, 0.25, 0.5, 0.75, 1.0]) * np.pi / 2  # nodes of a 65 grid at r = 0, 1/4 ... 1
+    views = np.concatenate([direction_from_angles(np.zeros(5), np.pi / 2 - zen),
+                            direction_from_angles(np.full(5, np.pi / 2), np.pi / 2 - zen)])
+    kw = dict(time_s=40.0, origin_m=(10.0, -5.0))
+    np.testing.assert_allclose(snap.cloudiness_at(views), np.clip(layer.cloudiness_at(views, **kw), 0, 1),
+                               atol=1e-9)
+    np.testing.assert_allclose(snap.angle_noise_at(views), layer.angle_noise_at(views, **kw), atol=1e-9)
+    # between the nodes it interpolates: close to the layer where clouds are wider than a pixel
+    rng = np.random.default_rng(0)
+    views = direction_from_angles(rng.uniform(-np.pi, np.pi, 200), np.deg2rad(rng.uniform(30.0, 90.0, 200)))
+    assert np.max(np.abs(snap.cloudiness_at(views) - layer.cloudiness_at(views, **kw))) < 0.1
 
 
 def test_polarizer_lamp():

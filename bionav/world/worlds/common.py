@@ -10,6 +10,7 @@ from typing import Callable
 
 import numpy as np
 
+from bionav.light.capture import CaptureLight
 from bionav.world.lights import DirectionalLight
 from bionav.world.scene import CompiledScene, Scene
 
@@ -50,20 +51,21 @@ def lane_order(grid_shape: tuple[int, int], *, lane_axis: int = 1) -> np.ndarray
 
 
 @dataclass(frozen=True)
-class Daylight:
-    """Daylight through a room's windows while a database was being recorded.
+class Windows:
+    """Where the capture light enters a room: its windows (geometry of an indoor world).
 
     The living-room databases took hours to record (a supervised robot, its
     position corrected semi-automatically at every cell; thesis 3.1, Kreft
     2007). Meanwhile the sun moved: its light, entering through the windows,
     lays bright patches on the floor, the furniture and the walls that move
     across the room and come and go with passing clouds, and the brightness
-    of the sky seen through the windows changes. A cell's capture time follows
-    the robot's lanes (boustrophedon along grid axis ``lane_axis``, one image
-    every ``duration_h / N`` hours), so cells in far-apart lanes were taken
-    hours apart. Used by the camera model only (``db.realism=camera``,
-    :func:`bionav.db.camera.camera_images`); ``db.realism=ideal`` renders the
-    scene as built.
+    of the sky seen through the windows changes. The light itself (sun path,
+    clouds, skylight factor per capture) is the world's
+    :class:`~bionav.light.capture.CaptureLight` (``World.daylight``); this
+    class is the room's side: which openings let the sun in, which lights
+    and panes stand for the sky outside. Used by the camera model only
+    (``db.realism=camera``, :func:`bionav.db.camera.capture_scenes`);
+    ``db.realism=ideal`` renders the scene as built.
 
     Parameters
     ----------
@@ -75,94 +77,25 @@ class Daylight:
         ``wall`` in ``"x0", "x1", "y0", "y1"`` (the wall at ``x = 0``,
         ``x = lx``, ``y = 0``, ``y = ly``), ``u0 .. u1`` the span along the
         wall and ``z0 .. z1`` the height span, metres.
-    sun_azimuth_deg, sun_elevation_deg : (float, float)
-        Direction towards the sun at the first and at the last capture
-        (azimuth counter-clockwise from world ``+x``), degrees; in between
-        linear in time.
-    sun_irradiance : float
-        Irradiance of the unclouded sun on a surface facing it, in the units
-        of the scene's lights.
-    duration_h : float
-        Hours from the first to the last image (stated with the world).
-    cloud_sigma : float
-        Log-standard deviation of the clouds' transmission of the sun.
-    cloud_images : float
-        Correlation length of the clouds in captured images (an AR(1)
-        process along the capture order).
     sky_lights : tuple of int
         Indices into ``scene.lights`` of the lights standing for the skylight
-        through the windows; scaled by ``(1 + T) / 2`` with the cloud
-        transmission ``T`` (brighter sky when the sun is out).
+        through the windows; scaled by the capture light's skylight factor.
     panes : tuple of int
         Material indices of the window panes; their emission is scaled like
         the skylight.
-    lane_axis : int
-        Grid axis (0: ``i``, 1: ``j``) along which the robot drove its lanes.
     """
 
     room: tuple[float, float, float]
     windows: tuple[tuple[str, float, float, float, float], ...]
-    sun_azimuth_deg: tuple[float, float]
-    sun_elevation_deg: tuple[float, float]
-    sun_irradiance: float
-    duration_h: float
-    cloud_sigma: float = 0.0
-    cloud_images: float = 20.0
     sky_lights: tuple[int, ...] = ()
     panes: tuple[int, ...] = ()
-    lane_axis: int = 1
 
-    def capture_fraction(self, cells: np.ndarray, grid_shape: tuple[int, int]) -> np.ndarray:
-        """Capture time of each cell as a fraction ``0 .. 1`` of the session (boustrophedon lanes).
-
-        Parameters
-        ----------
-        cells : ndarray, shape (N, 2), int
-            Grid cells ``(i, j)``.
-        grid_shape : (int, int)
-            ``(nx, ny)``.
-
-        Returns
-        -------
-        ndarray, shape (N,)
-            0 for the first cell of the first lane, 1 for the last cell of the last lane.
-        """
-        cells = np.asarray(cells, np.int64).reshape(-1, 2)
-        order = lane_order(grid_shape, lane_axis=self.lane_axis)
-        return order[cells[:, 0], cells[:, 1]] / max(order.size - 1, 1)
-
-    def conditions(self, cells: np.ndarray, grid_shape: tuple[int, int], *, seed: int) -> dict:
-        """Sun direction, cloud transmission and skylight factor at each cell's capture.
-
-        Returns
-        -------
-        dict
-            ``fraction`` (N,) capture time fraction, ``sun_dir`` (N, 3) unit
-            vectors towards the sun, ``transmission`` (N,) clouds' transmission
-            of the sun (mean 1 over the session's process), ``sky`` (N,)
-            skylight factor ``(1 + T) / 2``.
-        """
-        f = self.capture_fraction(cells, grid_shape)
-        az = np.radians(self.sun_azimuth_deg[0] + f * (self.sun_azimuth_deg[1] - self.sun_azimuth_deg[0]))
-        el = np.radians(self.sun_elevation_deg[0] + f * (self.sun_elevation_deg[1] - self.sun_elevation_deg[0]))
-        sun = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
-        # clouds: a stationary AR(1) log-transmission along the capture order (seeded per session)
-        n_total = int(np.prod(grid_shape))
-        rng = stream(seed, "daylight/clouds")
-        rho = float(np.exp(-1.0 / max(self.cloud_images, 1e-9)))
-        z = np.empty(n_total)
-        e = rng.standard_normal(n_total)
-        z[0] = e[0]
-        for k in range(1, n_total):
-            z[k] = rho * z[k - 1] + np.sqrt(1.0 - rho * rho) * e[k]
-        s = float(self.cloud_sigma)
-        t_all = np.exp(s * z - 0.5 * s * s)
-        idx = np.rint(f * (n_total - 1)).astype(np.int64)
-        t = t_all[idx]
-        return {"fraction": f, "sun_dir": sun, "transmission": t, "sky": 0.5 * (1.0 + t)}
-
-    def session_scene(self, scene: Scene) -> Scene:
+    def session_scene(self, scene: Scene, *, sun_irradiance: float) -> Scene:
         """A copy of ``scene`` with the sun added and the room closed against it except at the windows.
+
+        ``sun_irradiance``: the unclouded sun's irradiance on a surface facing
+        it (:attr:`CaptureLight.sun_irradiance <bionav.light.capture.CaptureLight>`),
+        in the units of the scene's lights.
 
         The walls of the room shell cast no shadows (the lamps are inside);
         the sun, outside, must be blocked by the walls and the ceiling except
@@ -194,7 +127,7 @@ class Daylight:
                 else:
                     y0 = -m - t if wall == "y0" else ly + m
                     s.box((u0, y0, z0), (u1, y0 + t, z1), blk)
-        s.add_light(DirectionalLight((0.0, 0.0, 1.0), float(self.sun_irradiance)))
+        s.add_light(DirectionalLight((0.0, 0.0, 1.0), float(sun_irradiance)))
         return s
 
     def capture_lighting(self, session: CompiledScene, *, sun_index: int, sky_index: np.ndarray, sun_dir,
@@ -332,8 +265,11 @@ class World:
         ``(x0, y0, x1, y1)`` of an obstacle-free floor rectangle (apartment).
     info : dict
         Free-form facts about the world (room size, sun position ...).
-    daylight : Daylight, optional
-        Daylight through the windows during the recording (camera model only).
+    daylight : CaptureLight, optional
+        The light during the recording (sun path, clouds; camera model only),
+        entering through ``windows``.
+    windows : Windows, optional
+        The room's windows through which ``daylight`` enters (given with it).
     supervisor : Supervisor, optional
         The person supervising the recording (camera model only).
     floor_tilt_deg : float
@@ -377,13 +313,17 @@ class World:
     floor_tilt_deg: float = 0.0
     heading_drift_deg: float = 0.0
     light_level: float = 1.0
-    daylight: Daylight | None = None
+    daylight: CaptureLight | None = None
+    windows: Windows | None = None
     supervisor: Supervisor | None = None
     capture_scene: Callable[[int, int], Scene] | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.light_level) and self.light_level > 0):
             raise ValueError(f"World.light_level must be a finite number > 0, got {self.light_level!r}")
+        if (self.daylight is None) != (self.windows is None):
+            raise ValueError("World.daylight and World.windows come together (the capture light and the "
+                             "windows it enters through); give both or neither")
         if self.cells is None:
             self.cells = np.ones(self.grid_shape, bool)
 

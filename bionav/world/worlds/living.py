@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from bionav.light.capture import CaptureLight
 from bionav.world import textures as tx
 from bionav.world.lights import Ambient, PointLight
 from bionav.world.scene import Scene
-from bionav.world.worlds.common import Daylight, Supervisor, World, stream
+from bionav.world.worlds.common import Supervisor, Windows, World, lane_order, stream
 from bionav.world.worlds.furniture import cabinet, chair, oriented_box, potted_plant, shelf, table, wall_picture
 
 SPACING = 0.1
@@ -35,7 +36,7 @@ HEADING_DRIFT_DEG = {"living": 12.0, "kitchen": 6.0}
 #: Contrast of the painted walls (texture value range; real painted walls are nearly uniform).
 WALL_TEXTURE = (0.7, 0.8)
 #: Seconds per image of the supervised recording (drive, semi-automatic position correction, capture):
-#: fixes the hours the sun moves while a database is taken (Daylight.duration_h).
+#: fixes the hours the sun moves while a database is taken (CaptureLight.seconds_per_capture).
 SECONDS_PER_IMAGE = 40.0
 #: Irradiance of the unclouded sun entering through the windows, in the units of the scene's lights
 #: (the ceiling lamp gives about 0.8 on the floor below it); 0 would be an overcast day.
@@ -81,7 +82,7 @@ def _window(scene: Scene, r: np.random.Generator, *, wall_x: float | None, wall_
             width: float, lx: float, ly: float, open_fraction: float = 0.6) -> tuple[int, tuple]:
     """A bright window with curtains drawn to both sides, on an x- or y-wall.
 
-    Returns the pane's material and the opening as :class:`~bionav.world.worlds.common.Daylight`
+    Returns the pane's material and the opening as :class:`~bionav.world.worlds.common.Windows`
     takes it: ``(wall, u0, u1, z0, z1)``.
     """
     pane = scene.material(texture=tx.window_view(r), fit=True, albedo=0.2, emission=1.6)
@@ -185,14 +186,14 @@ def build_living_room(seed: int = 0) -> World:
     scene.ambient = Ambient(up=0.3, down=0.2)
     scene.exposure = 1.5
     # an afternoon: the sun moves west past the south window (azimuth -60 -> -100 deg, sinking)
-    daylight = Daylight(room=(lx, ly, lz), windows=windows, sun_azimuth_deg=(-60.0, -100.0),
-                        sun_elevation_deg=(40.0, 22.0), sun_irradiance=SUN_IRRADIANCE,
-                        duration_h=11 * 22 * SECONDS_PER_IMAGE / 3600.0, cloud_sigma=CLOUD_SIGMA,
-                        cloud_images=CLOUD_IMAGES, sky_lights=(sky,), panes=panes, lane_axis=1)
+    daylight = CaptureLight(order=lane_order((11, 22), lane_axis=1), seconds_per_capture=SECONDS_PER_IMAGE,
+                            sun_azimuth_deg=(-60.0, -100.0), sun_elevation_deg=(40.0, 22.0),
+                            sun_irradiance=SUN_IRRADIANCE, cloud_sigma=CLOUD_SIGMA, cloud_images=CLOUD_IMAGES)
+    openings = Windows(room=(lx, ly, lz), windows=windows, sky_lights=(sky,), panes=panes)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 22),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["living"],
                  heading_drift_deg=HEADING_DRIFT_DEG["living"],
-                 daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
+                 daylight=daylight, windows=openings, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
                                                           jitter_m=SUPERVISOR_JITTER, lane_axis=1))
 
 
@@ -226,14 +227,14 @@ def build_living_kitchen(seed: int = 0) -> World:
     scene.ambient = Ambient(up=0.3, down=0.2)
     scene.exposure = 1.5
     # a morning: the sun rises in front of the east windows (azimuth -50 -> +16 deg)
-    daylight = Daylight(room=(lx, ly, lz), windows=windows, sun_azimuth_deg=(-50.0, 16.0),
-                        sun_elevation_deg=(15.0, 40.0), sun_irradiance=SUN_IRRADIANCE,
-                        duration_h=11 * 36 * SECONDS_PER_IMAGE / 3600.0, cloud_sigma=CLOUD_SIGMA,
-                        cloud_images=CLOUD_IMAGES, sky_lights=(), panes=panes, lane_axis=1)
+    daylight = CaptureLight(order=lane_order((11, 36), lane_axis=1), seconds_per_capture=SECONDS_PER_IMAGE,
+                            sun_azimuth_deg=(-50.0, 16.0), sun_elevation_deg=(15.0, 40.0),
+                            sun_irradiance=SUN_IRRADIANCE, cloud_sigma=CLOUD_SIGMA, cloud_images=CLOUD_IMAGES)
+    openings = Windows(room=(lx, ly, lz), windows=windows, sky_lights=(), panes=panes)
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"],
                  heading_drift_deg=HEADING_DRIFT_DEG["kitchen"],
-                 daylight=daylight, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
+                 daylight=daylight, windows=openings, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
                                                           jitter_m=SUPERVISOR_JITTER, lane_axis=1))
 
 
@@ -276,7 +277,7 @@ def _dining_corner(scene: Scene, seed: int, gx1: float) -> None:
 def _kitchen_living_room(scene: Scene, seed: int, lx: float, ly: float, gy0: float, gx1: float, gy1: float):
     """*roeben1*'s living room: sofa, shelf, TV, armchair, plant, lamp, east windows, door and pictures.
 
-    Returns the windows' panes and openings (as :class:`~bionav.world.worlds.common.Daylight` takes them).
+    Returns the windows' panes and openings (as :class:`~bionav.world.worlds.common.Windows` takes them).
     """
     r = stream(seed, "kitchen/living")
     _sofa(scene, r, x=0.4, y=gy0 + 3.5 + 0.2, yaw=0.0, width=2.0)
