@@ -257,18 +257,6 @@ def landscape_albedo(wavelengths_nm=WAVELENGTHS_NM) -> np.ndarray:
     return np.interp(np.asarray(wavelengths_nm, dtype=float), WAVELENGTHS_NM, _landscape_albedo())
 
 
-def band_reflectance_table() -> tuple[list[str], np.ndarray]:
-    """Names and band reflectances ``(M, 5)`` of every material (documentation and plots)."""
-    names = list(MATERIALS)
-    return names, np.array([MATERIALS[n].reflectance for n in names])
-
-
-def mean_spectra_table() -> tuple[list[str], np.ndarray]:
-    """Names and mean reflectance spectra ``(M, L)`` on ``WAVELENGTHS_NM`` of every material."""
-    names = list(MATERIALS)
-    return names, np.array([MATERIALS[n].mean_spectrum() for n in names])
-
-
 #: The material of :data:`MATERIALS` that each surface kind of the rendered worlds is made of
 #: (the ``kind`` of a :class:`bionav.world.scene.RenderMaterial`, e.g. the campus of
 #: :mod:`bionav.world.worlds.outdoor`): the five-band albedos of a rendered world are these
