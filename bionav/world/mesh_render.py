@@ -17,13 +17,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Sequence
 
-import numba
 import numpy as np
 
 from bionav.errors import UserError
 from bionav.geometry import PanoramaGeometry
 from bionav.world.mesh import TriangleMesh
 from bionav.world.mesh_kernels import build_grid, cast_kernel, edge_form, vertical_kernel
+from bionav.world.render import _run_threads
 
 #: Bump when a change to the mesh renderer changes pixels (invalidates cached databases).
 MESH_RENDERER_VERSION = 1
@@ -181,16 +181,6 @@ class MeshWorld:
         return pos, free
 
 
-def _run(threads, kernel, *args):
-    n = numba.config.NUMBA_NUM_THREADS if threads is None else max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
-    prev = numba.get_num_threads()
-    numba.set_num_threads(n)
-    try:
-        kernel(*args)
-    finally:
-        numba.set_num_threads(prev)
-
-
 def cast_mesh_directions(world: MeshWorld, *, position: Sequence[float], azimuths, elevations,
                          threads: int | None = 1):
     """Depth and hit index for the ray grid ``elevations x azimuths`` (any field of view).
@@ -213,7 +203,7 @@ def cast_mesh_directions(world: MeshWorld, *, position: Sequence[float], azimuth
     depth = np.empty((el.size, az.size))
     index = np.empty((el.size, az.size), np.int64)
     ox, oy, oz = (float(v) for v in position)
-    _run(threads, cast_kernel, ox, oy, oz, az, el, *world._grid_args(), float(world.ground_z),
+    _run_threads(threads, cast_kernel, ox, oy, oz, az, el, *world._grid_args(), float(world.ground_z),
          world.ground == "plane", depth, index)
     return depth, index
 

@@ -291,15 +291,6 @@ class Warping2D(_PlaneWarping):
         compass_fraction: float = bounded(0.25, gt=0.0, le=1.0)
         fine_search: bool = False
 
-    def _check(self) -> None:
-        super()._check()
-        cfg = self.config
-        if cfg.n_rho < 1 or not (0.0 <= cfg.rho_max < 1.0):
-            raise UserError(
-                f"homing.n_rho={cfg.n_rho} / homing.rho_max={cfg.rho_max} are invalid: need n_rho >= 1 "
-                "and 0 <= rho_max < 1 (the thesis uses 20 steps up to 0.95)"
-            )
-
     def home_vector(self, snapshot, current, *, neighbours=None) -> HomeVector:
         """2D-warping search; ``angle`` in the current view's frame, ``compass = psi``."""
         from bionav.homing.warping import warping2d
