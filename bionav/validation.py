@@ -313,7 +313,11 @@ def checked_config(config: Any, *, prefix: str) -> Any:
     """
     if dataclasses.is_dataclass(config) and not isinstance(config, type):
         seen = getattr(config, _CHECKED_VALUES, None)
-        if seen is not None and seen == dataclasses.astuple(config):
+        try:
+            unchanged = seen is not None and seen == dataclasses.astuple(config)
+        except ValueError:  # a field changed to an array after the check: its == is element-wise
+            unchanged = False
+        if unchanged:
             return config
     return check_config(config, prefix=prefix)
 

@@ -61,6 +61,16 @@ def test_a_checked_config_changed_afterwards_is_checked_again(homing_checks):
     assert homing_checks == ["homing", "homing", "homing", "homing"]
 
 
+def test_a_checked_config_changed_to_an_array_is_checked_again():
+    """An array's == is element-wise: the "unchanged since the check" test must not trip over it."""
+    import numpy as np
+
+    _, config = plugin_config("homing", {"name": "sift"})
+    config.image_size = np.array([72, 16])
+    with pytest.raises(UserError, match=r"bad value homing\.image_size=\[72 16\]: it is not a list"):
+        SiftHoming(config, geometry=GEOMETRY)
+
+
 @pytest.mark.slow
 def test_the_command_line_refuses_a_bad_value_once(tmp_path):
     proc = run_bionav("homing=sift", "homing.sigma=-1", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
