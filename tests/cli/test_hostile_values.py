@@ -249,6 +249,7 @@ def test_typed_config_is_the_one_path():
             typed_config(node, Node, key="node", what="the node")
 
 
+@pytest.mark.slow
 def test_every_db_preset_uses_every_key_it_sets():
     """The presets' own values pass the unused-key check (a stand-in's grid as its preset records it)."""
     from bionav.config import compose, config_options

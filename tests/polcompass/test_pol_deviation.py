@@ -51,6 +51,7 @@ def test_pooling_is_the_median_and_too_few_samples_give_none():
     assert pooled_deviation([None]) is None
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)")
 def test_deviation_bench_learns_on_the_other_day(tmp_path):
     from omegaconf import OmegaConf

@@ -25,6 +25,7 @@ def _run(tmp_path, name, exp, sensor):
     return {k: v for k, v in metrics.items() if k != "wall_time_s"}, tmp_path / name
 
 
+@pytest.mark.slow
 def test_a_calibration_file_replaces_the_rotation_and_replays_without_the_file(tmp_path):
     # 1. a rotation run over the serial driver calibrates the (simulated, toleranced) units from the rotation
     rotation, rot_dir = _run(tmp_path, "rotation", experiment_config("rotation", **SMALL), {"name": "polcompass_serial"})

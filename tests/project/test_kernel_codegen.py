@@ -18,7 +18,9 @@ from concurrent.futures import ThreadPoolExecutor
 import pytest
 from kernel_codegen import kernel_asm
 
-pytestmark = pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="x86 targets and mnemonics")
+# slow: the module compiles every kernel in fresh processes for two targets (about 45 s)
+pytestmark = [pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="x86 targets and mnemonics"),
+              pytest.mark.slow]
 
 #: packed instructions each kernel must contain, on vector registers (ymm for AVX2, ymm or zmm for AVX-512)
 PACKED = {

@@ -37,6 +37,7 @@ def test_wheel_ships_configs_and_entry_points(wheel):
     assert "[bionav.configs]" in entry_points
 
 
+@pytest.mark.slow
 def test_wheel_install_runs_from_outside_the_checkout(wheel, tmp_path):
     target = tmp_path / "site"
     proc = _pip("install", "--no-deps", "--target", str(target), str(wheel), "-q", cwd=tmp_path)
@@ -47,6 +48,7 @@ def test_wheel_install_runs_from_outside_the_checkout(wheel, tmp_path):
     assert "sim_original" in proc.stdout and "grid_homing" in proc.stdout
 
 
+@pytest.mark.slow
 def test_regular_install_runs_from_the_checkout_root(wheel, tmp_path):
     """`pip install . && python -m bionav` from the clone's root imports the source tree, which has
     bionav/conf in place: the configs must be found (the README's first Quickstart command)."""

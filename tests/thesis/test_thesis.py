@@ -217,6 +217,7 @@ def test_cli_tiny_preset_end_to_end(tmp_path):
     assert "4 found completed" in again.stdout and "0 to run" in again.stdout
 
 
+@pytest.mark.slow
 def test_cli_reports_why_an_item_is_missing(tmp_path):
     out = tmp_path / "r"
     proc = run_bionav("--preset", "tiny", "--only", "5.3", "--out", str(out), "--report-only", cwd=tmp_path,

@@ -23,6 +23,7 @@ def test_a_face_naming_a_missing_vertex(tmp_path, faces, needle):
     assert_fails_cleanly(proc, str(path), needle, "vertices 0..2", "re-export", code=2, max_seconds=120)
 
 
+@pytest.mark.slow
 def test_a_fifo_named_like_a_mesh(tmp_path):
     path = tmp_path / "world.ply"
     os.mkfifo(path)
