@@ -49,4 +49,4 @@ def test_replay_of_a_missing_log_is_one_clear_error(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "bionav.experiments.cleaning_replay", str(tmp_path / "nowhere")],
                           capture_output=True, text=True)
     assert proc.returncode == 2
-    assert proc.stderr.startswith("error:") and "Traceback" not in proc.stderr
+    assert proc.stderr.startswith("bionav.experiments.cleaning_replay: error:") and "Traceback" not in proc.stderr

@@ -16,6 +16,8 @@ from bionav.robot.controller import LanePlan
 from bionav.robot.oracle import GeometricHoming, GeometricHomingConfig, oracle_camera
 from bionav.robot.recording import ReplayMismatch, load_logged_runs, replay_episode
 
+PROG = "bionav.experiments.cleaning_replay"  # as run_main names every command in its messages
+
 PLAN = LanePlan(n_lanes=3, lane_length=1.2)
 
 EXPERIMENT = {
@@ -152,7 +154,7 @@ def test_a_log_recorded_with_the_controllers_track_width_still_replays(tmp_path)
 
     out = replay("disagree", disagree)
     assert out.returncode == 2 and "Traceback" not in out.stderr and out.stdout == ""
-    assert out.stderr.startswith(f"error: {tmp_path / 'disagree.mcap'} was recorded with controller.track_width=0.3 "
+    assert out.stderr.startswith(f"{PROG}: error: {tmp_path / 'disagree.mcap'} was recorded with controller.track_width=0.3 "
                                  "and experiment.track_width=0.4"), out.stderr
     assert "Replay it with the bionav version that recorded it (bionav " in out.stderr
 

@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import argparse
 import logging
-import sys
 from pathlib import Path
 
 _DESCRIPTION = "replay logged cleaning runs and check that the controller emits the logged commands"
 
 
 def main(argv: list[str] | None = None) -> int:
-    from bionav.errors import UserError
     from bionav.experiments.cleaning import replay_log
 
     parser = argparse.ArgumentParser(prog="python -m bionav.experiments.cleaning_replay", description=_DESCRIPTION)
@@ -22,11 +20,7 @@ def main(argv: list[str] | None = None) -> int:
     path = Path(args.log)
     if path.is_dir():
         path = path / "run.mcap"
-    try:
-        results = replay_log(path, runs=args.run)
-    except UserError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    results = replay_log(path, runs=args.run)  # a UserError becomes "<prog>: error: ..." in run_main
     for k, r in results.items():
         print(f"run {k}: {r.n_ticks} ticks replayed, every command identical")
     return 0
