@@ -199,6 +199,23 @@ def _trace(ox, oy, oz, dx, dy, dz, el, cands, j, n_cands, el_lo, el_hi, rho_min,
     return best, kind, idx, face
 
 
+@njit(cache=True, inline="always")
+def _disk_bounds(ox, oy, cx, cy, rad):
+    """A footprint disk (centre ``cx, cy``, radius ``rad``, m) seen from ``(ox, oy)``: its nearest and
+    farthest horizontal distance, the azimuth of its centre and the half-angle it spans around it
+    (``lo = hi = 0`` when the camera stands inside it)."""
+    rho = math.sqrt((cx - ox) ** 2 + (cy - oy) ** 2)
+    rho_min = max(rho - rad, 0.0)
+    rho_max = rho + rad
+    ac = math.atan2(cy - oy, cx - ox)
+    lo = 0.0
+    hi = 0.0
+    if rho_min > 0.0:
+        hi = math.asin(rad / rho)
+        lo = -hi
+    return rho_min, rho_max, ac, lo, hi
+
+
 @njit(cache=True)
 def _prim_bounds(ox, oy, oz, kind, i, boxes, frusta, ells):
     """Angular bounds of a primitive seen from ``(ox, oy, oz)``.
@@ -239,27 +256,12 @@ def _prim_bounds(ox, oy, oz, kind, i, boxes, frusta, ells):
         zlo = cz - hz
         zhi = cz + hz
     elif kind == 1:
-        cx, cy = frusta[i, 0], frusta[i, 1]
-        rad = max(frusta[i, 4], frusta[i, 5])
-        rho = math.sqrt((cx - ox) ** 2 + (cy - oy) ** 2)
-        rho_min = max(rho - rad, 0.0)
-        rho_max = rho + rad
-        ac = math.atan2(cy - oy, cx - ox)
-        if rho_min > 0.0:
-            hi = math.asin(rad / rho)
-            lo = -hi
+        rho_min, rho_max, ac, lo, hi = _disk_bounds(ox, oy, frusta[i, 0], frusta[i, 1],
+                                                    max(frusta[i, 4], frusta[i, 5]))
         zlo = frusta[i, 2]
         zhi = frusta[i, 3]
     else:
-        cx, cy = ells[i, 0], ells[i, 1]
-        rad = max(ells[i, 3], ells[i, 4])
-        rho = math.sqrt((cx - ox) ** 2 + (cy - oy) ** 2)
-        rho_min = max(rho - rad, 0.0)
-        rho_max = rho + rad
-        ac = math.atan2(cy - oy, cx - ox)
-        if rho_min > 0.0:
-            hi = math.asin(rad / rho)
-            lo = -hi
+        rho_min, rho_max, ac, lo, hi = _disk_bounds(ox, oy, ells[i, 0], ells[i, 1], max(ells[i, 3], ells[i, 4]))
         zlo = ells[i, 2] - ells[i, 5]
         zhi = ells[i, 2] + ells[i, 5]
     el_hi = math.atan2(zhi - oz, rho_min if zhi > oz else rho_max)
