@@ -17,6 +17,7 @@ from pathlib import Path
 
 from bionav.errors import UserError
 from bionav.files import user_path
+from bionav.registry import names_by_group
 
 EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
@@ -37,7 +38,7 @@ def _fail(message: str, code: int = EXIT_USER_ERROR) -> None:
     sys.exit(code)
 
 
-def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, bool]]:
+def _precheck(argv: list[str]) -> list[tuple[Path, bool]]:
     """Catch unknown plugin names before Hydra starts; return the output dirs given (path, is_sweep)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
@@ -59,7 +60,7 @@ def _precheck(argv: list[str], names: dict[str, list[str]]) -> list[tuple[Path, 
     except Exception:
         return []  # Hydra reports syntax errors itself
     dirs: list[tuple[Path, bool]] = []
-    groups = {g: list(v) for g, v in names.items()}
+    groups = {g: list(v) for g, v in names_by_group().items()}
     for group in YAML_GROUPS:
         if _yaml_options(group):  # only groups that exist; otherwise `key=value` is a plain value
             groups.setdefault(group, [])
@@ -509,7 +510,7 @@ def _check_before_running(argv: list[str]) -> bool | None:
     """
     from bionav.config import register_configs
 
-    names = register_configs()
+    register_configs()
     from bionav.clihelp import help_text, wants_help
 
     if wants_help(argv) and "--hydra-help" not in argv:  # Hydra's own help copies its repository per group
@@ -525,7 +526,7 @@ def _check_before_running(argv: list[str]) -> bool | None:
     if not completion and not any(
         a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
     ):
-        output_dirs = _precheck(argv, names)
+        output_dirs = _precheck(argv)
     if not completion and not any(a in ("--help", "-h", "--hydra-help", "-cp", "-cn", "-cd", "--config-path",
                                         "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
         _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))

@@ -81,6 +81,11 @@ class PluginConfigSource(ConfigSource):
     ``name`` field (:func:`plugin_node_class`). A plugin that fails to load, or whose name two
     distributions claim, gives :class:`BrokenPluginNode`, so that selecting it raises its
     message from :func:`plugin_config`, and listing is never broken by it.
+
+    It also serves the typed schemas of ``bionav.schemas`` (``db_schema``,
+    ``experiment_schema/<name>``, ...; :func:`register_configs`): each dataclass becomes a
+    structured config only when Hydra loads it, so a command pays for the one experiment
+    schema it composes, not for all of them.
     """
 
     def __init__(self, provider: str, path: str) -> None:
@@ -103,25 +108,34 @@ class PluginConfigSource(ConfigSource):
 
     def is_group(self, config_path: str) -> bool:
         path = config_path.strip("/")
-        return path == "" or registry.kind_of_group(path) is not None
+        return path == "" or registry.kind_of_group(path) is not None or path in _schema_groups()
 
     def is_config(self, config_path: str) -> bool:
         group, name = self._split(config_path)
-        return registry.kind_of_group(group) is not None and name in registry.names_by_group().get(group, ())
+        if f"{group}/{name}".strip("/") in _SCHEMAS:
+            return True
+        kind = registry.kind_of_group(group)
+        # a name no entry point declares is answered without importing any plugin (Hydra asks for `sensor/None`)
+        return kind is not None and name in registry.entry_points_of(kind) and name in registry.names_in_group(group)
 
     def list(self, config_path: str, results_filter: Any) -> list[str]:
         from hydra.core.object_type import ObjectType
 
         path = config_path.strip("/")
-        if path == "":
-            groups = [g for g in PLUGIN_GROUPS]
-            return sorted(groups) if results_filter in (None, ObjectType.GROUP) else []
-        if registry.kind_of_group(path) is None or results_filter == ObjectType.GROUP:
-            return []
-        return sorted(registry.names_by_group().get(path, ()))
+        prefix = f"{path}/" if path else ""
+        schemas = [key[len(prefix):] for key in _SCHEMAS if key.startswith(prefix) and "/" not in key[len(prefix):]]
+        groups = [g for g in _schema_groups() if g.startswith(prefix) and "/" not in g[len(prefix):]]
+        groups = [g[len(prefix):] for g in groups] + (list(PLUGIN_GROUPS) if path == "" else [])
+        configs = schemas + (sorted(registry.names_in_group(path)) if registry.kind_of_group(path) else [])
+        return sorted(set((groups if results_filter in (None, ObjectType.GROUP) else [])
+                          + (configs if results_filter in (None, ObjectType.CONFIG) else [])))
 
     def load_config(self, config_path: str) -> ConfigResult:
         group, name = self._split(config_path)
+        schema = _SCHEMAS.get(f"{group}/{name}".strip("/"))
+        if schema is not None:  # a typed schema of bionav.schemas, converted now
+            return ConfigResult(config=OmegaConf.structured(schema[0]), path=f"{self.scheme()}://{self.path}",
+                                provider=schema[1], header={"package": None})
         kind = registry.kind_of_group(group)
         provider = self.provider
         try:
@@ -137,19 +151,15 @@ class PluginConfigSource(ConfigSource):
 
 
 @functools.cache
-def register_configs() -> dict[str, list[str]]:
+def register_configs() -> None:
     """Register the search-path plugin, the plugin config source and the schemas (once per process).
 
-    Plugins are not imported here (:class:`PluginConfigSource` loads the one selected).
-
-    Returns
-    -------
-    dict
-        Config group -> names of the plugins selectable in it (broken ones included).
+    Plugins are not imported here (:class:`PluginConfigSource` loads the one selected; the
+    names selectable per group are :func:`bionav.registry.names_by_group`).
     """
     Plugins.instance().register(BionavSearchPathPlugin)
     Plugins.instance().register(PluginConfigSource)
-    store = ConfigStore.instance()
+    store = _SchemaStore()
     # typed schemas of config nodes, registered by the rooms that own them (entry points
     # ``bionav.schemas``); e.g. every db preset is merged onto ``db_schema``
     schemas = registry.config_schemas()
@@ -163,7 +173,37 @@ def register_configs() -> dict[str, list[str]]:
             store.store(name=name, node=schema, provider="bionav")
         else:  # a registration function: experiment_schema/<name>, hydra/launcher=submitit_slurm, ...
             schema(store)
-    return registry.names_by_group()
+
+
+#: typed schemas registered through ``bionav.schemas``: config path (``experiment_schema/grid_homing``,
+#: ``db_schema``) -> (dataclass or instance, provider); served by :class:`PluginConfigSource`
+_SCHEMAS: dict[str, tuple[Any, str]] = {}
+
+
+def _schema_groups() -> set[str]:
+    """Config groups holding schemas (``experiment_schema``), parents included."""
+    out: set[str] = set()
+    for key in _SCHEMAS:
+        parts = key.split("/")[:-1]
+        out |= {"/".join(parts[: i + 1]) for i in range(len(parts))}
+    return out
+
+
+class _SchemaStore:
+    """What ``bionav.schemas`` registration functions store into (the ``store`` argument).
+
+    It has :meth:`hydra.core.config_store.ConfigStore.store`'s signature but keeps the
+    dataclass as it is; :class:`PluginConfigSource` turns it into a structured config when
+    Hydra loads it. A node with a ``package`` goes to Hydra's ConfigStore unchanged.
+    """
+
+    def store(self, name: str, node: Any, group: str | None = None, package: str | None = None,
+              provider: str | None = None) -> None:
+        if package is not None:
+            ConfigStore.instance().store(name=name, node=node, group=group, package=package, provider=provider)
+            return
+        name = name[: -len(".yaml")] if name.endswith(".yaml") else name
+        _SCHEMAS[f"{group}/{name}" if group else name] = (node, provider or "bionav")
 
 
 def config_options(group: str) -> list[str]:

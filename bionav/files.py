@@ -26,10 +26,12 @@ import io
 import json
 import os
 import secrets
+import sys
 from pathlib import Path
-from typing import IO, Any, Callable, Iterable, Sequence
+from typing import IO, TYPE_CHECKING, Any, Callable, Iterable, Sequence
 
-import numpy as np
+if TYPE_CHECKING:  # numpy is imported where an array is hashed: start-up paths (TAB completion) stay without it
+    import numpy as np
 
 __all__ = ["cache_key", "check_cache_dir", "default_cache_dir", "not_a_regular_file", "read_json_file", "user_path",
            "write_atomic", "write_csv_atomic", "write_json_atomic"]
@@ -195,6 +197,8 @@ def cache_key(payload: Any, *arrays: np.ndarray) -> str:
     str
         64 hexadecimal digits.
     """
+    import numpy as np
+
     h = hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode())
     for array in arrays:
         arr = np.ascontiguousarray(array)
@@ -250,9 +254,10 @@ def write_atomic(path: str | Path, data: str | bytes | Callable[[IO[bytes]], Non
 
 
 def _json_scalar(value: Any) -> Any:
-    if isinstance(value, np.generic):
+    np = sys.modules.get("numpy")  # a NumPy value exists only where numpy was imported
+    if np is not None and isinstance(value, np.generic):
         return value.item()
-    if isinstance(value, np.ndarray):
+    if np is not None and isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, Path):
         return str(value)

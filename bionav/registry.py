@@ -38,7 +38,7 @@ GROUPS: dict[str, str] = {
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"
-#: entry-point group of structured config schemas (``name = "module:Dataclass"``) stored in Hydra's ConfigStore
+#: entry-point group of structured config schemas (``name = "module:Dataclass"`` or a registration function) served to Hydra
 SCHEMA_GROUP = "bionav.schemas"
 
 

@@ -73,15 +73,24 @@ def test_installed_bash_completion_completes_python_m_bionav(tmp_path):
     assert proc.stdout.split() == ["db=sim_hall1", "db=sim_hall2"]
 
 
-def _imported_modules(args: list[str], tmp_path) -> set[str]:
-    """Modules imported by bionav's command line ``ARGS`` (run in a fresh interpreter)."""
+def _imported_modules(args: list[str], tmp_path, *, comp_line: str | None = None,
+                      stdout: list[str] | None = None) -> set[str]:
+    """Modules imported by bionav's command line ``ARGS`` (run in a fresh interpreter).
+
+    ``comp_line``: the shell's COMP_LINE of a completion query; ``stdout``: receives the output.
+    """
     out = tmp_path / "modules.json"
     code = ("import json, sys\nfrom bionav.cli import main\ntry:\n    main(%r)\nexcept SystemExit as exc:\n"
             "    assert not exc.code, exc.code\nopen(%r, 'w').write(json.dumps(sorted(sys.modules)))\n"
             % (list(args), str(out)))
+    env = dict(os.environ, BIONAV_CACHE=str(tmp_path / "cache"))
+    if comp_line is not None:
+        env.update(COMP_LINE=comp_line, COMP_POINT=str(len(comp_line)))
     proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=120,
-                          env=dict(os.environ, BIONAV_CACHE=str(tmp_path / "cache")))
+                          env=env)
     assert proc.returncode == 0, proc.stderr[-2000:]
+    if stdout is not None:
+        stdout.append(proc.stdout)
     return set(json.loads(out.read_text()))
 
 
@@ -94,6 +103,18 @@ def test_plugins_are_imported_only_when_selected(tmp_path):
     composed = _imported_modules(["homing=mfdid", "--cfg", "job"], tmp_path)
     assert "bionav.plugins.homing.mfdid" in composed
     assert "bionav.plugins.homing.sift" not in composed and "bionav.plugins.homing.warping" not in composed
+
+
+def test_a_key_completion_composes_without_other_plugins_or_numpy_free_rooms(tmp_path):
+    """TAB after a key composes the default config: only the selected plugin (sift) is imported; no sensor
+    plugin (Hydra asks for ``sensor/None``), no database room (its schema is read without NumPy's users)."""
+    printed: list[str] = []
+    modules = _imported_modules(["-sc", "query=bash"], tmp_path, comp_line="python -m bionav homing.search_r",
+                                stdout=printed)
+    assert printed[0].split() == ["homing.search_radius="]
+    plugins = {m for m in modules if m.startswith("bionav.plugins.") and m.count(".") >= 3}
+    assert plugins == {"bionav.plugins.homing.sift"}, plugins
+    assert "bionav.db.database" not in modules and "bionav.experiments.grid_homing" not in modules
 
 
 @pytest.mark.slow

@@ -214,11 +214,11 @@ import json, sys
 from bionav.cli import _precheck
 from bionav.config import register_configs
 from hydra import compose, initialize
-names = register_configs()
+register_configs()
 out = []
 for args in json.load(sys.stdin):
     try:
-        _precheck(args, names)
+        _precheck(args)
         with initialize(version_base="1.3", config_path=None):
             cfg = compose("config", overrides=args)
         out.append(None if cfg.get("experiment") else "no experiment node")

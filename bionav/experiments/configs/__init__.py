@@ -1,7 +1,7 @@
 """Typed configs of the experiments: one dataclass per ``experiment=<name>``, defaults in one place.
 
-Each dataclass is stored in Hydra's ConfigStore as ``experiment_schema/<name>``
-(:func:`register`); the preset ``conf/experiment/<name>.yaml`` puts it under
+Each dataclass is registered as ``experiment_schema/<name>`` (:func:`register`;
+:func:`bionav.config.register_configs` serves it to Hydra when a command composes it); the preset ``conf/experiment/<name>.yaml`` puts it under
 ``experiment`` first in its defaults list and then sets only what differs or
 what refers to other keys. Hydra therefore rejects unknown keys and values of
 the wrong type at composition; :func:`experiment_config` fills the defaults
@@ -169,7 +169,11 @@ EXPERIMENT_CONFIGS: dict[str, type] = {
 
 
 def register(store=None) -> None:
-    """Store every experiment's dataclass as ``experiment_schema/<name>`` in Hydra's ConfigStore."""
+    """Store every experiment's dataclass as ``experiment_schema/<name>`` in ``store`` (default Hydra's ConfigStore).
+
+    :func:`bionav.config.register_configs` passes a store that keeps the dataclasses as they are and
+    turns one into a structured config only when Hydra composes it (start-up stays fast).
+    """
     from hydra.core.config_store import ConfigStore
 
     store = store or ConfigStore.instance()
