@@ -15,6 +15,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from bionav.clihelp import composition_message
 from bionav.errors import UserError
 from bionav.files import user_path
 from bionav.registry import names_by_group
@@ -112,9 +113,8 @@ def _concrete_overrides(argv: list[str]) -> list[str] | None:
     """The command line's overrides with each sweep replaced by its first value (None: unparsable)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
-    args = [a for a in argv if not a.startswith("-")]
-    try:
-        overrides = OverridesParser.create().parse_overrides(args)
+    try:  # the words after --cfg, --info, -cn, ... are not overrides
+        overrides = OverridesParser.create().parse_overrides(_override_words(argv))
     except Exception:
         return None  # Hydra reports syntax errors itself
     out = []
@@ -133,47 +133,6 @@ def _concrete_overrides(argv: list[str]) -> list[str] | None:
         else:
             out.append(override.input_line)
     return out
-
-
-def _node_keys(overrides: list[str], node: str) -> list[str]:
-    """Keys of config node ``node`` when composed with the group choices among ``overrides``."""
-    from omegaconf import DictConfig, OmegaConf
-
-    from bionav.config import compose
-
-    groups = [o for o in overrides if "." not in o.split("=", 1)[0].lstrip("+~")]
-    try:
-        cfg = compose(groups)
-    except Exception:
-        return []
-    value = OmegaConf.select(cfg, node) if node else cfg
-    return [str(k) for k in value.keys()] if isinstance(value, DictConfig) else []
-
-
-def composition_message(exc: BaseException, overrides: list[str]) -> str:
-    """One paragraph for a Hydra composition error (misspelt key, wrong type, unknown option)."""
-    from bionav.config import unknown_key_message
-
-    cause = exc.__cause__ or exc.__context__
-    full_key = str(getattr(cause, "full_key", "") or "")
-    first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    name = type(cause).__name__ if cause is not None else ""
-    if name in ("ConfigAttributeError", "ConfigKeyError") and full_key:
-        if "." in full_key:
-            node, bad = full_key.rsplit(".", 1)
-        else:
-            node, bad = "", full_key
-        message = unknown_key_message(node, bad, _node_keys(overrides, node))
-        return f"{message} Fix the spelling on the command line (`python -m bionav --cfg job` shows the whole config)."
-    if name == "ValidationError" and full_key:
-        given = next((o.split("=", 1)[1] for o in overrides if o.split("=", 1)[0].lstrip("+~") == full_key), "?")
-        reason = str(cause).splitlines()[0]
-        return (f"bad value {full_key}={given}: {reason}. Give {full_key} a value of its declared type "
-                f"(`python -m bionav --cfg job` shows the current value).")
-    if type(exc).__name__ == "MissingConfigException":
-        return (f"{first}. Pick one of the available options (`python -m bionav --help` lists them, "
-                "`python -m bionav.plugins` the installed plugins).")
-    return f"the configuration cannot be composed: {first}. Check the overrides on the command line."
 
 
 def _check_composition(argv: list[str], *, validate: bool = True) -> None:

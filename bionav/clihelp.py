@@ -7,6 +7,9 @@ groups of the entry points (:func:`bionav.registry.names_by_group`, no plugin im
 the sensors), then composes the config once, with the command line's overrides, for the
 ``== Config ==`` part. Internal groups (``experiment_schema``, ``db_schema``) are not listed;
 Hydra's groups (``hydra/launcher=...``) are in ``--hydra-help``.
+
+:func:`composition_message` is the one paragraph users read when the command line does not
+compose (a misspelt or moved key, a wrong type, an unknown option).
 """
 
 from __future__ import annotations
@@ -63,3 +66,49 @@ def help_text(overrides: Sequence[str]) -> str:
     lines += ["", "", "== Config ==", "Override anything in the config (foo.bar=value)", "",
               OmegaConf.to_yaml(OmegaConf.create(job)).rstrip("\n"), "", footer]
     return "\n".join(lines) + "\n"
+
+
+def _node_keys(overrides: list[str], node: str) -> list[str]:
+    """Keys of config node ``node`` when composed with the group choices among ``overrides``."""
+    from omegaconf import DictConfig, OmegaConf
+
+    from bionav.config import compose
+
+    groups = [o for o in overrides if "." not in o.split("=", 1)[0].lstrip("+~")]
+    try:
+        cfg = compose(groups)
+    except Exception:
+        return []
+    value = OmegaConf.select(cfg, node) if node else cfg
+    return [str(k) for k in value.keys()] if isinstance(value, DictConfig) else []
+
+
+def composition_message(exc: BaseException, overrides: list[str]) -> str:
+    """One paragraph for a Hydra composition error (misspelt key, wrong type, unknown option)."""
+    from bionav.config import unknown_key_message
+
+    cause = exc.__cause__ or exc.__context__
+    full_key = str(getattr(cause, "full_key", "") or "")
+    first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    name = type(cause).__name__ if cause is not None else ""
+    if name in ("ConfigAttributeError", "ConfigKeyError") and full_key:
+        if "." in full_key:
+            node, bad = full_key.rsplit(".", 1)
+        else:
+            node, bad = "", full_key
+        from bionav.experiments.configs import LEGACY_KEYS
+
+        if full_key in LEGACY_KEYS:  # a setting that moved (one setting per quantity): say where to
+            return (f"{full_key} is no longer a setting: it is {LEGACY_KEYS[full_key]} now (one setting per "
+                    f"quantity); pass {LEGACY_KEYS[full_key]}=... instead.")
+        message = unknown_key_message(node, bad, _node_keys(overrides, node))
+        return f"{message} Fix the spelling on the command line (`python -m bionav --cfg job` shows the whole config)."
+    if name == "ValidationError" and full_key:
+        given = next((o.split("=", 1)[1] for o in overrides if o.split("=", 1)[0].lstrip("+~") == full_key), "?")
+        reason = str(cause).splitlines()[0]
+        return (f"bad value {full_key}={given}: {reason}. Give {full_key} a value of its declared type "
+                f"(`python -m bionav --cfg job` shows the current value).")
+    if type(exc).__name__ == "MissingConfigException":
+        return (f"{first}. Pick one of the available options (`python -m bionav --help` lists them, "
+                "`python -m bionav.plugins` the installed plugins).")
+    return f"the configuration cannot be composed: {first}. Check the overrides on the command line."

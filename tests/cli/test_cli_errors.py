@@ -4,14 +4,7 @@ import json
 import os
 
 import pytest
-from helpers import run_bionav
-
-
-def _clean_failure(proc, *needles):
-    assert proc.returncode != 0, proc.stdout
-    assert "Traceback" not in proc.stderr, proc.stderr
-    for needle in needles:
-        assert needle in proc.stderr, proc.stderr
+from helpers import assert_fails_cleanly, run_bionav
 
 
 def test_help_lists_choices(tmp_path):
@@ -23,18 +16,32 @@ def test_help_lists_choices(tmp_path):
 
 def test_unknown_homing_lists_available(tmp_path):
     proc = run_bionav("homing=siftt", cwd=tmp_path)
-    _clean_failure(proc, "unknown homing 'siftt'", "sift", "mfdid")
+    assert_fails_cleanly(proc, "unknown homing 'siftt'", "sift", "mfdid")
     assert proc.returncode == 2
 
 
 def test_unknown_database_lists_available(tmp_path):
     proc = run_bionav("db=sim_nowhere", cwd=tmp_path)
-    _clean_failure(proc, "unknown db 'sim_nowhere'", "sim_original")
+    assert_fails_cleanly(proc, "unknown db 'sim_nowhere'", "sim_original")
 
 
 def test_wrong_parameter_type(tmp_path):
     proc = run_bionav("homing.window=wide", cwd=tmp_path)
-    _clean_failure(proc, "window")
+    assert_fails_cleanly(proc, "window")
+
+
+def test_cfg_job_checks_the_overrides_like_a_run(tmp_path):
+    """``--cfg job``'s value ``job`` is not an override: the keys after it are still checked by bionav."""
+    proc = run_bionav("homing.serch_radius=3", "--cfg", "job", cwd=tmp_path)
+    assert_fails_cleanly(proc, "unknown key homing.serch_radius", "Did you mean homing.search_radius?", code=2)
+    proc = run_bionav("experiment.step_length=abc", "--cfg", "job", cwd=tmp_path)
+    assert_fails_cleanly(proc, "bad value experiment.step_length=abc", code=2)
+
+
+def test_a_moved_setting_names_its_new_key(tmp_path):
+    """One setting per quantity (issue 28): an old command line's controller.track_width is pointed to its home."""
+    proc = run_bionav("experiment=cleaning", "controller.track_width=0.3", "--cfg", "job", cwd=tmp_path)
+    assert_fails_cleanly(proc, "controller.track_width is no longer a setting", "experiment.track_width=", code=2)
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root can write anywhere")
@@ -42,20 +49,20 @@ def test_unwritable_output_dir_nonroot(tmp_path):
     locked = tmp_path / "locked"
     locked.mkdir(mode=0o500)
     proc = run_bionav(f"hydra.run.dir={locked}/run", cwd=tmp_path)
-    _clean_failure(proc, "not writable")
+    assert_fails_cleanly(proc, "not writable")
 
 
 def test_unwritable_output_dir(tmp_path):
     target = tmp_path / "a_file"
     target.write_text("not a directory")
     proc = run_bionav(f"hydra.run.dir={target}/run", cwd=tmp_path)
-    _clean_failure(proc)
+    assert_fails_cleanly(proc)
 
 
 def test_failed_run_writes_failed_metrics(tmp_path):
     run_dir = tmp_path / "run"
     proc = run_bionav("experiment.name=no_such_experiment", f"hydra.run.dir={run_dir}", cwd=tmp_path)
-    _clean_failure(proc, "no experiment named 'no_such_experiment'")
+    assert_fails_cleanly(proc, "no experiment named 'no_such_experiment'")
     metrics = json.loads((run_dir / "metrics.json").read_text())
     assert metrics["status"] == "failed" and "no_such_experiment" in metrics["error"]
     assert (run_dir / "run.mcap").stat().st_size > 0
