@@ -50,10 +50,10 @@ def test_polarization_view_depolarizes_where_the_layer_is_cloudy():
 def test_simple_sky_behind_the_layer():
     layer = CloudLayer(cover=0.4, seed=3, brightness=1.25)
     sun = (0.0, -0.8, 0.6)
-    clear = SimpleSky(sun_direction=sun, clouds=0.0)
-    sky = SimpleSky(sun_direction=sun, clouds=0.0, layer=layer, time_s=100.0)
+    clear = SimpleSky(sun_direction=sun)
+    sky = SimpleSky(sun_direction=sun, layer=layer, time_s=100.0)
     d = _directions(seed=2)
     c = layer.cloudiness_at(d, time_s=100.0)[:, None]
     np.testing.assert_allclose(sky(d), (1 - c) * clear(d) + c * 1.25 * clear(np.array([[1.0, 0, 0]])), rtol=1e-12)
     assert sky(d).shape == (400, 1) and not np.allclose(sky(d), clear(d))
-    assert SimpleSky(sun_direction=sun, clouds=0.0, layer=CloudLayer(cover=0.0))(d) == pytest.approx(clear(d))
+    assert SimpleSky(sun_direction=sun, layer=CloudLayer(cover=0.0))(d) == pytest.approx(clear(d))
