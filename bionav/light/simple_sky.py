@@ -50,6 +50,9 @@ class SimpleSky:
     times the clear horizon's (sunlit cumulus are brighter than the blue sky
     they hide) where it is cloud, blended over the cloud edges and, towards
     the horizon, where distant clouds merge, towards the layer's ``cover``.
+    ``L(horizon)`` is the clear sky at the east horizon, ``d = (1, 0, 0)``:
+    ``horizon`` plus the sun's glow there (``glow * exp(-angle / 0.15)``, a
+    few 1e-4 for a sun 75-90 degrees away, as the campus').
     Without a layer (or with ``cover=0``) the sky is exactly the clear ``L``.
 
     Parameters
