@@ -326,7 +326,7 @@ def _cache_params(name: str, seed: int, noise: float, geometry, world, positions
     from bionav.world.render import RENDERER_VERSION
 
     compiled_digest = world.scene.compile().digest()
-    return {
+    params = {
         "renderer_version": RENDERER_VERSION,
         "database_version": DATABASE_VERSION,
         "name": name,
@@ -340,6 +340,9 @@ def _cache_params(name: str, seed: int, noise: float, geometry, world, positions
         "exposure": float(world.scene.exposure),
         "scene": compiled_digest,
     }
+    if "sky" in world.info:  # the scene's sky (not in the compiled digest): the campus' SimpleSky
+        params["sky"] = world.info["sky"]
+    return params
 
 
 def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
@@ -363,6 +366,7 @@ def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
         params["light_level"] = float(world.light_level)
     if "capture_light" in world.info:  # light changing during the capture (sim_uni)
         params["capture_light"] = world.info["capture_light"]
+        params.pop("sky", None)  # each capture's sky is the capture light's, not the scene's
     return camera, pose_error
 
 

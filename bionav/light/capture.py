@@ -105,8 +105,6 @@ class CaptureLight:
         renderer's units; per band times :data:`~bionav.light.simple_sky.SKY_GAIN`.
     channels : tuple of str
         Band names.
-    seed : int
-        Seed of the sky (:class:`SimpleSky`).
     """
 
     order: np.ndarray
@@ -121,7 +119,6 @@ class CaptureLight:
     sun_irradiance: float = 2.2
     sky_irradiance: float = 1.2
     channels: tuple[str, ...] = ("grey",)
-    seed: int = 0
 
     def __post_init__(self) -> None:
         ephemeris = self.site_deg is not None and self.start_utc is not None
@@ -141,18 +138,18 @@ class CaptureLight:
     def describe(self) -> dict:
         """The model's parameters (JSON; part of the render cache key)."""
         c = self.clouds
-        if c is not None and self.start_utc is not None:  # the uni capture's key, unchanged since capture-light-2
+        if c is not None and self.start_utc is not None:  # the uni capture's key (capture-light-2)
             return {"model": "capture-light-2", "start_utc": self.start_utc, "site_deg": list(self.site_deg),
                     "seconds_per_capture": float(self.seconds_per_capture), "cloud_cover": float(c.cover),
                     "cloud_optical_depth": float(c.optical_depth), "cloud_height_m": float(c.height_m),
                     "cloud_scale_m": float(c.scale_m), "cloud_softness": float(c.softness),
                     "cloud_resolution": float(c.resolution), "wind_mps": [float(v) for v in c.wind_mps],
-                    "cloud_brightness": float(c.brightness), "cloud_seed": int(c.seed), "seed": int(self.seed)}
+                    "cloud_brightness": float(c.brightness), "cloud_seed": int(c.seed)}
         order = np.ascontiguousarray(self.order, np.int64)
         out = {"model": "capture-light-3", "order_sha256": hashlib.sha256(order.tobytes()).hexdigest()[:16],
                "grid_shape": list(order.shape), "seconds_per_capture": float(self.seconds_per_capture),
                "sun_irradiance": float(self.sun_irradiance), "sky_irradiance": float(self.sky_irradiance),
-               "channels": list(self.channels), "seed": int(self.seed)}
+               "channels": list(self.channels)}
         if self.start_utc is not None:
             out.update(start_utc=self.start_utc, site_deg=[float(v) for v in self.site_deg])
         else:
@@ -226,9 +223,8 @@ class CaptureLight:
         sun = self.sun_direction(t)
         air_mass = 1.0 / max(float(sun[2]), np.sin(np.deg2rad(1.0)))
         transmittance = float(self.clouds.transmittance_at(sun, air_mass=air_mass, time_s=t))
-        clear = SimpleSky(sun_direction=tuple(sun), channels=self.channels, clouds=0.0, seed=int(self.seed))
-        sky = SimpleSky(sun_direction=tuple(sun), channels=self.channels, clouds=0.0, seed=int(self.seed),
-                        layer=self.clouds, time_s=t)
+        clear = SimpleSky(sun_direction=tuple(sun), channels=self.channels)
+        sky = SimpleSky(sun_direction=tuple(sun), channels=self.channels, layer=self.clouds, time_s=t)
         dirs, w = hemisphere_directions()
         ratio = float((sky(dirs)[:, 0] * w).sum() / (clear(dirs)[:, 0] * w).sum())
         sun_e = np.array([self.sun_irradiance * SUN_GAIN.get(ch, 1.0) * transmittance for ch in self.channels])

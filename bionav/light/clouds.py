@@ -7,7 +7,8 @@
   :mod:`bionav.light.daylight`, the uni capture light of
   :mod:`bionav.light.capture`) and the polarization (cloudiness, e-vector
   noise; :class:`~bionav.light.polarized_sky.SkyModel` takes a layer as its
-  ``clouds``).
+  ``clouds``) and the clouds of the rendered worlds' sky
+  (:class:`~bionav.light.simple_sky.SimpleSky` takes a layer as its ``layer``).
 * :class:`CloudMap` (polarized-light compass recordings, thesis chapter 4):
   a snapshot of a layer over the sky hemisphere (:meth:`CloudLayer.hemisphere_map`):
   its cloudiness and e-vector noise field sampled on a map, so that a
@@ -200,7 +201,9 @@ class CloudLayer:
     -----
     One layer, three views: :meth:`density_at` (cover),
     :meth:`transmittance_at` (shade of the direct sun) and
-    :meth:`cloudiness_at` / :meth:`angle_noise_at` (polarization). Frame:
+    :meth:`cloudiness_at` / :meth:`angle_noise_at` (polarization; the
+    cloudiness also blends the rendered sky of
+    :class:`~bionav.light.simple_sky.SimpleSky` towards ``brightness``). Frame:
     east-north-up; the field drifts with ``wind_mps`` (frozen turbulence).
     """
 

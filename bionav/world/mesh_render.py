@@ -108,7 +108,7 @@ class MeshWorld:
         if self.sky is None:
             from bionav.light.simple_sky import SimpleSky
 
-            self.sky = SimpleSky(sun_direction=tuple(self.sun), channels=self.band_names, glow=0.6, clouds=0.0)
+            self.sky = SimpleSky(sun_direction=tuple(self.sun), channels=self.band_names, glow=0.6)
         grey = self.mesh.grey
         shade = np.ones(len(self.mesh))
         if self.shading == "lambert":

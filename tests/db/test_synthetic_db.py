@@ -156,6 +156,25 @@ def test_cache_round_trip_and_key(tmp_path):
     assert cache_key({"a": 1, "b": 2}) == cache_key({"b": 2, "a": 1}) != cache_key({"a": 1, "b": 3})
 
 
+def test_uni_ideal_cache_key_follows_the_sky(tmp_path, monkeypatch):
+    """The campus' sky is not in the compiled scene's digest: its description (World.info["sky"]) keys the renders."""
+    from bionav.world.worlds import outdoor
+
+    kw = dict(image_size=(24, 4), cache_dir=tmp_path)
+    ideal = synthetic_database("sim_uni", **kw)
+    assert synthetic_database("sim_uni", **kw).meta["from_cache"]
+    monkeypatch.setattr(outdoor, "CLOUD_RADIANCE", 2.0)  # brighter clouds in the sky, same geometry
+    brighter = synthetic_database("sim_uni", **kw)
+    assert not brighter.meta["from_cache"] and brighter.meta["cache_file"] != ideal.meta["cache_file"]
+    world = get_spec("sim_uni").builder(0)
+    k = int(np.flatnonzero((ideal.positions == [4, 8]).all(axis=1))[0])
+    sky = np.isinf(render_depth(world.scene, position=world.cell_position(4, 8),
+                                geometry=get_spec("sim_uni").geometry(24, 4))[0])
+    assert sky.any() and np.all(brighter.images[k][sky] >= ideal.images[k][sky])
+    assert np.any(brighter.images[k][sky] > ideal.images[k][sky])  # the clouds in view are brighter
+    np.testing.assert_array_equal(brighter.images[k][~sky], ideal.images[k][~sky])  # nothing else changed
+
+
 def test_random_rotation_rolls_and_records_headings(tmp_path):
     kw = dict(image_size=(40, 6), cache_dir=tmp_path, noise=0.0)
     db = synthetic_database("sim_original", **kw)

@@ -50,10 +50,42 @@ def test_polarization_view_depolarizes_where_the_layer_is_cloudy():
 def test_simple_sky_behind_the_layer():
     layer = CloudLayer(cover=0.4, seed=3, brightness=1.25)
     sun = (0.0, -0.8, 0.6)
-    clear = SimpleSky(sun_direction=sun, clouds=0.0)
-    sky = SimpleSky(sun_direction=sun, clouds=0.0, layer=layer, time_s=100.0)
+    clear = SimpleSky(sun_direction=sun)
+    sky = SimpleSky(sun_direction=sun, layer=layer, time_s=100.0)
     d = _directions(seed=2)
     c = layer.cloudiness_at(d, time_s=100.0)[:, None]
     np.testing.assert_allclose(sky(d), (1 - c) * clear(d) + c * 1.25 * clear(np.array([[1.0, 0, 0]])), rtol=1e-12)
     assert sky(d).shape == (400, 1) and not np.allclose(sky(d), clear(d))
-    assert SimpleSky(sun_direction=sun, clouds=0.0, layer=CloudLayer(cover=0.0))(d) == pytest.approx(clear(d))
+    assert SimpleSky(sun_direction=sun, layer=CloudLayer(cover=0.0))(d) == pytest.approx(clear(d))
+
+
+def test_simple_sky_is_brighter_where_the_layer_is_denser():
+    """Away from the sun's glow the clear sky is the same at one elevation: the radiance rises with the density."""
+    layer = CloudLayer(cover=0.4, seed=3, scale_m=600.0, softness=0.05, resolution=1e-4, brightness=1.25)
+    sky = SimpleSky(sun_direction=(0.0, 0.0, 1.0), glow=0.0, layer=layer, time_s=50.0)
+    az = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
+    el = np.deg2rad(40.0)
+    d = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.full_like(az, np.sin(el))], axis=1)
+    c = layer.density_at(d, time_s=50.0)
+    assert np.sum(c < 1e-6) > 20 and np.sum(c > 1.0 - 1e-6) > 20  # clear and cloudy lines of sight
+    radiance = sky(d)[:, 0]
+    order = np.argsort(c, kind="stable")
+    assert np.all(np.diff(radiance[order]) >= -1e-12)  # never darker where denser
+    # clear: the clear-sky formula by hand; full cloud: 1.25 times the clear horizon (0.95)
+    clear = 0.55 + (0.95 - 0.55) * (1.0 - np.sin(el)) ** 2
+    assert radiance[c < 1e-6] == pytest.approx(clear, abs=1e-6)
+    assert radiance[c > 1.0 - 1e-6] == pytest.approx(1.25 * 0.95, abs=1e-6)
+
+
+def test_simple_sky_without_cover_is_exactly_the_clear_sky_and_the_texture_is_deterministic():
+    sun = (0.3, -0.7, 0.65)
+    d = _directions(seed=4)
+    clear = SimpleSky(sun_direction=sun, channels=("UV", "G"))(d)
+    assert np.array_equal(SimpleSky(sun_direction=sun, channels=("UV", "G"), layer=CloudLayer(cover=0.0))(d), clear)
+    cloudy = SimpleSky(sun_direction=sun, channels=("UV", "G"), layer=CloudLayer(cover=0.5, seed=7), time_s=12.0)
+    again = SimpleSky(sun_direction=sun, channels=("UV", "G"), layer=CloudLayer(cover=0.5, seed=7), time_s=12.0)
+    other = SimpleSky(sun_direction=sun, channels=("UV", "G"), layer=CloudLayer(cover=0.5, seed=8), time_s=12.0)
+    assert np.array_equal(cloudy(d), again(d)) and not np.allclose(cloudy(d), other(d))
+    # the bands keep their sky gains (UV 1.4, G 1.0) behind the clouds too
+    np.testing.assert_allclose(cloudy(d)[:, 0], 1.4 * cloudy(d)[:, 1], rtol=1e-12)
+    assert cloudy.describe()["layer"]["seed"] == 7 and cloudy.describe() != other.describe()

@@ -7,6 +7,7 @@ import pytest
 
 from bionav.geometry import PanoramaGeometry
 from bionav.light.clouds import CloudLayer
+from bionav.light.simple_sky import SimpleSky
 from bionav.light.sun import parse_time, sun_position
 from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.render import render_panorama
@@ -108,3 +109,26 @@ def test_relit_scene_renders_as_a_freshly_built_one(uni):
 def test_ideal_uni_is_the_campus_unchanged(uni):
     assert uni.scene.compile().digest() == build_campus(0).scene.compile().digest()
     assert uni.capture_scene is not None and "capture_light" in uni.info
+
+
+def test_the_campus_sky_shows_the_capture_layer_frozen_at_the_first_capture(uni):
+    """db.realism=ideal: the campus' clouds are the capture light's layer (outdoor.campus_clouds) at time 0."""
+    sky = uni.scene.sky
+    layer = uni_capture_light(uni.cells, 0).clouds
+    assert sky.layer == layer == outdoor.campus_clouds(0) and sky.time_s == 0.0
+    assert uni.info["sky"] == sky.describe() and uni.info["sky"]["layer"]["cover"] == outdoor.CLOUD_COVER
+    # the sky seen from the grid: the clear sky blended by the layer's cloud fraction towards the cloud's
+    # radiance, 1.25 times the clear east horizon (0.95 plus a trace of the sun's glow); the first capture's sky
+    # (other sun) has the same clouds
+    d = np.random.default_rng(5).normal(size=(4000, 3))
+    d[:, 2] = np.abs(d[:, 2]) + 0.1
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    c = layer.density_at(d)[:, None]
+    assert 0.2 < np.mean(c > 0.5) < 0.6
+    first = uni_capture_light(uni.cells, 0).conditions(0, 0)["sky"]
+    for s in (sky, first):
+        clear = SimpleSky(sun_direction=s.sun_direction)
+        horizon = clear(np.array([[1.0, 0.0, 0.0]]))
+        assert horizon[0, 0] == pytest.approx(0.95, abs=1e-3)
+        np.testing.assert_allclose(s(d), (1 - c) * clear(d) + c * outdoor.CLOUD_RADIANCE * horizon, rtol=1e-12)
+    assert first.time_s == 0.0 and first.layer == sky.layer and first.sun_direction != sky.sun_direction

@@ -83,6 +83,24 @@ def capture_order(cells: np.ndarray) -> np.ndarray:
     return order
 
 
+def campus_clouds(seed: int) -> CloudLayer:
+    """The campus' cloud layer (:class:`~bionav.light.clouds.CloudLayer`) with this module's assumptions.
+
+    One layer for the campus' sky and the uni capture's light: the default sky
+    of :func:`build_campus` shows it at ``time_s=0`` (the clouds of the first
+    capture, frozen), :func:`uni_capture_light` lets it drift over the sky and
+    the sun during the capture.
+
+    Parameters
+    ----------
+    seed : int
+        The world's seed (the layer's).
+    """
+    return CloudLayer(cover=CLOUD_COVER, optical_depth=CLOUD_OPTICAL_DEPTH, seed=int(seed), height_m=CLOUD_HEIGHT_M,
+                      scale_m=CLOUD_SCALE_M, wind_mps=WIND_MPS, softness=CLOUD_SOFTNESS,
+                      resolution=float(np.deg2rad(CLOUD_RESOLUTION_DEG)), brightness=CLOUD_RADIANCE)
+
+
 def uni_capture_light(cells: np.ndarray, seed: int) -> CaptureLight:
     """The light of the uni capture (:class:`~bionav.light.capture.CaptureLight`) with this module's assumptions.
 
@@ -91,13 +109,10 @@ def uni_capture_light(cells: np.ndarray, seed: int) -> CaptureLight:
     cells : ndarray, shape (10, 17), bool
         The grid cells that exist (their :func:`capture_order`).
     seed : int
-        The world's seed (the cloud layer's and the sky's).
+        The world's seed (the cloud layer's, :func:`campus_clouds`).
     """
-    clouds = CloudLayer(cover=CLOUD_COVER, optical_depth=CLOUD_OPTICAL_DEPTH, seed=int(seed), height_m=CLOUD_HEIGHT_M,
-                        scale_m=CLOUD_SCALE_M, wind_mps=WIND_MPS, softness=CLOUD_SOFTNESS,
-                        resolution=float(np.deg2rad(CLOUD_RESOLUTION_DEG)), brightness=CLOUD_RADIANCE)
-    return CaptureLight(order=capture_order(cells), clouds=clouds, site_deg=SITE_DEG, start_utc=CAPTURE_START_UTC,
-                        seconds_per_capture=SECONDS_PER_CAPTURE, seed=int(seed))
+    return CaptureLight(order=capture_order(cells), clouds=campus_clouds(seed), site_deg=SITE_DEG,
+                        start_utc=CAPTURE_START_UTC, seconds_per_capture=SECONDS_PER_CAPTURE)
 
 
 def relit_at(scene: Scene, light: CaptureLight, i: int, j: int) -> Scene:
@@ -128,7 +143,9 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
         wood soil``. Default :func:`bionav.light.materials.band_albedos`.
     sky : callable, optional
         ``sky(directions (N, 3)) -> radiance (N, C)``; default
-        :class:`~bionav.light.simple_sky.SimpleSky` for the sun position.
+        :class:`~bionav.light.simple_sky.SimpleSky` for the sun position behind
+        the campus' cloud layer (:func:`campus_clouds`, at ``time_s=0``);
+        its parameters are recorded as ``World.info["sky"]`` (a render cache key).
     sun_elevation, sun_azimuth : float
         Sun position in radians (azimuth CCW from world ``+x``; ``-pi/2`` is
         south, so the grid north of the main building lies in its shadow).
@@ -151,8 +168,10 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
         if np.asarray(v).reshape(-1).size not in (1, c):
             raise ValueError(f"albedo of {k!r} must have 1 or {c} values")
     sun = tuple(float(v) for v in direction_from_angles(sun_azimuth, sun_elevation))
+    info = {"sun_elevation": float(sun_elevation), "sun_azimuth": float(sun_azimuth), "channels": channels}
     if sky is None:
-        sky = SimpleSky(sun_direction=sun, channels=channels, seed=int(seed))
+        sky = SimpleSky(sun_direction=sun, channels=channels, layer=campus_clouds(seed))
+        info["sky"] = sky.describe()
     if sun_irradiance is None:
         sun_irradiance = [2.2 * SUN_GAIN.get(ch, 1.0) for ch in channels]
     if sky_irradiance is None:
@@ -180,9 +199,7 @@ def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
     scene.ambient = Ambient(up=tuple(up), down=tuple(0.4 * up))
     scene.exposure = exposure
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=GRID_SHAPE,
-                 camera_height=CAMERA_HEIGHT,
-                 info={"sun_elevation": float(sun_elevation), "sun_azimuth": float(sun_azimuth),
-                       "channels": channels}, floor_tilt_deg=FLOOR_TILT_DEG)
+                 camera_height=CAMERA_HEIGHT, info=info, floor_tilt_deg=FLOOR_TILT_DEG)
 
 
 def _campus_ground(seed: int, scene: Scene, mat: Callable[..., int]) -> None:
