@@ -38,11 +38,6 @@ def test_cfg_job_checks_the_overrides_like_a_run(tmp_path):
     assert_fails_cleanly(proc, "bad value experiment.step_length=abc", code=2)
 
 
-def test_a_moved_setting_names_its_new_key(tmp_path):
-    """One setting per quantity (issue 28): an old command line's controller.track_width is pointed to its home."""
-    proc = run_bionav("experiment=cleaning", "controller.track_width=0.3", "--cfg", "job", cwd=tmp_path)
-    assert_fails_cleanly(proc, "controller.track_width is no longer a setting", "experiment.track_width=", code=2)
-
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root can write anywhere")
 def test_unwritable_output_dir_nonroot(tmp_path):

@@ -149,4 +149,6 @@ def test_track_width_is_the_robots_one_setting(tmp_path):
     assert OdometryController(OdometryConfig())._wheels(0.0, 1.0) == pytest.approx((-0.15, 0.15))  # default 0.30 m
     proc = run_bionav("experiment=cleaning", "controller.track_width=0.4", f"hydra.run.dir={tmp_path / 'run'}",
                       cwd=tmp_path)
-    assert_fails_cleanly(proc, "unknown key controller.track_width", code=2)
+    # the moved setting is named with its one home (it was a bare "unknown key" before the hint)
+    assert_fails_cleanly(proc, "controller.track_width is no longer a setting", "pass experiment.track_width=",
+                         code=2)
