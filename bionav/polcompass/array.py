@@ -194,9 +194,11 @@ class UnitEvectors:
         E-vector as a unit vector in the sensor frame (axial).
     pair_total : ndarray, shape ``(N, K, J)``, optional
         Light through each POL-OP, ``s_a + s_b`` (counts divided by the gains): its count-noise scale.
-        ``x`` is NaN where a POL-OP is unusable at that sample (:func:`masked_pol_ops`: a saturated,
-        overflowing or dark photodiode, a faulty unit), so a unit with one good POL-OP still reads
-        ``x = d cos(2a - 2 alpha)`` there (:func:`bionav.polcompass.decoders.sun_from_pol_op_fit`).
+    pol_op_valid : ndarray of bool, shape ``(N, K, J)``, optional
+        Which POL-OPs read usable counts (:func:`masked_pol_ops`: no saturated, overflowing or dark
+        photodiode, unit not faulty), so that a unit with one good POL-OP still gives
+        ``x = d cos(2a - 2 alpha)`` (:func:`bionav.polcompass.decoders.sun_from_pol_op_fit`). ``None``
+        (not checked): only the POL-OPs of the units a decoder's ``valid`` mask keeps are used.
     """
 
     x: np.ndarray
@@ -205,6 +207,7 @@ class UnitEvectors:
     intensity: np.ndarray
     evector: np.ndarray
     pair_total: np.ndarray | None = None
+    pol_op_valid: np.ndarray | None = None
 
 
 def stokes_evector(counts, array: PolArray):
@@ -300,14 +303,15 @@ def masked_pol_ops(ev: UnitEvectors, pol_op_valid, *, faulty_units=()) -> UnitEv
     -------
     UnitEvectors
         Angles, degrees and e-vectors unchanged (a decoder's per-unit ``valid`` mask still says which
-        units read both POL-OPs); ``x`` NaN where ``pol_op_valid`` is false.
+        units read both POL-OPs); ``x`` NaN and :attr:`UnitEvectors.pol_op_valid` false where
+        ``pol_op_valid`` is false or the unit is faulty.
     """
-    ok = np.asarray(pol_op_valid, bool)
-    units = np.zeros(ok.shape[-2], bool)
+    units = np.zeros(np.shape(ev.x)[-2], bool)
     units[list(faulty_units)] = True
-    x = np.where(ok & ~units[:, None], ev.x, np.nan)
+    ok = np.asarray(pol_op_valid, bool) & ~units[:, None] & np.isfinite(ev.x)
+    x = np.where(ok, ev.x, np.nan)
     intensity = np.where(units, np.nan, ev.intensity)
-    return UnitEvectors(x, ev.angle, ev.degree, intensity, ev.evector, ev.pair_total)
+    return UnitEvectors(x, ev.angle, ev.degree, intensity, ev.evector, ev.pair_total, ok)
 
 
 def counts_from_stokes(intensity, q, u, array: PolArray, *, efficiency: float = 1.0):

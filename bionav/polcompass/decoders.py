@@ -324,7 +324,8 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     if fallback.any():
         rows = np.flatnonzero(fallback)
         sub = _rows(ev, rows)
-        f_score, f_total, f_ok = _pol_op_scores(sub, table=table, array=array, noise_counts=noise_counts,
+        f_score, f_total, f_ok = _pol_op_scores(sub, np.asarray(valid, bool)[rows], table=table, array=array,
+                                                noise_counts=noise_counts,
                                                 model_error=model_error, min_units=min_units)
         score[rows], total[rows] = f_score, f_total
         bright[rows] = brightness_azimuth(sub, np.isfinite(sub.intensity), array)
@@ -340,7 +341,8 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
 def _rows(ev: UnitEvectors, rows) -> UnitEvectors:
     """Some samples of ``ev``."""
     pt = None if ev.pair_total is None else ev.pair_total[rows]
-    return UnitEvectors(ev.x[rows], ev.angle[rows], ev.degree[rows], ev.intensity[rows], ev.evector[rows], pt)
+    ok = None if ev.pol_op_valid is None else ev.pol_op_valid[rows]
+    return UnitEvectors(ev.x[rows], ev.angle[rows], ev.degree[rows], ev.intensity[rows], ev.evector[rows], pt, ok)
 
 
 def pol_op_table(table: SkyTable, array: PolArray):
@@ -353,13 +355,14 @@ def pol_op_table(table: SkyTable, array: PolArray):
     return table.degree[:, :, None] * (table.cos2[:, :, None] * np.cos(a2) + table.sin2[:, :, None] * np.sin(a2))
 
 
-def _pol_op_scores(ev: UnitEvectors, *, table: SkyTable, array: PolArray, noise_counts: float, model_error: float,
-                   min_units: int, min_degree: float = 0.05):
+def _pol_op_scores(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, noise_counts: float,
+                   model_error: float, min_units: int, min_degree: float = 0.05):
     """Scores of :func:`sun_from_pol_op_fit` on the table's azimuths ``(N, G)``, the normalising totals ``(N,)`` and
     whether each sample has enough readings ``(N,)``."""
     x = np.asarray(ev.x, float)
     xs = np.nan_to_num(x)
-    readable = np.isfinite(x)
+    checked = np.asarray(valid, bool)[..., None] if ev.pol_op_valid is None else np.asarray(ev.pol_op_valid, bool)
+    readable = np.isfinite(x) & checked
     if noise_counts > 0 and ev.pair_total is not None:
         s = np.nan_to_num(np.asarray(ev.pair_total, float))
         with np.errstate(divide="ignore"):
@@ -375,7 +378,7 @@ def _pol_op_scores(ev: UnitEvectors, *, table: SkyTable, array: PolArray, noise_
     return score, np.maximum(np.sum(w * xs.reshape(n, -1) ** 2, axis=-1), 1e-12), enough
 
 
-def sun_from_pol_op_fit(ev: UnitEvectors, *, table: SkyTable, array: PolArray, noise_counts: float = 0.0,
+def sun_from_pol_op_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, noise_counts: float = 0.0,
                         model_error: float = np.deg2rad(10.0), margin: float = 0.01, min_units: int = 2) -> SunEstimate:
     """The solar azimuth from every usable POL-OP, not every usable unit.
 
@@ -388,12 +391,15 @@ def sun_from_pol_op_fit(ev: UnitEvectors, *, table: SkyTable, array: PolArray, n
     ``lambda = sum x b / sum b^2`` and the score ``(sum x b)_+^2 / sum b^2`` is maximised on the grid, then
     refined by a parabola; the eq. 4.6 pair as in :func:`sun_from_sky_fit` (the degree pattern is not
     mirror-symmetric for tilted units), else the brighter side (units with a finite intensity, saturated
-    ones included). ``sky_fit`` uses it for samples where too few units read both POL-OPs.
+    ones included: only faulty units' intensities are NaN). ``sky_fit`` uses it for samples where too few units read both POL-OPs.
 
     Parameters
     ----------
     ev : UnitEvectors
-        ``x`` NaN where a POL-OP is unusable (:func:`bionav.polcompass.array.masked_pol_ops`).
+        With :attr:`~bionav.polcompass.array.UnitEvectors.pol_op_valid` (:func:`bionav.polcompass.array.masked_pol_ops`)
+        every usable POL-OP takes part; without it only those of the units in ``valid``.
+    valid : ndarray of bool, shape ``(N, K)``
+        Units reading both POL-OPs (the per-unit mask of the other decoders).
     table : SkyTable
     array : PolArray
     noise_counts : float
@@ -411,7 +417,7 @@ def sun_from_pol_op_fit(ev: UnitEvectors, *, table: SkyTable, array: PolArray, n
     SunEstimate
         NaN where the sample has too few usable POL-OPs.
     """
-    score, total, ok = _pol_op_scores(ev, table=table, array=array, noise_counts=noise_counts, model_error=model_error,
+    score, total, ok = _pol_op_scores(ev, valid, table=table, array=array, noise_counts=noise_counts, model_error=model_error,
                                       min_units=min_units)
     _, first, second, gap = _pick_pair(score, table.azimuths, total, margin)
     resolved = gap > margin
