@@ -107,7 +107,8 @@ def prepare_session(session, rc) -> SessionData:
     index = np.concatenate([np.full(r.yaw.size, i) for i, r in enumerate(rots)])
     array = build_array(rc, rots[0].file_azimuths)
     faults = detect_faults(counts, saturation_counts=rc.saturation_counts, dark_counts=rc.dark_counts,
-                           imbalance_decades=rc.imbalance_decades, blind_fraction=rc.blind_fraction)
+                           imbalance_decades=rc.imbalance_decades, blind_fraction=rc.blind_fraction,
+                           pairs=array.pairs)
     excluded = excluded_units(rc, faults, counts.shape[1])
     valid = sample_validity(counts, saturation_counts=rc.saturation_counts, dark_counts=rc.dark_counts,
                             imbalance_decades=rc.imbalance_decades)

@@ -337,6 +337,7 @@ def detect_faults(
     imbalance_decades: float = 0.15,
     blind_fraction: float = 0.5,
     min_usable_fraction: float = 0.05,
+    pairs=None,
 ) -> list[UnitFault]:
     """Per-unit fault report of a session from its counts alone.
 
@@ -353,6 +354,10 @@ def detect_faults(
         which a unit is polarization-blind.
     min_usable_fraction : float
         Units usable at fewer samples are dropped too.
+    pairs : ndarray of int, shape ``(J, 2)``, optional
+        The POL-OPs' photodiode pairs: a unit counts as usable at a sample where one of its POL-OPs is
+        (:func:`pol_op_validity`; a unit whose one pair is always saturated still gives the other). None:
+        only where every photodiode is usable.
 
     Returns
     -------
@@ -363,8 +368,12 @@ def detect_faults(
     sat = (c.max(axis=-1) >= saturation_counts).mean(axis=0)
     lit = c.min(axis=-1) >= dark_counts
     dark = 1.0 - lit.mean(axis=0)
-    usable = sample_validity(c, saturation_counts=saturation_counts, dark_counts=dark_counts,
-                             imbalance_decades=np.inf).mean(axis=0)
+    if pairs is None:
+        usable = sample_validity(c, saturation_counts=saturation_counts, dark_counts=dark_counts,
+                                 imbalance_decades=np.inf).mean(axis=0)
+    else:
+        usable = pol_op_validity(c, pairs, saturation_counts=saturation_counts,
+                                 dark_counts=dark_counts).any(axis=-1).mean(axis=0)
     if p == 4:
         same = (c[..., 0] == c[..., 1]) | (c[..., 2] == c[..., 3])
         imb = pair_imbalance(c)
