@@ -20,9 +20,10 @@ Decoders
     the best one within 45 degrees of its antipode (eq. 4.6 generalised to tilted
     units); the lower error wins, and where the errors differ by less than
     the margin the brighter side of the sky (first harmonic of the units'
-    intensities) decides. Samples where fewer than ``min_units`` units read
-    both POL-OPs (a saturated pair, a photodiode read fault) are decoded from
-    every usable POL-OP instead (:func:`sun_from_pol_op_fit`).
+    intensities) decides. Samples where a unit reads only one of its POL-OPs
+    (a saturated pair, a photodiode read fault), or where fewer than
+    ``min_units`` units read both, are decoded from every usable POL-OP
+    instead (:func:`sun_from_pol_op_fit`), so partly saturated units vote.
 ``two_unit`` (the thesis' solution)
     Eqs. 4.4-4.5 give each unit's e-vector; for single scattering the sun is
     perpendicular to every e-vector, so two units give ``s = +-(e_i x e_j)``
@@ -298,9 +299,10 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
         Fewest units taking part for a sample to be decoded (two e-vectors fix the sun); fewer: NaN,
         ``SunEstimate.valid`` False (below the noise floor nothing is claimed).
     pol_op_fallback : bool
-        Samples with fewer than ``min_units`` units taking part are decoded from every usable POL-OP
-        (:func:`sun_from_pol_op_fit`: units with one saturated pair or one faulty photodiode still vote);
-        NaN only where that has too few readings too.
+        Samples with fewer than ``min_units`` units taking part, and samples where a unit reads one POL-OP
+        only (:attr:`UnitEvectors.pol_op_valid`: one saturated pair, one faulty photodiode), are decoded from
+        every usable POL-OP (:func:`sun_from_pol_op_fit`), so such units still vote; where that has too few
+        readings the whole units' fit stays (NaN if there is none).
 
     Returns
     -------
@@ -320,22 +322,30 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     usable = w0.sum(axis=-1) > 0
     total = np.maximum(w.sum(axis=-1), 1e-12)
     bright = brightness_azimuth(ev, valid, array)
-    fallback = ~usable if pol_op_fallback else np.zeros_like(usable)
+    fallback = _pol_op_rows(ev, usable) if pol_op_fallback else np.zeros_like(usable)
     if fallback.any():
         rows = np.flatnonzero(fallback)
         sub = _rows(ev, rows)
         f_score, f_total, f_ok = _pol_op_scores(sub, np.asarray(valid, bool)[rows], table=table, array=array,
-                                                noise_counts=noise_counts,
-                                                model_error=model_error, min_units=min_units)
+                                                noise_counts=noise_counts, model_error=model_error, min_units=min_units)
+        rows, f_score, f_total = rows[f_ok], f_score[f_ok], f_total[f_ok]  # too few POL-OPs: the whole units' fit stays
         score[rows], total[rows] = f_score, f_total
-        bright[rows] = brightness_azimuth(sub, np.isfinite(sub.intensity), array)
+        bright[rows] = brightness_azimuth(_rows(ev, rows), np.isfinite(ev.intensity[rows]), array)
         usable = usable.copy()
-        usable[rows] = f_ok
+        usable[rows] = True
     _, first, second, gap = _pick_pair(score, table.azimuths, total, margin)
     resolved = gap > margin
     by_light, other = _choose_by_brightness(first, second, bright)
     azimuth = np.where(usable, np.where(resolved, first, by_light), np.nan)
     return SunEstimate(azimuth, np.where(usable, np.where(resolved, second, other), np.nan), resolved & usable)
+
+
+def _pol_op_rows(ev: UnitEvectors, usable):
+    """Samples ``sky_fit`` decodes from every usable POL-OP: too few whole units (not ``usable``), or a unit that
+    reads one POL-OP only (it votes there; needs :attr:`UnitEvectors.pol_op_valid`), shape ``(N,)``."""
+    if ev.pol_op_valid is None:
+        return ~usable
+    return ~usable | np.any(np.sum(ev.pol_op_valid, axis=-1) == 1, axis=-1)
 
 
 def _rows(ev: UnitEvectors, rows) -> UnitEvectors:
@@ -391,7 +401,8 @@ def sun_from_pol_op_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolA
     ``lambda = sum x b / sum b^2`` and the score ``(sum x b)_+^2 / sum b^2`` is maximised on the grid, then
     refined by a parabola; the eq. 4.6 pair as in :func:`sun_from_sky_fit` (the degree pattern is not
     mirror-symmetric for tilted units), else the brighter side (units with a finite intensity, saturated
-    ones included: only faulty units' intensities are NaN). ``sky_fit`` uses it for samples where too few units read both POL-OPs.
+    ones included: only faulty units' intensities are NaN). ``sky_fit`` uses it for samples where a unit reads one POL-OP
+    only or too few units read both.
 
     Parameters
     ----------

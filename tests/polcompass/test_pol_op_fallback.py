@@ -118,3 +118,22 @@ def test_fallback_claims_nothing_without_enough_pol_ops():
     est = sun_from_sky_fit(ev, valid, table=sky_table(arr, el), array=arr, sun_elevation=el, min_units=2,
                            pol_op_fallback=True)
     assert np.isnan(est.azimuth).all() and not est.resolved.any()
+
+
+def test_a_partly_saturated_unit_votes_beside_whole_units():
+    # four whole units and three units with one overflowing pair: the sample is fitted on every usable POL-OP
+    phi = np.deg2rad(np.arange(-170.0, 180.0, 31.0))
+    el = np.deg2rad(50.0)
+    arr, counts = _sky_counts(phi, el)
+    counts[:, 4:7, 0:2] = 32768.0
+    valid = sample_validity(counts, saturation_counts=SAT, dark_counts=1.0, imbalance_decades=0.15)
+    ok = pol_op_validity(counts, arr.pairs, saturation_counts=SAT, dark_counts=1.0)
+    ev = masked_pol_ops(evectors_from_counts(counts, arr), ok, faulty_units=[7])
+    valid[:, 7] = False
+    kw = dict(table=sky_table(arr, el), array=arr, sun_elevation=el, min_units=2)
+    whole = sun_from_sky_fit(ev, valid, **kw)
+    both = sun_from_sky_fit(ev, valid, pol_op_fallback=True, **kw)
+    alone = sun_from_pol_op_fit(ev, valid, table=kw["table"], array=arr)
+    np.testing.assert_array_equal(both.azimuth, alone.azimuth)  # the POL-OP fit decided
+    for est in (whole, both):  # noise-free: both agree with the sun
+        np.testing.assert_allclose(np.degrees(wrap_angle(est.azimuth - phi)), 0.0, atol=0.1)
