@@ -31,9 +31,9 @@ class SkyFitConfig:
         dark noise (0.0-0.5 counts rms per photodiode after sunset, docs/polcompass.md "Dusk").
     min_units : fewest units taking part for a sample to be decoded; fewer: no heading (``valid`` false),
         unless ``pol_op_fallback``.
-    pol_op_fallback : such samples are decoded from every usable POL-OP instead
-        (:func:`bionav.polcompass.decoders.sun_from_pol_op_fit`: a unit with one saturated pair still gives one
-        equation); docs/polcompass.md "Real skies".
+    pol_op_fallback : such samples, and samples where a unit reads one of its POL-OPs only, are decoded from every
+        usable POL-OP instead (:func:`bionav.polcompass.decoders.sun_from_pol_op_fit`: a unit with one saturated pair
+        still gives one equation); docs/polcompass.md "Real skies".
     """
 
     residual: str = bounded("perpendicular", choices=("perpendicular", "angle"))
