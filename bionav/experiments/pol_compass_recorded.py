@@ -95,9 +95,9 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
     """
     from bionav.experiments import pol_compass_plots as plots_mod
     from bionav.polcompass import heading_errors
-    from bionav.polcompass.array import PolArray, evectors_from_counts
+    from bionav.polcompass.array import PolArray, evectors_from_counts, masked_pol_ops
     from bionav.polcompass.decoders import heading_from_sun
-    from bionav.polcompass.recordings import sample_validity
+    from bionav.polcompass.recordings import pol_op_validity, sample_validity
 
     sensor = session.sensor
     if hasattr(sensor, "remaining"):
@@ -127,6 +127,9 @@ def recorded_rotation_mode(session, exp, *, sensor_config, decoder, plots=None) 
                   schema=CALIBRATION_SCHEMA)
     with np.errstate(invalid="ignore", divide="ignore"):
         ev = evectors_from_counts(counts, array)
+    # a fault mask per POL-OP too: a unit with one saturated pair still gives one equation (sky_fit's fallback)
+    ev = masked_pol_ops(ev, pol_op_validity(counts, array.pairs, saturation_counts=sensor_config.saturation_counts,
+                                            dark_counts=sensor_config.dark_counts))
     est = decoder.decode(ev, valid & np.isfinite(ev.angle), array=array, sun_elevation=float(session.sun.elevation))
     heading = heading_from_sun(est.azimuth, session.sun.azimuth)
     ok = np.isfinite(heading)

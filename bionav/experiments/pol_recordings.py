@@ -153,11 +153,12 @@ def _decoders(cfg, ctx, exp) -> tuple[str, dict]:
 
 
 def _calibration_for(prepared, rc, ctx, decoder):
-    """``calibration(day) -> (ArrayCalibration or None, label)`` for ``recordings.calibration``.
+    """``calibration(day, period) -> (ArrayCalibration or None, label)`` for ``recordings.calibration``.
 
     ``auto`` self-calibrates the daylight sessions, writes ``calibration.json`` pooled over all days and
     gives each day the calibration of the others (with ``tilt`` in ``calibration_parts`` also the mount tilt
-    learned on the others with ``decoder``); a file is loaded once; ``none`` gives none.
+    learned on the others with ``decoder``) in the conditions of ``recordings.calibration_conditions``; a file
+    is loaded once and applied in those conditions; ``none`` gives none.
     """
     from dataclasses import replace
 
@@ -174,14 +175,16 @@ def _calibration_for(prepared, rc, ctx, decoder):
             pooled.save(ctx.dir / "calibration.json")
         cache = {}
 
-        def for_day(day):
+        def for_day(day, period):
             if day not in cache:
                 cal, label = leave_one_day_out(estimates, day)
                 if tilt and cal is not None:
                     cal = replace(cal, mount_tilt=mount_tilt(prepared, rc, cal, decoder, leave_out_day=day))
                     label += " + mount tilt"
                 cache[day] = (cal, label)
-            return cache[day]
+            cal, label = cache[day]
+            skip = _not_applied(rc, period) if cal is not None else None
+            return (None, skip) if skip else (cal, label)
 
         return for_day
     fixed = None
@@ -192,7 +195,17 @@ def _calibration_for(prepared, rc, ctx, decoder):
         if tilt and fixed.mount_tilt is None:
             log.warning("recordings.calibration_parts has tilt but %s holds no mount tilt; none is applied", how)
     label = "none" if fixed is None else f"file {how}"
-    return lambda day: (fixed, label)
+
+    def for_file(day, period):
+        skip = _not_applied(rc, period) if fixed is not None else None
+        return (None, skip) if skip else (fixed, label)
+
+    return for_file
+
+
+def _not_applied(rc, period):
+    """Why the calibration is not applied to ``period`` (a label), or None where it is."""
+    return None if period in rc.calibration_conditions else f"none ({period} not in recordings.calibration_conditions)"
 
 
 class _Tally:
@@ -274,7 +287,7 @@ def _score_all(ctx, exp, rc, prepared, calibration_for, decoders, chosen) -> _Ta
     rng_sim = ctx.rng.spawn(1)[0]
     for data in ctx.progress(prepared, desc="sessions", total=len(prepared)):
         session = data.session
-        cal, cal_label = calibration_for(session.day)
+        cal, cal_label = calibration_for(session.day, data.period)
         tally.n_rotations += len(session.rotations)
         for f in data.faults:
             tally.fault_rows.append({"session": session.name, **f.to_dict()})

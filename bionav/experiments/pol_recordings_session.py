@@ -84,13 +84,22 @@ class SessionData:
     excluded: list
     sun: Any
     period: str
+    pol_op_valid: np.ndarray | None = None  # (N, K, J): both photodiodes of the POL-OP usable, unit not dropped
+
+
+def session_evectors(counts, array, pol_op_valid, excluded):
+    """E-vectors of a session's counts with every unusable POL-OP masked (:func:`~bionav.polcompass.array.masked_pol_ops`)."""
+    from bionav.polcompass.array import evectors_from_counts, masked_pol_ops
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ev = evectors_from_counts(counts, array)
+    return ev if pol_op_valid is None else masked_pol_ops(ev, pol_op_valid, faulty_units=excluded)
 
 
 def prepare_session(session, rc) -> SessionData:
     """Counts, validity, e-vectors and the sun position of one session."""
     from bionav.light import sun_position
-    from bionav.polcompass.array import evectors_from_counts
-    from bionav.polcompass.recordings import detect_faults, sample_validity
+    from bionav.polcompass.recordings import detect_faults, pol_op_validity, sample_validity
 
     rots = session.rotations
     counts = np.concatenate([r.counts for r in rots])
@@ -98,13 +107,15 @@ def prepare_session(session, rc) -> SessionData:
     index = np.concatenate([np.full(r.yaw.size, i) for i, r in enumerate(rots)])
     array = build_array(rc, rots[0].file_azimuths)
     faults = detect_faults(counts, saturation_counts=rc.saturation_counts, dark_counts=rc.dark_counts,
-                           imbalance_decades=rc.imbalance_decades, blind_fraction=rc.blind_fraction)
+                           imbalance_decades=rc.imbalance_decades, blind_fraction=rc.blind_fraction,
+                           pairs=array.pairs)
     excluded = excluded_units(rc, faults, counts.shape[1])
     valid = sample_validity(counts, saturation_counts=rc.saturation_counts, dark_counts=rc.dark_counts,
                             imbalance_decades=rc.imbalance_decades)
     valid[:, excluded] = False
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ev = evectors_from_counts(counts, array)
+    pol_ok = pol_op_validity(counts, array.pairs, saturation_counts=rc.saturation_counts, dark_counts=rc.dark_counts)
+    pol_ok[:, excluded] = False
+    ev = session_evectors(counts, array, pol_ok, excluded)
     valid &= np.isfinite(ev.angle)
     when = session.time_utc(rc.utc_offset_hours)
     if when is None:
@@ -117,7 +128,7 @@ def prepare_session(session, rc) -> SessionData:
         period = "canopy"
     else:
         period = "tod_daylight" if np.degrees(sun.elevation) >= rc.dusk_elevation_deg else "tod_dusk"
-    return SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period)
+    return SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period, pol_ok)
 
 
 def calibration_sessions(datas, rc) -> list:
@@ -165,17 +176,14 @@ def leave_one_day_out(estimates, day):
 def calibrated(data: SessionData, calibration, parts, solver: str = "pol_op") -> SessionData:
     """The session decoded through a calibrated array (same counts and validity; ``solver``: see
     :meth:`~bionav.polcompass.array_calibration.ArrayCalibration.apply`)."""
-    from bionav.polcompass.array import evectors_from_counts
-
     if calibration is None:
         return data
     array = calibration.apply(data.array, gains="gains" in parts, angles="angles" in parts, azimuths=False,
                               solver=solver)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ev = evectors_from_counts(data.counts, array)
+    ev = session_evectors(data.counts, array, data.pol_op_valid, data.excluded)
     valid = data.valid & np.isfinite(ev.angle)
     return SessionData(data.session, array, data.counts, data.yaw, data.rotation_index, valid, ev, data.faults,
-                       data.excluded, data.sun, data.period)
+                       data.excluded, data.sun, data.period, data.pol_op_valid)
 
 
 def decode_session(decoder, data: SessionData, mount_tilt=None):
@@ -247,7 +255,8 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     from dataclasses import replace
 
     from bionav.light import SkyModel, random_cloud_map
-    from bionav.polcompass.array import counts_from_stokes, evectors_from_counts, stokes_from_sky
+    from bionav.polcompass.array import counts_from_stokes, stokes_from_sky
+    from bionav.polcompass.recordings import pol_op_validity
 
     clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
     model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
@@ -271,11 +280,12 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     saturation = float(np.max(data.counts)) if data.counts.size else np.inf
     valid = (counts.max(axis=-1) < saturation) & (counts.min(axis=-1) > 0)
     valid[:, data.excluded] = False
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ev = evectors_from_counts(counts, data.array)
+    pol_ok = pol_op_validity(counts, data.array.pairs, saturation_counts=saturation, dark_counts=1.0)
+    pol_ok[:, data.excluded] = False
+    ev = session_evectors(counts, data.array, pol_ok, data.excluded)
     valid &= np.isfinite(ev.angle)
     return SessionData(data.session, data.array, counts, data.yaw, data.rotation_index, valid, ev, data.faults,
-                       data.excluded, data.sun, data.period)
+                       data.excluded, data.sun, data.period, pol_ok)
 
 
 def prepared_sessions(rc) -> tuple[list, list]:
@@ -311,6 +321,7 @@ __all__ = [
     "prepared_sessions",
     "self_calibrate",
     "session_errors",
+    "session_evectors",
     "simulate_session",
     "view_field",
 ]

@@ -192,6 +192,13 @@ class UnitEvectors:
         Mean photodiode reading of each unit.
     evector : ndarray, shape ``(N, K, 3)``
         E-vector as a unit vector in the sensor frame (axial).
+    pair_total : ndarray, shape ``(N, K, J)``, optional
+        Light through each POL-OP, ``s_a + s_b`` (counts divided by the gains): its count-noise scale.
+    pol_op_valid : ndarray of bool, shape ``(N, K, J)``, optional
+        Which POL-OPs read usable counts (:func:`masked_pol_ops`: no saturated, overflowing or dark
+        photodiode, unit not faulty), so that a unit with one good POL-OP still gives
+        ``x = d cos(2a - 2 alpha)`` (:func:`bionav.polcompass.decoders.sun_from_pol_op_fit`). ``None``
+        (not checked): only the POL-OPs of the units a decoder's ``valid`` mask keeps are used.
     """
 
     x: np.ndarray
@@ -199,6 +206,8 @@ class UnitEvectors:
     degree: np.ndarray
     intensity: np.ndarray
     evector: np.ndarray
+    pair_total: np.ndarray | None = None
+    pol_op_valid: np.ndarray | None = None
 
 
 def stokes_evector(counts, array: PolArray):
@@ -272,8 +281,37 @@ def evectors_from_counts(counts, array: PolArray) -> UnitEvectors:
             angle[..., g] = a
             degree[..., g] = d
     evector = np.cos(angle)[..., None] * frames[:, :, 0] + np.sin(angle)[..., None] * frames[:, :, 1]
-    intensity = np.mean(counts / array.gains, axis=-1)
-    return UnitEvectors(x, angle, degree, intensity, evector)
+    s = counts / array.gains
+    intensity = np.mean(s, axis=-1)
+    return UnitEvectors(x, angle, degree, intensity, evector, s[..., array.pairs[:, 0]] + s[..., array.pairs[:, 1]])
+
+
+def masked_pol_ops(ev: UnitEvectors, pol_op_valid, *, faulty_units=()) -> UnitEvectors:
+    """The e-vectors with every unusable POL-OP's output ``x`` set to NaN (a fault mask per POL-OP, not per unit).
+
+    Parameters
+    ----------
+    ev : UnitEvectors
+    pol_op_valid : ndarray of bool, shape ``(N, K, J)``
+        Whether both photodiodes of each POL-OP read usable counts at each sample
+        (:func:`bionav.polcompass.recordings.pol_op_validity`).
+    faulty_units : sequence of int
+        Units dropped for the whole session (blind, a bad photodiode): every reading of theirs, the
+        intensity included, becomes NaN.
+
+    Returns
+    -------
+    UnitEvectors
+        Angles, degrees and e-vectors unchanged (a decoder's per-unit ``valid`` mask still says which
+        units read both POL-OPs); ``x`` NaN and :attr:`UnitEvectors.pol_op_valid` false where
+        ``pol_op_valid`` is false or the unit is faulty.
+    """
+    units = np.zeros(np.shape(ev.x)[-2], bool)
+    units[list(faulty_units)] = True
+    ok = np.asarray(pol_op_valid, bool) & ~units[:, None] & np.isfinite(ev.x)
+    x = np.where(ok, ev.x, np.nan)
+    intensity = np.where(units, np.nan, ev.intensity)
+    return UnitEvectors(x, ev.angle, ev.degree, intensity, ev.evector, ev.pair_total, ok)
 
 
 def counts_from_stokes(intensity, q, u, array: PolArray, *, efficiency: float = 1.0):

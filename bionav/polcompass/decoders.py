@@ -20,7 +20,10 @@ Decoders
     the best one within 45 degrees of its antipode (eq. 4.6 generalised to tilted
     units); the lower error wins, and where the errors differ by less than
     the margin the brighter side of the sky (first harmonic of the units'
-    intensities) decides.
+    intensities) decides. Samples where a unit reads only one of its POL-OPs
+    (a saturated pair, a photodiode read fault), or where fewer than
+    ``min_units`` units read both, are decoded from every usable POL-OP
+    instead (:func:`sun_from_pol_op_fit`), so partly saturated units vote.
 ``two_unit`` (the thesis' solution)
     Eqs. 4.4-4.5 give each unit's e-vector; for single scattering the sun is
     perpendicular to every e-vector, so two units give ``s = +-(e_i x e_j)``
@@ -243,7 +246,7 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
                      residual: str = "perpendicular", weight_power: float = 1.0, robust_iterations: int = 2,
                      robust_scale: float = np.deg2rad(20.0), reject: float | None = np.deg2rad(30.0),
                      model_error: float = np.deg2rad(10.0), margin: float = 0.01, noise_counts: float = 0.0,
-                     min_units: int = 1) -> SunEstimate:
+                     min_units: int = 1, pol_op_fallback: bool = False) -> SunEstimate:
     """bionav's least-squares fit of the sky model's pattern (see the module docstring).
 
     Parameters
@@ -295,6 +298,11 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     min_units : int
         Fewest units taking part for a sample to be decoded (two e-vectors fix the sun); fewer: NaN,
         ``SunEstimate.valid`` False (below the noise floor nothing is claimed).
+    pol_op_fallback : bool
+        Samples with fewer than ``min_units`` units taking part, and samples where a unit reads one POL-OP
+        only (:attr:`UnitEvectors.pol_op_valid`: one saturated pair, one faulty photodiode), are decoded from
+        every usable POL-OP (:func:`sun_from_pol_op_fit`), so such units still vote; where that has too few
+        readings the whole units' fit stays (NaN if there is none).
 
     Returns
     -------
@@ -311,12 +319,122 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
         score, w = _angle_scores(ev, w0, table=table, **robust)
     else:
         raise ValueError(f"residual must be 'perpendicular' or 'angle', got {residual!r}")
-    _, first, second, gap = _pick_pair(score, table.azimuths, np.maximum(w.sum(axis=-1), 1e-12), margin)
-    resolved = gap > margin
-    by_light, other = _choose_by_brightness(first, second, brightness_azimuth(ev, valid, array))
     usable = w0.sum(axis=-1) > 0
+    total = np.maximum(w.sum(axis=-1), 1e-12)
+    bright = brightness_azimuth(ev, valid, array)
+    fallback = _pol_op_rows(ev, usable) if pol_op_fallback else np.zeros_like(usable)
+    if fallback.any():
+        rows = np.flatnonzero(fallback)
+        sub = _rows(ev, rows)
+        f_score, f_total, f_ok = _pol_op_scores(sub, np.asarray(valid, bool)[rows], table=table, array=array,
+                                                noise_counts=noise_counts, model_error=model_error, min_units=min_units)
+        rows, f_score, f_total = rows[f_ok], f_score[f_ok], f_total[f_ok]  # too few POL-OPs: the whole units' fit stays
+        score[rows], total[rows] = f_score, f_total
+        bright[rows] = brightness_azimuth(_rows(ev, rows), np.isfinite(ev.intensity[rows]), array)
+        usable = usable.copy()
+        usable[rows] = True
+    _, first, second, gap = _pick_pair(score, table.azimuths, total, margin)
+    resolved = gap > margin
+    by_light, other = _choose_by_brightness(first, second, bright)
     azimuth = np.where(usable, np.where(resolved, first, by_light), np.nan)
     return SunEstimate(azimuth, np.where(usable, np.where(resolved, second, other), np.nan), resolved & usable)
+
+
+def _pol_op_rows(ev: UnitEvectors, usable):
+    """Samples ``sky_fit`` decodes from every usable POL-OP: too few whole units (not ``usable``), or a unit that
+    reads one POL-OP only (it votes there; needs :attr:`UnitEvectors.pol_op_valid`), shape ``(N,)``."""
+    if ev.pol_op_valid is None:
+        return ~usable
+    return ~usable | np.any(np.sum(ev.pol_op_valid, axis=-1) == 1, axis=-1)
+
+
+def _rows(ev: UnitEvectors, rows) -> UnitEvectors:
+    """Some samples of ``ev``."""
+    pt = None if ev.pair_total is None else ev.pair_total[rows]
+    ok = None if ev.pol_op_valid is None else ev.pol_op_valid[rows]
+    return UnitEvectors(ev.x[rows], ev.angle[rows], ev.degree[rows], ev.intensity[rows], ev.evector[rows], pt, ok)
+
+
+def pol_op_table(table: SkyTable, array: PolArray):
+    """Model POL-OP outputs ``b_kj(phi) = d^_k cos(2 a^_k - 2 alpha_kj)`` for the table's solar azimuths, shape ``(G, K, J)``.
+
+    ``d^``, ``a^``: the table's degree and e-vector angle in each unit frame; ``alpha_kj``: the first polarizer
+    angle of POL-OP ``j`` (:attr:`PolArray.pair_angles`), radians.
+    """
+    a2 = 2.0 * array.pair_angles  # (K, J)
+    return table.degree[:, :, None] * (table.cos2[:, :, None] * np.cos(a2) + table.sin2[:, :, None] * np.sin(a2))
+
+
+def _pol_op_scores(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, noise_counts: float,
+                   model_error: float, min_units: int, min_degree: float = 0.05):
+    """Scores of :func:`sun_from_pol_op_fit` on the table's azimuths ``(N, G)``, the normalising totals ``(N,)`` and
+    whether each sample has enough readings ``(N,)``."""
+    x = np.asarray(ev.x, float)
+    xs = np.nan_to_num(x)
+    checked = np.asarray(valid, bool)[..., None] if ev.pol_op_valid is None else np.asarray(ev.pol_op_valid, bool)
+    readable = np.isfinite(x) & checked
+    if noise_counts > 0 and ev.pair_total is not None:
+        s = np.nan_to_num(np.asarray(ev.pair_total, float))
+        with np.errstate(divide="ignore"):
+            sigma_x = np.where(s > 0, np.sqrt(2.0) * float(noise_counts) / np.where(s > 0, s, 1.0), np.inf)
+        readable &= sigma_x / (2.0 * np.maximum(np.abs(xs), min_degree)) <= model_error
+    n = x.shape[0]
+    w = readable.reshape(n, -1).astype(float)
+    b = pol_op_table(table, array).reshape(table.azimuths.size, -1)  # (G, K J)
+    sxb = (w * xs.reshape(n, -1)) @ b.T
+    sbb = w @ (b**2).T
+    score = np.maximum(sxb, 0.0) ** 2 / np.maximum(sbb, 1e-12)
+    enough = (readable.any(axis=-1).sum(axis=-1) >= max(int(min_units), 2)) & (readable.reshape(n, -1).sum(axis=-1) >= 3)
+    return score, np.maximum(np.sum(w * xs.reshape(n, -1) ** 2, axis=-1), 1e-12), enough
+
+
+def sun_from_pol_op_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArray, noise_counts: float = 0.0,
+                        model_error: float = np.deg2rad(10.0), margin: float = 0.01, min_units: int = 2) -> SunEstimate:
+    """The solar azimuth from every usable POL-OP, not every usable unit.
+
+    A POL-OP ``j`` of unit ``k`` reads ``x_kj = d_k cos(2 a_k - 2 alpha_kj)`` (eq. 4.3), one equation
+    even where the unit's other POL-OP is saturated. Against the sky model's pattern (the table's
+    degree ``d^_k(phi)`` and angle ``a^_k(phi)`` at the known sun elevation, heading unknown) the fit
+    minimises ``sum_kj (x_kj - lambda b_kj(phi))^2`` over the solar azimuth ``phi`` and a common degree
+    scale ``lambda > 0`` (the sky's maximum degree times the polarizer efficiency, unknown at each
+    sample), with ``b_kj = d^_k cos(2 a^_k - 2 alpha_kj)`` (:func:`pol_op_table`): in closed form
+    ``lambda = sum x b / sum b^2`` and the score ``(sum x b)_+^2 / sum b^2`` is maximised on the grid, then
+    refined by a parabola; the eq. 4.6 pair as in :func:`sun_from_sky_fit` (the degree pattern is not
+    mirror-symmetric for tilted units), else the brighter side (units with a finite intensity, saturated
+    ones included: only faulty units' intensities are NaN). ``sky_fit`` uses it for samples where a unit reads one POL-OP
+    only or too few units read both.
+
+    Parameters
+    ----------
+    ev : UnitEvectors
+        With :attr:`~bionav.polcompass.array.UnitEvectors.pol_op_valid` (:func:`bionav.polcompass.array.masked_pol_ops`)
+        every usable POL-OP takes part; without it only those of the units in ``valid``.
+    valid : ndarray of bool, shape ``(N, K)``
+        Units reading both POL-OPs (the per-unit mask of the other decoders).
+    table : SkyTable
+    array : PolArray
+    noise_counts : float
+        Count noise per photodiode; a POL-OP whose angle noise ``sqrt(2) sigma_c / (2 S |x|)``
+        (``S``: :attr:`UnitEvectors.pair_total`, ``|x|`` at least 0.05) exceeds ``model_error`` is left out.
+    model_error : float
+        Radians.
+    margin : float
+        Minimum normalised score gap of the pair for a resolved choice.
+    min_units : int
+        Fewest units with a usable POL-OP (at least 2, and at least 3 POL-OPs: ``phi`` and ``lambda``).
+
+    Returns
+    -------
+    SunEstimate
+        NaN where the sample has too few usable POL-OPs.
+    """
+    score, total, ok = _pol_op_scores(ev, valid, table=table, array=array, noise_counts=noise_counts, model_error=model_error,
+                                      min_units=min_units)
+    _, first, second, gap = _pick_pair(score, table.azimuths, total, margin)
+    resolved = gap > margin
+    by_light, other = _choose_by_brightness(first, second, brightness_azimuth(ev, np.isfinite(ev.intensity), array))
+    azimuth = np.where(ok, np.where(resolved, first, by_light), np.nan)
+    return SunEstimate(azimuth, np.where(ok, np.where(resolved, second, other), np.nan), resolved & ok)
 
 
 def _fit_weights(ev: UnitEvectors, valid, *, weight_power, noise_counts, model_error, min_units):

@@ -268,6 +268,34 @@ def pair_imbalance(counts):
         return np.log10((c[..., 0] + c[..., 1]) / (c[..., 2] + c[..., 3]))
 
 
+def photodiode_validity(counts, *, saturation_counts: float, dark_counts: float):
+    """Which photodiodes read usable counts, shape ``(N, K, P)``: below ``saturation_counts`` (not saturated
+    or overflowing) and at least ``dark_counts`` (a zero has no log ratio; a lone zero among lit
+    photodiodes is a read fault of that photodiode)."""
+    c = np.asarray(counts, float)
+    return (c < saturation_counts) & (c >= dark_counts)
+
+
+def pol_op_validity(counts, pairs, *, saturation_counts: float, dark_counts: float):
+    """Which POL-OPs read usable counts: both photodiodes of the pair usable (:func:`photodiode_validity`).
+
+    Parameters
+    ----------
+    counts : ndarray, shape ``(N, K, P)``
+    pairs : ndarray of int, shape ``(J, 2)``
+        Photodiode indices of each POL-OP (:attr:`bionav.polcompass.array.PolArray.pairs`).
+
+    Returns
+    -------
+    ndarray of bool, shape ``(N, K, J)``
+        A unit with one saturated pair still has its other POL-OP, one equation
+        ``x = d cos(2a - 2 alpha)`` (:func:`bionav.polcompass.decoders.sun_from_pol_op_fit`).
+    """
+    ok = photodiode_validity(counts, saturation_counts=saturation_counts, dark_counts=dark_counts)
+    pairs = np.atleast_2d(np.asarray(pairs, int))
+    return ok[..., pairs[:, 0]] & ok[..., pairs[:, 1]]
+
+
 def sample_validity(counts, *, saturation_counts: float, dark_counts: float, imbalance_decades: float):
     """Which units give usable readings at each sample, shape ``(N, K)``.
 
@@ -277,7 +305,7 @@ def sample_validity(counts, *, saturation_counts: float, dark_counts: float, imb
     than ``imbalance_decades``.
     """
     c = np.asarray(counts, float)
-    ok = (c.max(axis=-1) < saturation_counts) & (c.min(axis=-1) >= dark_counts)
+    ok = np.all(photodiode_validity(c, saturation_counts=saturation_counts, dark_counts=dark_counts), axis=-1)
     if c.shape[-1] == 4:
         imb = pair_imbalance(c)
         ok &= np.isfinite(imb) & (np.abs(imb) <= imbalance_decades)
@@ -309,6 +337,7 @@ def detect_faults(
     imbalance_decades: float = 0.15,
     blind_fraction: float = 0.5,
     min_usable_fraction: float = 0.05,
+    pairs=None,
 ) -> list[UnitFault]:
     """Per-unit fault report of a session from its counts alone.
 
@@ -325,6 +354,10 @@ def detect_faults(
         which a unit is polarization-blind.
     min_usable_fraction : float
         Units usable at fewer samples are dropped too.
+    pairs : ndarray of int, shape ``(J, 2)``, optional
+        The POL-OPs' photodiode pairs: a unit counts as usable at a sample where one of its POL-OPs is
+        (:func:`pol_op_validity`; a unit whose one pair is always saturated still gives the other). None:
+        only where every photodiode is usable.
 
     Returns
     -------
@@ -335,8 +368,12 @@ def detect_faults(
     sat = (c.max(axis=-1) >= saturation_counts).mean(axis=0)
     lit = c.min(axis=-1) >= dark_counts
     dark = 1.0 - lit.mean(axis=0)
-    usable = sample_validity(c, saturation_counts=saturation_counts, dark_counts=dark_counts,
-                             imbalance_decades=np.inf).mean(axis=0)
+    if pairs is None:
+        usable = sample_validity(c, saturation_counts=saturation_counts, dark_counts=dark_counts,
+                                 imbalance_decades=np.inf).mean(axis=0)
+    else:
+        usable = pol_op_validity(c, pairs, saturation_counts=saturation_counts,
+                                 dark_counts=dark_counts).any(axis=-1).mean(axis=0)
     if p == 4:
         same = (c[..., 0] == c[..., 1]) | (c[..., 2] == c[..., 3])
         imb = pair_imbalance(c)

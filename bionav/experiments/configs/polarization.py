@@ -146,6 +146,10 @@ class RecordingsConfig:
     calibration_parts : which parts to apply: ``gains`` (photodiode gains), ``angles`` (polarizer offsets), ``tilt``
         (the sensor's first-order mount tilt, learned from the daylight rotations with the chosen decoder).
         Default ``[angles]``: on the recordings the estimated gains made every decoder worse (docs/polcompass.md).
+    calibration_conditions : the session conditions (``tod_daylight``, ``tod_dusk``, ``canopy``) a calibration is
+        applied to; the others are decoded uncalibrated (``sessions.csv`` column ``calibration`` says why).
+        Default: all three (docs/polcompass.md "Self-calibration": what leaving canopy out does, and why that is
+        not the default).
     calibration_solver : ``pol_op`` (the POL-OP chain, each pair at its mean calibrated orientation) or
         ``stokes`` (every photodiode at its own angle, linear least squares).
     """
@@ -168,6 +172,8 @@ class RecordingsConfig:
     calibration: str = "none"
     calibration_parts: list[str] = bounded(["angles", "tilt"], length=(1, 3), item=Range(choices=("gains", "angles", "tilt")))
     calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
+    calibration_conditions: list[str] = bounded(
+        ["tod_daylight", "tod_dusk", "canopy"], length=(0, 3), item=Range(choices=("tod_daylight", "tod_dusk", "canopy")))
 
     def validate(self) -> None:
         """``exclude_units`` is ``auto``, ``none`` or a list of unit numbers (called by ``typed_config``)."""

@@ -29,7 +29,11 @@ class SkyFitConfig:
         it (:func:`bionav.polcompass.decoders.angle_noise`), units whose angle noise exceeds
         ``model_error_deg`` take no part. 0.5 is measured on the recorded sensor: quantisation (0.29) and
         dark noise (0.0-0.5 counts rms per photodiode after sunset, docs/polcompass.md "Dusk").
-    min_units : fewest units taking part for a sample to be decoded; fewer: no heading (``valid`` false).
+    min_units : fewest units taking part for a sample to be decoded; fewer: no heading (``valid`` false),
+        unless ``pol_op_fallback``.
+    pol_op_fallback : such samples, and samples where a unit reads one of its POL-OPs only, are decoded from every
+        usable POL-OP instead (:func:`bionav.polcompass.decoders.sun_from_pol_op_fit`: a unit with one saturated pair
+        still gives one equation); docs/polcompass.md "Real skies".
     """
 
     residual: str = bounded("perpendicular", choices=("perpendicular", "angle"))
@@ -44,6 +48,7 @@ class SkyFitConfig:
     neutral_point_separation_deg: float = bounded(0.0, ge=0.0, le=60.0)
     noise_counts: float = bounded(0.5, ge=0.0, le=1e6)
     min_units: int = bounded(2, ge=1, le=64)
+    pol_op_fallback: bool = True
 
 
 class SkyFit(Decoder):
@@ -84,6 +89,7 @@ class SkyFit(Decoder):
             margin=self.config.margin,
             noise_counts=self.config.noise_counts,
             min_units=self.config.min_units,
+            pol_op_fallback=self.config.pol_op_fallback,
         )
 
 
