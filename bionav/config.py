@@ -112,7 +112,7 @@ class PluginConfigSource(ConfigSource):
 
     def is_config(self, config_path: str) -> bool:
         group, name = self._split(config_path)
-        if f"{group}/{name}".strip("/") in _SCHEMAS:
+        if f"{group}/{name}".strip("/") in _schemas():
             return True
         kind = registry.kind_of_group(group)
         # a name no entry point declares is answered without importing any plugin (Hydra asks for `sensor/None`)
@@ -123,7 +123,7 @@ class PluginConfigSource(ConfigSource):
 
         path = config_path.strip("/")
         prefix = f"{path}/" if path else ""
-        schemas = [key[len(prefix):] for key in _SCHEMAS if key.startswith(prefix) and "/" not in key[len(prefix):]]
+        schemas = [key[len(prefix):] for key in _schemas() if key.startswith(prefix) and "/" not in key[len(prefix):]]
         groups = [g for g in _schema_groups() if g.startswith(prefix) and "/" not in g[len(prefix):]]
         groups = [g[len(prefix):] for g in groups] + (list(PLUGIN_GROUPS) if path == "" else [])
         configs = schemas + (sorted(registry.names_in_group(path)) if registry.kind_of_group(path) else [])
@@ -132,7 +132,7 @@ class PluginConfigSource(ConfigSource):
 
     def load_config(self, config_path: str) -> ConfigResult:
         group, name = self._split(config_path)
-        schema = _SCHEMAS.get(f"{group}/{name}".strip("/"))
+        schema = _schemas().get(f"{group}/{name}".strip("/"))
         if schema is not None:  # a typed schema of bionav.schemas, converted now
             return ConfigResult(config=OmegaConf.structured(schema[0]), path=f"{self.scheme()}://{self.path}",
                                 provider=schema[1], header={"package": None})
@@ -159,6 +159,17 @@ def register_configs() -> None:
     """
     Plugins.instance().register(BionavSearchPathPlugin)
     Plugins.instance().register(PluginConfigSource)
+    _schemas()
+
+
+@functools.cache
+def _schemas() -> dict[str, tuple[Any, str]]:
+    """The typed schemas of ``bionav.schemas``: config path -> (dataclass or instance, provider).
+
+    Keys are ``db_schema``, ``experiment_schema/grid_homing``, ...; :class:`PluginConfigSource`
+    serves them. Read once per process, also in a launcher's worker process (joblib, submitit,
+    SLURM), where Hydra restores its plugins but no bionav code has run yet.
+    """
     store = _SchemaStore()
     # typed schemas of config nodes, registered by the rooms that own them (entry points
     # ``bionav.schemas``); e.g. every db preset is merged onto ``db_schema``
@@ -173,17 +184,13 @@ def register_configs() -> None:
             store.store(name=name, node=schema, provider="bionav")
         else:  # a registration function: experiment_schema/<name>, hydra/launcher=submitit_slurm, ...
             schema(store)
-
-
-#: typed schemas registered through ``bionav.schemas``: config path (``experiment_schema/grid_homing``,
-#: ``db_schema``) -> (dataclass or instance, provider); served by :class:`PluginConfigSource`
-_SCHEMAS: dict[str, tuple[Any, str]] = {}
+    return store.nodes
 
 
 def _schema_groups() -> set[str]:
     """Config groups holding schemas (``experiment_schema``), parents included."""
     out: set[str] = set()
-    for key in _SCHEMAS:
+    for key in _schemas():
         parts = key.split("/")[:-1]
         out |= {"/".join(parts[: i + 1]) for i in range(len(parts))}
     return out
@@ -197,13 +204,16 @@ class _SchemaStore:
     Hydra loads it. A node with a ``package`` goes to Hydra's ConfigStore unchanged.
     """
 
+    def __init__(self) -> None:
+        self.nodes: dict[str, tuple[Any, str]] = {}
+
     def store(self, name: str, node: Any, group: str | None = None, package: str | None = None,
               provider: str | None = None) -> None:
         if package is not None:
             ConfigStore.instance().store(name=name, node=node, group=group, package=package, provider=provider)
             return
         name = name[: -len(".yaml")] if name.endswith(".yaml") else name
-        _SCHEMAS[f"{group}/{name}" if group else name] = (node, provider or "bionav")
+        self.nodes[f"{group}/{name}" if group else name] = (node, provider or "bionav")
 
 
 def config_options(group: str) -> list[str]:
