@@ -10,6 +10,11 @@ Rows (wall and CPU seconds of a fresh ``python -m bionav`` process, median and m
 
 Targets (issue 28, 2 idle cores): ``help`` and ``cfg_job`` <= 1.5 s wall, a TAB completion
 <= 0.5 s wall. The CPU time is the child's own (user + system, ``os.wait4``).
+
+Bytecode is cached as on a user's machine, whatever the environment says: the children write it to
+a private ``PYTHONPYCACHEPREFIX`` folder (removed at the end; nothing is written into the checkout),
+filled by one warm-up round, with ``PYTHONDONTWRITEBYTECODE`` unset (set, every module of bionav
+would be compiled from source at every start, 0.1-0.2 s more).
 """
 
 from __future__ import annotations
@@ -30,8 +35,9 @@ COMMANDS = {
 }
 
 
-def _time_once(args: list[str], comp_line: str | None) -> tuple[float, float]:
-    env = dict(os.environ)
+def _time_once(args: list[str], comp_line: str | None, *, pycache: str) -> tuple[float, float]:
+    env = dict(os.environ, PYTHONPYCACHEPREFIX=pycache)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     if comp_line is not None:
         env.update(COMP_LINE=comp_line, COMP_POINT=str(len(comp_line)))
     start = time.perf_counter()
@@ -56,12 +62,15 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=5, help="alternated rounds (default: 5; 1..100)")
     args = parser.parse_args(argv)
     bounded_int(parser, "--repeat", args.repeat, 1, 100)
-    for args_, comp in COMMANDS.values():  # warm the file-system and bytecode caches once
-        _time_once(args_, comp)
+    import tempfile
+
     samples: dict[str, list[tuple[float, float]]] = {name: [] for name in COMMANDS}
-    for _ in range(args.repeat):
-        for name, (args_, comp) in COMMANDS.items():
-            samples[name].append(_time_once(args_, comp))
+    with tempfile.TemporaryDirectory(prefix="bionav-pycache-") as pycache:
+        for args_, comp in COMMANDS.values():  # warm the file-system and bytecode caches once
+            _time_once(args_, comp, pycache=pycache)
+        for _ in range(args.repeat):
+            for name, (args_, comp) in COMMANDS.items():
+                samples[name].append(_time_once(args_, comp, pycache=pycache))
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
     for name, rows in samples.items():
         walls, cpus = [w for w, _ in rows], [c for _, c in rows]
