@@ -353,7 +353,7 @@ def _sim_metrics(exp, tally: _Tally) -> dict:
     """The simulation's parameters and ``sim_<condition>_mae_deg``."""
     metrics = {"sim_repeats": exp.sim_repeats}
     for key in ("sim_gain_sigma", "sim_angle_sigma_deg", "sim_noise", "sim_canopy_cover", "sim_max_degree",
-                "sim_view_sigma", "sim_tilt_sigma_deg", "sim_azimuth_sigma_deg"):
+                "sim_view_sigma", "sim_view_shared", "sim_tilt_sigma_deg", "sim_azimuth_sigma_deg"):
         metrics[key] = getattr(exp, key)
     for g in GROUPS:
         if tally.sim_err[g]:

@@ -225,7 +225,7 @@ def mount_tilt(datas, rc, calibration, decoder, *, leave_out_day=None):
     return pooled_deviation(fits)
 
 
-def view_field(rng, heading, unit_azimuths, n_photodiodes: int, *, n_harmonics: int = 12):
+def view_field(rng, heading, unit_azimuths, n_photodiodes: int, *, n_harmonics: int = 12, shared: float = 0.0):
     """A random smooth field of unit variance per photodiode over the world azimuth it looks at, shape ``(N, K, P)``.
 
     ``g_kp(theta) = sum_{h=1..H} a_kph cos(h theta) + b_kph sin(h theta)`` with ``a, b ~ N(0, 1/H)``, evaluated
@@ -233,13 +233,27 @@ def view_field(rng, heading, unit_azimuths, n_photodiodes: int, *, n_harmonics: 
     ``exp(sim_view_sigma g)``: what makes the real units depart from one shared sky ring (about 11 % rms on
     the recordings, ``SessionCalibration.residual_rms``) -- e.g. each unit's own field of view, reflections,
     the horizon -- which gains, polarizer offsets and pointing do not (docs/polcompass.md).
+
+    ``shared`` (0..1) is the fraction of the variance that a unit's photodiodes share: ``g_kp = sqrt(shared)
+    u_k + sqrt(1 - shared) g'_kp`` with ``u_k`` one such field per unit. What a unit's photodiodes see alike
+    (its aperture, a reflection) cancels in a POL-OP's log ratio; what differs between them (each polarizer's
+    own angular acceptance) turns the e-vector. ``shared = 0`` draws exactly the per-photodiode field above.
     """
+    if not 0.0 <= shared <= 1.0:
+        raise ValueError(f"shared must be in [0, 1], got {shared}")
     k = np.size(unit_azimuths)
     theta = np.asarray(heading, float)[:, None] + np.asarray(unit_azimuths, float)[None, :]  # (N, K)
     h = np.arange(1, n_harmonics + 1)
-    a, b = rng.standard_normal((2, k, n_photodiodes, n_harmonics)) / np.sqrt(n_harmonics)
     ang = theta[:, :, None] * h  # (N, K, H)
-    return np.einsum("nkh,kph->nkp", np.cos(ang), a) + np.einsum("nkh,kph->nkp", np.sin(ang), b)
+
+    def field(n: int):
+        a, b = rng.standard_normal((2, k, n, n_harmonics)) / np.sqrt(n_harmonics)
+        return np.einsum("nkh,kph->nkp", np.cos(ang), a) + np.einsum("nkh,kph->nkp", np.sin(ang), b)
+
+    own = field(n_photodiodes)
+    if shared == 0.0:
+        return own
+    return np.sqrt(shared) * field(1) + np.sqrt(1.0 - shared) * own
 
 
 def simulate_session(data: SessionData, exp, rng) -> SessionData:
@@ -274,7 +288,7 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     counts = counts * scale * gains
     if exp.sim_view_sigma > 0:  # each photodiode's own smooth departure from the shared sky ring (world frame)
         counts = counts * np.exp(exp.sim_view_sigma * view_field(rng, mount + data.yaw, data.array.unit_azimuths,
-                                                                   counts.shape[-1]))
+                                                                   counts.shape[-1], shared=exp.sim_view_shared))
     counts = counts * (1.0 + exp.sim_noise * rng.standard_normal(counts.shape))
     counts = np.clip(np.round(counts), 0, None)
     saturation = float(np.max(data.counts)) if data.counts.size else np.inf

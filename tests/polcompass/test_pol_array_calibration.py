@@ -260,3 +260,26 @@ def test_the_simulated_view_field_gives_the_ring_residual_it_was_fitted_with():
         field = view_field(np.random.default_rng(5), 0.7 + yaw, arr.unit_azimuths, 4)
         residual[sigma] = calibrate_session(np.round(counts * np.exp(sigma * field)), yaw, valid, arr).residual_rms
     assert residual[0.0] < 0.01 and 0.06 < residual[0.1] < 0.12
+    # the share of the field a unit's photodiodes have in common (sim_view_shared, fitted on the daylight MAE)
+    # leaves the ring residual as it was: the counts cannot tell it, only the headings can
+    field = view_field(np.random.default_rng(5), 0.7 + yaw, arr.unit_azimuths, 4, shared=0.8)
+    shared = calibrate_session(np.round(counts * np.exp(0.1 * field)), yaw, valid, arr).residual_rms
+    assert shared == pytest.approx(residual[0.1], abs=0.02)
+
+
+def test_a_shared_view_field_is_the_same_for_a_units_photodiodes_and_keeps_unit_variance():
+    """``view_field(shared=s)``: ``sqrt(s) u_k + sqrt(1 - s) g_kp``; all shared cancels in every POL-OP's log ratio."""
+    from bionav.experiments.pol_recordings_session import view_field
+
+    heading = np.linspace(0, 2 * np.pi, 3000, endpoint=False)
+    whole = view_field(np.random.default_rng(1), heading, FILE_AZIMUTHS, 4, shared=1.0)
+    assert np.array_equal(whole[..., 0], whole[..., 3]) and np.array_equal(whole[..., 1], whole[..., 2])
+    own = view_field(np.random.default_rng(1), heading, FILE_AZIMUTHS, 4)
+    assert np.array_equal(own, view_field(np.random.default_rng(1), heading, FILE_AZIMUTHS, 4, shared=0.0))
+    part = view_field(np.random.default_rng(1), heading, FILE_AZIMUTHS, 4, shared=0.8)
+    # the difference between two photodiodes of a unit keeps 1 - s of the variance of independent fields (2)
+    diff = np.var(part[..., 0] - part[..., 1]) / np.var(own[..., 0] - own[..., 1])
+    assert diff == pytest.approx(0.2, rel=1e-9)
+    assert np.var(part) == pytest.approx(1.0, abs=0.4)
+    with pytest.raises(ValueError, match="shared"):
+        view_field(np.random.default_rng(1), heading, FILE_AZIMUTHS, 4, shared=1.5)

@@ -1,8 +1,8 @@
 """Typed configs of the experiments: one dataclass per ``experiment=<name>``, defaults in one place.
 
 Each dataclass is registered as ``experiment_schema/<name>`` (:func:`register`;
-:func:`bionav.config.register_configs` serves it to Hydra when a command composes it); the preset ``conf/experiment/<name>.yaml`` puts it under
-``experiment`` first in its defaults list and then sets only what differs or
+:func:`bionav.config.register_configs` serves it to Hydra when a command composes it); the
+preset ``conf/experiment/<name>.yaml`` puts it under ``experiment`` first in its defaults list and then sets only what differs or
 what refers to other keys. Hydra therefore rejects unknown keys and values of
 the wrong type at composition; :func:`experiment_config` fills the defaults
 for configs built without Hydra and checks every value against its range
