@@ -12,12 +12,11 @@ from bionav.polcompass.array import (
     log_ratios_from_counts,
     stokes_from_sky,
 )
-from bionav.polcompass.decoders import (
-    sky_table,
+from bionav.polcompass.decoders import sky_table, sun_from_sky_fit
+from bionav.polcompass.published_decoders import (
     sun_from_eigenvector,
     sun_from_four_zeros,
     sun_from_mean_vector,
-    sun_from_sky_fit,
     sun_from_sol,
     sun_from_two_units,
 )

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.plugins.decoders.base import Decoder
-from bionav.polcompass.decoders import sun_from_eigenvector, sun_from_four_zeros, sun_from_mean_vector, sun_from_sol
+from bionav.polcompass.published_decoders import sun_from_eigenvector, sun_from_four_zeros, sun_from_mean_vector, sun_from_sol
 from bionav.validation import bounded
 
 

@@ -7,7 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from bionav.plugins.decoders.base import Decoder
-from bionav.polcompass.decoders import sky_table, sun_from_sky_fit, sun_from_two_units
+from bionav.polcompass.decoders import sky_table, sun_from_sky_fit
+from bionav.polcompass.published_decoders import sun_from_two_units
 from bionav.validation import bounded
 
 
