@@ -270,7 +270,7 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
 
     from bionav.light import SkyModel, random_cloud_map
     from bionav.polcompass.array import counts_from_stokes, stokes_from_sky
-    from bionav.polcompass.recordings import pol_op_validity
+    from bionav.polcompass.recordings import photodiode_validity, pol_op_validity
 
     clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
     model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
@@ -292,7 +292,7 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     counts = counts * (1.0 + exp.sim_noise * rng.standard_normal(counts.shape))
     counts = np.clip(np.round(counts), 0, None)
     saturation = float(np.max(data.counts)) if data.counts.size else np.inf
-    valid = (counts.max(axis=-1) < saturation) & (counts.min(axis=-1) > 0)
+    valid = np.all(photodiode_validity(counts, saturation_counts=saturation, dark_counts=1.0), axis=-1)  # counts are whole
     valid[:, data.excluded] = False
     pol_ok = pol_op_validity(counts, data.array.pairs, saturation_counts=saturation, dark_counts=1.0)
     pol_ok[:, data.excluded] = False
