@@ -187,13 +187,14 @@ def _schemas() -> dict[str, tuple[Any, str]]:
     return store.nodes
 
 
-def _schema_groups() -> set[str]:
-    """Config groups holding schemas (``experiment_schema``), parents included."""
+@functools.cache
+def _schema_groups() -> frozenset[str]:
+    """Config groups holding schemas (``experiment_schema``), parents included (once per process, as :func:`_schemas`)."""
     out: set[str] = set()
     for key in _schemas():
         parts = key.split("/")[:-1]
         out |= {"/".join(parts[: i + 1]) for i in range(len(parts))}
-    return out
+    return frozenset(out)
 
 
 class _SchemaStore:
