@@ -10,7 +10,9 @@ photodiodes each, on a robot turning in place; loader and format in
 
 with ``c`` one constant per session, the circular mean of ``decoded - yaw``
 over the session's rotations (the IMU yaw has an arbitrary zero, the sun moves
-little within a session). Each sample is decoded only from the units read at
+little within a session); ``recordings.reference=yaw_run`` fits one ``c`` per
+run of the logged yaw between odometry restarts instead, ``rotation`` one per
+rotation file (:func:`bionav.polcompass.recordings.yaw_restarts`). Each sample is decoded only from the units read at
 that moment; units found faulty from the session's counts are dropped with
 ``recordings.exclude_units=auto``.
 
@@ -232,6 +234,7 @@ def _session_base(data: SessionData, cal_label: str) -> dict:
         "sun_elevation_deg": float(np.degrees(data.sun.elevation)),
         "sun_azimuth_deg": float(np.degrees(data.sun.azimuth)),
         "n_rotations": len(session.rotations),
+        "reference_runs": 1 if data.reference_run is None else int(np.unique(data.reference_run).size),
         "excluded_units": " ".join(str(u) for u in data.excluded),
         "calibration": cal_label,
     }
@@ -253,7 +256,7 @@ def _score_session(ctx, exp, tally: _Tally, data: SessionData, sim_runs, decoder
     """Decode one (calibrated) session with every decoder and add its rows and errors to ``tally``."""
     for name, dec in decoders.items():
         heading, resolved, seconds = decode_session(dec, data, tilt)
-        err, c = session_errors(heading, data.yaw)
+        err, c = session_errors(heading, data.yaw, runs=data.reference_run)
         decoded = np.isfinite(heading)
         row = {**base, "decoder": name, **error_stats(err),
                "decoded_fraction": float(np.mean(decoded)),
@@ -271,7 +274,8 @@ def _score_session(ctx, exp, tally: _Tally, data: SessionData, sim_runs, decoder
             tally.real_err[data.period].append(err)
             tally.per_session_plot.append((data.session, data, err))
             if sim_runs:  # every repeat its own simulated device (gains) and cloud draw, errors pooled
-                s_err = np.concatenate([session_errors(decode_session(dec, sd)[0], sd.yaw)[0] for sd in sim_runs])
+                s_err = np.concatenate([session_errors(decode_session(dec, sd)[0], sd.yaw, runs=sd.reference_run)[0]
+                                        for sd in sim_runs])
                 s_stats = error_stats(s_err)
                 row["sim_mae_deg"] = s_stats["mae_deg"]
                 row["sim_rmse_deg"] = s_stats["rmse_deg"]
@@ -377,6 +381,7 @@ def _metrics(rc, exp, tally: _Tally, pooled_rows, chosen, n_bad: int) -> dict[st
         "n_bad_files": n_bad,
         "calibration": how if how in ("auto", "none") else "file",
         "calibration_parts": rc.calibration_parts,
+        "reference": rc.reference,
     }
     metrics.update(_condition_metrics(tally, pooled_rows, chosen))
     if exp.simulate:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -29,21 +29,33 @@ def circular_offset(decoded, yaw) -> float:
     return float(np.angle(np.mean(np.exp(1j * d)))) if d.size else 0.0
 
 
-def session_errors(decoded, yaw, *, undecoded_error: float = np.pi / 2.0):
-    """Errors ``wrap(decoded - yaw - c)`` with one ``c`` for the session; undecoded samples get ``undecoded_error``.
+def session_errors(decoded, yaw, *, runs=None, undecoded_error: float = np.pi / 2.0):
+    """Errors ``wrap(decoded - yaw - c)`` with one ``c`` per reference run; undecoded samples get ``undecoded_error``.
 
-    A sample a decoder cannot decode (NaN) counts as a 90 degree error, the
-    mean absolute error of a guess; ``sessions.csv`` also gives the MAE over
-    decoded samples only (``mae_decoded_deg``) and the decoded fraction.
+    ``runs`` (int, shape ``(N,)``) numbers the runs over which the logged yaw
+    keeps one reference (:attr:`SessionData.reference_run`, ``recordings.reference``);
+    None: one ``c`` for the whole session. A sample a decoder cannot decode
+    (NaN) counts as a 90 degree error, the mean absolute error of a guess;
+    ``sessions.csv`` also gives the MAE over decoded samples only
+    (``mae_decoded_deg``) and the decoded fraction.
 
     Returns
     -------
     errors : ndarray, radians in ``[-pi, pi)``
     c : float
+        The offset of the first run (radians).
     """
-    c = circular_offset(decoded, yaw)
-    err = wrap_angle(np.asarray(decoded, float) - np.asarray(yaw, float) - c)
-    return np.where(np.isfinite(err), err, undecoded_error), c
+    decoded = np.asarray(decoded, float)
+    yaw = np.asarray(yaw, float)
+    runs = np.zeros(decoded.shape, int) if runs is None else np.asarray(runs)
+    offsets = np.zeros(decoded.shape)
+    first = None
+    for r in np.unique(runs):
+        sel = runs == r
+        offsets[sel] = circular_offset(decoded[sel], yaw[sel])
+        first = offsets[sel][0] if first is None else first
+    err = wrap_angle(decoded - yaw - offsets)
+    return np.where(np.isfinite(err), err, undecoded_error), float(first or 0.0)
 
 
 def build_array(rc, file_azimuths):
@@ -85,6 +97,7 @@ class SessionData:
     sun: Any
     period: str
     pol_op_valid: np.ndarray | None = None  # (N, K, J): both photodiodes of the POL-OP usable, unit not dropped
+    reference_run: np.ndarray | None = None  # (N,): runs of one yaw reference (recordings.reference); None: the session
 
 
 def session_evectors(counts, array, pol_op_valid, excluded):
@@ -128,7 +141,24 @@ def prepare_session(session, rc) -> SessionData:
         period = "canopy"
     else:
         period = "tod_daylight" if np.degrees(sun.elevation) >= rc.dusk_elevation_deg else "tod_dusk"
-    return SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period, pol_ok)
+    return SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period, pol_ok,
+                       reference_runs(rots, index, rc.reference))
+
+
+def reference_runs(rotations, rotation_index, reference: str):
+    """Per sample, the run of one yaw reference under ``recordings.reference`` (int, ``(N,)``; None for ``session``).
+
+    ``yaw_run``: a new run starts at each rotation whose yaw restarts (:func:`bionav.polcompass.recordings.yaw_restarts`);
+    ``rotation``: every rotation is its own run.
+    """
+    if reference == "session":
+        return None
+    if reference == "rotation":
+        return np.asarray(rotation_index, int)
+    from bionav.polcompass.recordings import yaw_restarts
+
+    run_of_rotation = np.cumsum(yaw_restarts([r.yaw for r in rotations])) - 1
+    return run_of_rotation[np.asarray(rotation_index, int)]
 
 
 def calibration_sessions(datas, rc) -> list:
@@ -182,8 +212,7 @@ def calibrated(data: SessionData, calibration, parts, solver: str = "pol_op") ->
                               solver=solver)
     ev = session_evectors(data.counts, array, data.pol_op_valid, data.excluded)
     valid = data.valid & np.isfinite(ev.angle)
-    return SessionData(data.session, array, data.counts, data.yaw, data.rotation_index, valid, ev, data.faults,
-                       data.excluded, data.sun, data.period, data.pol_op_valid)
+    return replace(data, array=array, valid=valid, evectors=ev)
 
 
 def decode_session(decoder, data: SessionData, mount_tilt=None):
@@ -219,7 +248,7 @@ def mount_tilt(datas, rc, calibration, decoder, *, leave_out_day=None):
             continue
         dc = calibrated(d, calibration, rc.calibration_parts, rc.calibration_solver)
         heading, _resolved, _seconds = decode_session(decoder, dc)
-        err, _c = session_errors(heading, dc.yaw)
+        err, _c = session_errors(heading, dc.yaw, runs=dc.reference_run)
         fits.append(deviation_from_errors(wrap_angle(dc.sun.azimuth - heading), err, n_harmonics=1,
                                           scale=float(np.tan(dc.sun.elevation))))
     return pooled_deviation(fits)
@@ -266,8 +295,6 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     nominal device), with proportional noise and the same saturation; canopy
     sessions get a cloud field of ``sim_canopy_cover``.
     """
-    from dataclasses import replace
-
     from bionav.light import SkyModel, random_cloud_map
     from bionav.polcompass.array import counts_from_stokes, stokes_from_sky
     from bionav.polcompass.recordings import photodiode_validity, pol_op_validity
@@ -298,8 +325,7 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     pol_ok[:, data.excluded] = False
     ev = session_evectors(counts, data.array, pol_ok, data.excluded)
     valid &= np.isfinite(ev.angle)
-    return SessionData(data.session, data.array, counts, data.yaw, data.rotation_index, valid, ev, data.faults,
-                       data.excluded, data.sun, data.period, pol_ok)
+    return replace(data, counts=counts, valid=valid, evectors=ev, pol_op_valid=pol_ok)
 
 
 def prepared_sessions(rc) -> tuple[list, list]:
@@ -334,6 +360,7 @@ __all__ = [
     "prepare_session",
     "prepared_sessions",
     "self_calibrate",
+    "reference_runs",
     "session_errors",
     "session_evectors",
     "simulate_session",

@@ -152,6 +152,10 @@ class RecordingsConfig:
         not the default).
     calibration_solver : ``pol_op`` (the POL-OP chain, each pair at its mean calibrated orientation) or
         ``stokes`` (every photodiode at its own angle, linear least squares).
+    reference : over what the logged yaw is taken to keep one reference (one heading offset fitted per
+        run, for every decoder alike): ``session`` (default: the authors align the yaw once per session),
+        ``yaw_run`` (a new run where the yaw restarts at rest at zero, an odometry restart:
+        :func:`bionav.polcompass.recordings.yaw_restarts`) or ``rotation`` (every file; a lower bound).
     """
 
     path: Optional[str] = None
@@ -174,6 +178,7 @@ class RecordingsConfig:
     calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
     calibration_conditions: list[str] = bounded(
         ["tod_daylight", "tod_dusk", "canopy"], length=(0, 3), item=Range(choices=("tod_daylight", "tod_dusk", "canopy")))
+    reference: str = bounded("session", choices=("session", "yaw_run", "rotation"))
 
     def validate(self) -> None:
         """``exclude_units`` is ``auto``, ``none`` or a list of unit numbers (called by ``typed_config``)."""
