@@ -10,8 +10,9 @@ photodiodes each, on a robot turning in place; loader and format in
 
 with ``c`` one constant per session, the circular mean of ``decoded - yaw``
 over the session's rotations (the IMU yaw has an arbitrary zero, the sun moves
-little within a session); ``recordings.reference=yaw_run`` fits one ``c`` per
-run of the logged yaw between odometry restarts instead, ``rotation`` one per
+little within a session); ``recordings.reference=stitched`` first turns the
+runs of the logged yaw between odometry restarts into one reference by the
+counts' sky ring, ``yaw_run`` fits one ``c`` per run, ``rotation`` one per
 rotation file (:func:`bionav.polcompass.recordings.yaw_restarts`). Each sample is decoded only from the units read at
 that moment; units found faulty from the session's counts are dropped with
 ``recordings.exclude_units=auto``.
@@ -107,9 +108,10 @@ def _fmt(v, digits=1):
     return "-" if v is None else f"{v:.{digits}f}"
 
 
-def summary_markdown(session_rows, pooled_rows, decoders) -> str:
-    """Per-session and pooled MAE tables (degrees) as Markdown."""
-    lines = ["Per session: MAE / RMSE (degrees) per decoder", ""]
+def summary_markdown(session_rows, pooled_rows, decoders, *, reference: str = "session") -> str:
+    """Per-session and pooled MAE tables (degrees) as Markdown; ``reference``: ``recordings.reference``."""
+    lines = [f"Heading reference: `recordings.reference={reference}`", "",
+             "Per session: MAE / RMSE (degrees) per decoder", ""]
     lines.append("| session | condition | sun elev. (deg) | " + " | ".join(decoders) + " | sim (" + decoders[0] + ") |")
     lines.append("|" + "---|" * (4 + len(decoders)))
     by = {}
@@ -223,6 +225,13 @@ class _Tally:
         self.n_rotations = 0
 
 
+def _reference_runs(data: SessionData) -> int:
+    """Runs of the logged yaw a session is scored over: with one offset each, or stitched into one."""
+    if data.reference_run is not None:
+        return int(np.unique(data.reference_run).size)
+    return 1 if data.run_shifts is None else int(data.run_shifts.size)
+
+
 def _session_base(data: SessionData, cal_label: str) -> dict:
     session = data.session
     return {
@@ -234,7 +243,8 @@ def _session_base(data: SessionData, cal_label: str) -> dict:
         "sun_elevation_deg": float(np.degrees(data.sun.elevation)),
         "sun_azimuth_deg": float(np.degrees(data.sun.azimuth)),
         "n_rotations": len(session.rotations),
-        "reference_runs": 1 if data.reference_run is None else int(np.unique(data.reference_run).size),
+        "reference_runs": _reference_runs(data),
+        "yaw_run_shifts_deg": "" if data.run_shifts is None else " ".join(f"{v:.2f}" for v in np.degrees(data.run_shifts)),
         "excluded_units": " ".join(str(u) for u in data.excluded),
         "calibration": cal_label,
     }
@@ -248,7 +258,8 @@ def _record_rotations(ctx, data: SessionData, name: str, heading, err, resolved)
             "session": session.name, "file": session.rotations[r].path.name, "decoder": name,
             "yaw": data.yaw[sel].tolist(),
             "heading": [float(v) if np.isfinite(v) else None for v in heading[sel]],
-            "error": err[sel].tolist(), "resolved": resolved[sel].tolist()},
+            "error": err[sel].tolist(), "resolved": resolved[sel].tolist(),
+            "yaw_shift": 0.0 if data.yaw_shift is None else float(data.yaw_shift[sel][0])},
             schema_name="bionav.PolRecordingRotation")
 
 
@@ -315,13 +326,14 @@ def _pooled_rows(tally: _Tally) -> list[dict]:
     return rows
 
 
-def _write_outputs(ctx, exp, tally: _Tally, pooled_rows, chosen) -> None:
+def _write_outputs(ctx, exp, tally: _Tally, pooled_rows, chosen, reference: str = "session") -> None:
     from bionav.experiments import pol_recordings_plots as plots
 
     _write_csv(ctx.dir / "sessions.csv", tally.session_rows)
     _write_csv(ctx.dir / "pooled.csv", pooled_rows)
     _write_csv(ctx.dir / "faults.csv", tally.fault_rows)
-    (ctx.dir / "summary.md").write_text(summary_markdown(tally.session_rows, pooled_rows, tally.names))
+    (ctx.dir / "summary.md").write_text(summary_markdown(tally.session_rows, pooled_rows, tally.names,
+                                                                 reference=reference))
     plot_dir = ctx.plots
     plots.error_vs_time_of_day(plot_dir / "error_vs_time_of_day.png", tally.session_rows, tally.names)
     plots.session_distributions(plot_dir / "session_errors.png", tally.per_session_plot, chosen)
@@ -407,7 +419,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     if not tally.session_rows:
         raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
     pooled_rows = _pooled_rows(tally)
-    _write_outputs(ctx, exp, tally, pooled_rows, chosen)
+    _write_outputs(ctx, exp, tally, pooled_rows, chosen, rc.reference)
     metrics = _metrics(rc, exp, tally, pooled_rows, chosen, len(bad_files))
     if bad_files and rc.on_bad_file == "error":
         listed = " ".join(m for _p, m in bad_files[:3])

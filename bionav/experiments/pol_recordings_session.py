@@ -98,6 +98,8 @@ class SessionData:
     period: str
     pol_op_valid: np.ndarray | None = None  # (N, K, J): both photodiodes of the POL-OP usable, unit not dropped
     reference_run: np.ndarray | None = None  # (N,): runs of one yaw reference (recordings.reference); None: the session
+    yaw_shift: np.ndarray | None = None  # (N,): radians added to the logged yaw (recordings.reference=stitched)
+    run_shifts: np.ndarray | None = None  # (R,): radians each yaw run was turned by (recordings.reference=stitched)
 
 
 def session_evectors(counts, array, pol_op_valid, excluded):
@@ -141,24 +143,45 @@ def prepare_session(session, rc) -> SessionData:
         period = "canopy"
     else:
         period = "tod_daylight" if np.degrees(sun.elevation) >= rc.dusk_elevation_deg else "tod_dusk"
-    return SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period, pol_ok,
-                       reference_runs(rots, index, rc.reference))
+    data = SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period, pol_ok)
+    return with_reference(data, rc.reference)
 
 
-def reference_runs(rotations, rotation_index, reference: str):
-    """Per sample, the run of one yaw reference under ``recordings.reference`` (int, ``(N,)``; None for ``session``).
-
-    ``yaw_run``: a new run starts at each rotation whose yaw restarts (:func:`bionav.polcompass.recordings.yaw_restarts`);
-    ``rotation``: every rotation is its own run.
-    """
-    if reference == "session":
-        return None
-    if reference == "rotation":
-        return np.asarray(rotation_index, int)
+def yaw_runs(data: SessionData) -> np.ndarray:
+    """Per sample, the run of the logged yaw between its restarts (int, ``(N,)``, from 0;
+    :func:`bionav.polcompass.recordings.yaw_restarts`)."""
     from bionav.polcompass.recordings import yaw_restarts
 
-    run_of_rotation = np.cumsum(yaw_restarts([r.yaw for r in rotations])) - 1
-    return run_of_rotation[np.asarray(rotation_index, int)]
+    index = np.asarray(data.rotation_index, int)
+    starts = [data.yaw[index == r] for r in range(int(index.max()) + 1 if index.size else 0)]
+    return (np.cumsum(yaw_restarts(starts)) - 1)[index]
+
+
+def with_reference(data: SessionData, reference: str) -> SessionData:
+    """The session scored under ``recordings.reference``.
+
+    ``session``: as logged, one offset. ``yaw_run``: one offset per run between the yaw's restarts
+    (:attr:`SessionData.reference_run`). ``stitched``: each run turned by its shift against the first
+    run, found from the counts alone (:func:`bionav.polcompass.array_calibration.yaw_run_shifts`), then
+    one offset (:attr:`SessionData.yaw` is the stitched yaw, :attr:`SessionData.yaw_shift` what was
+    added). ``rotation``: one offset per rotation file.
+    """
+    if reference == "session":
+        return data
+    if reference == "rotation":
+        return replace(data, reference_run=np.asarray(data.rotation_index, int))
+    runs = yaw_runs(data)
+    if reference == "yaw_run":
+        return replace(data, reference_run=runs)
+    from bionav.polcompass.array_calibration import yaw_run_shifts
+
+    shifts = yaw_run_shifts(data.counts, data.yaw, data.valid, runs)
+    lost = np.flatnonzero(~np.isfinite(shifts))
+    if lost.size:
+        log.warning("%s: yaw run(s) %s have no readable counts in common with the first run and are not stitched (shift 0)",
+                    data.session.name, lost.tolist())
+    shift = np.nan_to_num(shifts)[runs]
+    return replace(data, yaw=data.yaw + shift, yaw_shift=shift, reference_run=None, run_shifts=np.nan_to_num(shifts))
 
 
 def calibration_sessions(datas, rc) -> list:
@@ -360,7 +383,8 @@ __all__ = [
     "prepare_session",
     "prepared_sessions",
     "self_calibrate",
-    "reference_runs",
+    "with_reference",
+    "yaw_runs",
     "session_errors",
     "session_evectors",
     "simulate_session",

@@ -141,6 +141,69 @@ def bin_by_yaw(counts, yaw, valid, *, n_bins: int = 120, min_samples: int = 2):
     return centres, out
 
 
+def yaw_run_shifts(counts, yaw, valid, runs, *, n_bins: int = 360, max_shift_deg: float = 20.0) -> np.ndarray:
+    """How far each run of the logged yaw is turned against the first, from the counts alone (radians, ``(R,)``).
+
+    Under a steady sky every run of a rotation session sees the same ring of log
+    counts per unit and photodiode; a run whose yaw restarted
+    (:func:`bionav.polcompass.recordings.yaw_restarts`) sees it turned by the
+    unlogged angle ``s``: ``f_r(theta) = f_0(theta + s)``. Each run's ring is
+    binned by yaw (:func:`bin_by_yaw`, each channel's mean removed), and ``s``
+    minimises the mean squared difference between the first run's ring and
+    run ``r``'s ring read at ``theta - s`` (whole bins within ``max_shift_deg``,
+    then a parabola through the three best; interpolating between bins would
+    favour half-bin shifts, where it averages the noise):
+    ``yaw + shift[run]`` puts every run in the first run's reference. No heading
+    truth and no decoder is used. A run sharing no ring bin with the first gets NaN.
+
+    Parameters
+    ----------
+    counts : ndarray, shape ``(N, K, P)``
+    yaw : ndarray, shape ``(N,)``
+        Radians CCW.
+    valid : ndarray of bool, shape ``(N, K)``
+    runs : ndarray of int, shape ``(N,)``
+        Run of each sample, ``0 .. R-1``.
+    n_bins : int
+        Ring bins over the full turn (a run should fill them: about 400 samples per turn fill 360).
+    max_shift_deg : float
+        Largest shift searched, degrees.
+
+    Returns
+    -------
+    ndarray, shape ``(R,)``
+        Radians CCW; ``shift[0] = 0``.
+    """
+    runs = np.asarray(runs, int)
+    counts, yaw, valid = np.asarray(counts), np.asarray(yaw, float), np.asarray(valid, bool)
+
+    def ring(sel):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # empty bins and dark channels: NaN
+            _c, y = bin_by_yaw(counts[sel], yaw[sel], valid[sel], n_bins=n_bins, min_samples=1)
+            return y - np.nanmean(y, axis=0, keepdims=True)
+
+    steps = np.arange(-int(np.ceil(max_shift_deg / 360.0 * n_bins)), int(np.ceil(max_shift_deg / 360.0 * n_bins)) + 1)
+    index = (np.arange(n_bins)[None] - steps[:, None]) % n_bins  # (S, B): ring r read at theta_b - s, whole bins
+    base = ring(runs == 0)
+    out = np.zeros(int(runs.max()) + 1 if runs.size else 1)
+    for r in range(1, out.size):
+        diff = ring(runs == r)[index] - base[None]  # (S, B, K, P)
+        n = np.sum(np.isfinite(diff), axis=(1, 2, 3))
+        if not n.any():
+            out[r] = np.nan
+            continue
+        cost = np.where(n > 0, np.nansum(diff**2, axis=(1, 2, 3)) / np.maximum(n, 1), np.inf)
+        j = int(np.argmin(cost))
+        dj = 0.0
+        if 0 < j < cost.size - 1 and np.all(np.isfinite(cost[j - 1:j + 2])):
+            lo, mid, hi = cost[j - 1:j + 2]
+            curv = lo - 2.0 * mid + hi
+            dj = 0.5 * (lo - hi) / curv if curv > 0 else 0.0
+        out[r] = (steps[j] + dj) * 2.0 * np.pi / n_bins
+    return out
+
+
 def mirror_gauge(stokes, theta):
     """Split a ring's Stokes components into the parts even and odd about the best mirror axis.
 

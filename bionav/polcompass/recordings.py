@@ -278,8 +278,8 @@ def yaw_restarts(yaws, *, zero_deg: float = YAW_ZERO_DEG, rest_deg: float = YAW_
     ``rest_deg`` and whose first sample lies within ``zero_deg`` of zero is
     taken as such a restart. On the sessions in ``../shared/data`` the
     decoded heading's per-rotation offset steps by a median of 3.5 degrees
-    at the 68 rotations this marks and by 0.7 degrees at the other 215
-    (docs/polcompass.md, "The logged yaw restarts").
+    where this marks a restart and by 0.7 degrees elsewhere (docs/polcompass.md,
+    "The reference: the logged yaw restarts").
 
     Parameters
     ----------

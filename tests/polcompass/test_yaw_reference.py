@@ -10,6 +10,7 @@ from helpers import external_data, run_bionav
 from bionav.experiments.pol_recordings_session import session_errors
 from bionav.light import SkyModel, sun_position
 from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
+from bionav.polcompass.array_calibration import yaw_run_shifts
 from bionav.polcompass.recordings import load_rotation, yaw_restarts
 
 COMPASS = external_data() / "celestial-compass"
@@ -53,6 +54,25 @@ def test_session_errors_fit_one_offset_per_run():
     assert np.degrees(np.abs(err1[np.isfinite(decoded)])).max() == pytest.approx(np.degrees(shift - mean), abs=0.1)
 
 
+def test_yaw_run_shifts_find_the_unlogged_turn_from_the_counts():
+    """Three runs of one sky; the robot restarted its yaw 7 degrees (run 1) and -4 degrees (run 2) turned."""
+    arr = PolArray.fan8()
+    sun = sun_position("2022-05-12T11:00:00+02:00", latitude_deg=39.2, longitude_deg=9.1)
+    sky = SkyModel(sun, max_degree=0.5)
+    rng = np.random.default_rng(5)
+    yaw = np.concatenate([_turn(400, start_deg=0.0, rest=6)] * 3)
+    runs = np.repeat([0, 1, 2], 400)
+    turned = np.deg2rad(np.array([0.0, 7.0, -4.0]))[runs]
+    inten, q, u = stokes_from_sky(sky, arr, 0.4 + turned + yaw)
+    counts = counts_from_stokes(3000.0 * inten, q, u, arr) * (1.0 + 0.01 * rng.standard_normal((1200, 8, 4)))
+    valid = np.ones((1200, 8), bool)
+    shifts = np.degrees(yaw_run_shifts(counts, yaw, valid, runs))
+    assert shifts[0] == 0.0 and shifts[1:] == pytest.approx([7.0, -4.0], abs=0.1)
+    valid[runs == 2] = False  # a run with nothing readable cannot be placed
+    shifts = yaw_run_shifts(counts, yaw, valid, runs)
+    assert np.degrees(shifts[1]) == pytest.approx(7.0, abs=0.1) and np.isnan(shifts[2])
+
+
 def _session_with_a_restart(root, shift_deg=10.0, n=90):
     """Three rotations under the model sky; the third restarts the yaw at zero with the robot ``shift_deg`` turned."""
     arr = PolArray.fan8()
@@ -78,7 +98,8 @@ def test_the_reference_option_scores_a_restarted_yaw_by_its_runs(tmp_path):
     _session_with_a_restart(tmp_path / "rec")
     shift = np.deg2rad(10.0)
     mean = np.degrees(np.arctan2(np.sin(shift), 2.0 + np.cos(shift)))  # the session offset's share of the shift
-    expected = {"session": (1, (2 * mean + (10.0 - mean)) / 3.0), "yaw_run": (2, 0.0), "rotation": (3, 0.0)}
+    expected = {"session": (1, (2 * mean + (10.0 - mean)) / 3.0), "stitched": (2, 0.0), "yaw_run": (2, 0.0),
+                "rotation": (3, 0.0)}
     for reference, (runs, mae) in expected.items():
         out = tmp_path / reference
         proc = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path / 'rec'}", f"hydra.run.dir={out}",
@@ -90,6 +111,10 @@ def test_the_reference_option_scores_a_restarted_yaw_by_its_runs(tmp_path):
         assert metrics["heading_mae_deg"] == pytest.approx(mae, abs=0.4), reference
         rows = list(csv.DictReader(open(out / "sessions.csv")))
         assert [int(r["reference_runs"]) for r in rows] == [runs]
+        assert f"recordings.reference={reference}" in (out / "summary.md").read_text()
+        if reference == "stitched":  # the counts alone turn the restarted run back by the robot's 10 degrees
+            first, second = map(float, rows[0]["yaw_run_shifts_deg"].split())
+            assert first == 0.0 and second == pytest.approx(10.0, abs=0.3)
 
 
 @pytest.mark.skipif(not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)")

@@ -152,10 +152,11 @@ class RecordingsConfig:
         not the default).
     calibration_solver : ``pol_op`` (the POL-OP chain, each pair at its mean calibrated orientation) or
         ``stokes`` (every photodiode at its own angle, linear least squares).
-    reference : over what the logged yaw is taken to keep one reference (one heading offset fitted per
-        run, for every decoder alike): ``session`` (default: the authors align the yaw once per session),
-        ``yaw_run`` (a new run where the yaw restarts at rest at zero, an odometry restart:
-        :func:`bionav.polcompass.recordings.yaw_restarts`) or ``rotation`` (every file; a lower bound).
+    reference : the heading reference the errors are taken against (the same for every decoder):
+        ``session`` (default: the logged yaw, one offset per session; the authors align the yaw once per
+        session), ``stitched`` (the yaw's runs between odometry restarts, :func:`bionav.polcompass.recordings.yaw_restarts`,
+        turned into the first run's reference by the counts' sky ring alone, then one offset per session),
+        ``yaw_run`` (one offset per run) or ``rotation`` (one per file; a lower bound).
     """
 
     path: Optional[str] = None
@@ -178,7 +179,7 @@ class RecordingsConfig:
     calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
     calibration_conditions: list[str] = bounded(
         ["tod_daylight", "tod_dusk", "canopy"], length=(0, 3), item=Range(choices=("tod_daylight", "tod_dusk", "canopy")))
-    reference: str = bounded("session", choices=("session", "yaw_run", "rotation"))
+    reference: str = bounded("session", choices=("session", "stitched", "yaw_run", "rotation"))
 
     def validate(self) -> None:
         """``exclude_units`` is ``auto``, ``none`` or a list of unit numbers (called by ``typed_config``)."""
