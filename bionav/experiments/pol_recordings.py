@@ -283,7 +283,7 @@ def _score_session(ctx, exp, tally: _Tally, data: SessionData, sim_runs, decoder
             tally.res_by_group[data.period].append(resolved)
             tally.valid_by_group[data.period].append(decoded)
             tally.real_err[data.period].append(err)
-            tally.per_session_plot.append((data.session, data, err))
+            tally.per_session_plot.append((data.session, data, err, decoded))
             if sim_runs:  # every repeat its own simulated device (gains) and cloud draw, errors pooled
                 s_err = np.concatenate([session_errors(decode_session(dec, sd)[0], sd.yaw, runs=sd.reference_run)[0]
                                         for sd in sim_runs])
@@ -340,6 +340,7 @@ def _write_outputs(ctx, exp, tally: _Tally, pooled_rows, chosen, reference: str 
     first = tally.per_session_plot[0]
     plots.raw_rotation(plot_dir / "raw_unit_responses.png", first[0], first[1])
     plots.clear_vs_canopy(plot_dir / "clear_vs_canopy.png", tally.real_err, chosen)
+    plots.yaw_reference(plot_dir / "yaw_reference.png", tally.per_session_plot, chosen, reference)
     if exp.simulate:
         plots.sim_vs_real(plot_dir / "sim_vs_real.png", tally.real_err, tally.sim_err, chosen)
 

@@ -55,8 +55,8 @@ def session_distributions(path, per_session, decoder) -> None:
     """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(max(6, 0.35 * len(per_session) + 2), 4.4))
-    data = [np.maximum(np.abs(np.degrees(err)), ERROR_FLOOR_DEG) for _s, _d, err in per_session]
-    labels = [f"{s.day[5:]} {s.time_of_day}{' C' if d.period == 'canopy' else ''}" for s, d, _e in per_session]
+    data = [np.maximum(np.abs(np.degrees(err)), ERROR_FLOOR_DEG) for _s, _d, err, *_ in per_session]
+    labels = [f"{s.day[5:]} {s.time_of_day}{' C' if d.period == 'canopy' else ''}" for s, d, *_ in per_session]
     ax.boxplot(data, whis=(5, 95), showfliers=False)
     ax.set_xticks(range(1, len(labels) + 1))
     ax.set_xticklabels(labels, rotation=90, fontsize=7)
@@ -118,4 +118,39 @@ def sim_vs_real(path, real, sim, decoder) -> None:
     ax.set_ylabel("fraction of samples")
     ax.set_title(f"sim-to-real gap, decoder={decoder}")
     ax.legend(fontsize=7)
+    save_figure(fig, path, dpi=DPI)
+
+
+def yaw_reference(path, per_session, decoder, reference: str) -> None:
+    """Per-rotation circular mean of the scored heading error over decoded samples (chosen decoder), sessions in a row.
+
+    Each run of the logged yaw is its own line; red dotted lines mark the rotations whose logged yaw restarts
+    (:func:`bionav.polcompass.recordings.yaw_restarts`): steps of the mean there are the
+    yaw reference moving, not the decoder (docs/polcompass.md, "The reference").
+    """
+    from bionav.experiments.pol_recordings_session import yaw_runs
+
+    plt = pyplot()
+    n_rot = sum(int(d.rotation_index.max()) + 1 for _s, d, *_ in per_session)
+    fig, ax = plt.subplots(figsize=(max(6.0, 0.05 * n_rot + 2.0), 4.0))
+    x0 = 0
+    for i, (_s, d, err, decoded) in enumerate(per_session):
+        r = int(d.rotation_index.max()) + 1
+        runs = yaw_runs(d)
+        means = []
+        for j in range(r):
+            e = err[(d.rotation_index == j) & decoded]  # undecoded samples (scored 90 degrees) left out
+            means.append(np.degrees(np.angle(np.mean(np.exp(1j * e)))) if e.size else np.nan)
+        run_of = np.array([runs[d.rotation_index == j][0] for j in range(r)])
+        for run in np.unique(run_of):  # one line per run of the yaw: a step between lines is the reference moving
+            js = np.flatnonzero(run_of == run)
+            ax.plot(x0 + js, np.asarray(means)[js], ".-", color="C0" if i % 2 == 0 else "C1", lw=0.9, ms=3)
+        for j in np.flatnonzero(np.diff(run_of)) + 1:
+            ax.axvline(x0 + j - 0.5, color="C3", lw=0.6, ls=":")
+        x0 += r + 1
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_xlabel("rotation (sessions one after another, alternating colours)")
+    ax.set_ylabel("mean heading error of the rotation (deg)")
+    ax.set_title(f"per-rotation mean error, decoder={decoder}, recordings.reference={reference}\n"
+                 "one line per run of the logged yaw; red dotted: the yaw restarts (odometry restart)", fontsize=9)
     save_figure(fig, path, dpi=DPI)

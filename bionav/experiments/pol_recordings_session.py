@@ -153,7 +153,8 @@ def yaw_runs(data: SessionData) -> np.ndarray:
     from bionav.polcompass.recordings import yaw_restarts
 
     index = np.asarray(data.rotation_index, int)
-    starts = [data.yaw[index == r] for r in range(int(index.max()) + 1 if index.size else 0)]
+    logged = data.yaw if data.yaw_shift is None else data.yaw - data.yaw_shift
+    starts = [logged[index == r] for r in range(int(index.max()) + 1 if index.size else 0)]
     return (np.cumsum(yaw_restarts(starts)) - 1)[index]
 
 

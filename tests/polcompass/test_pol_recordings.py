@@ -93,7 +93,8 @@ def test_experiment_on_synthetic_recordings_recovers_the_heading(tmp_path):
     rows = list(csv.DictReader(open(out / "sessions.csv")))
     assert {r["decoder"] for r in rows} == {"sky_fit", "two_unit", "sol", "four_zeros", "eigenvector", "mean_vector"}
     assert all(r["excluded_units"] == "7" and r["condition"] == "tod" and r["time_of_day"] == "13:00" for r in rows)
-    for name in ("error_vs_time_of_day", "session_errors", "raw_unit_responses", "clear_vs_canopy", "sim_vs_real"):
+    for name in ("error_vs_time_of_day", "session_errors", "raw_unit_responses", "clear_vs_canopy", "sim_vs_real",
+                 "yaw_reference"):
         assert (out / "plots" / f"{name}.png").stat().st_size > 1000
     from bionav.plugins.sensors.replay import read_topics
 
