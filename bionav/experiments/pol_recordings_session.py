@@ -179,8 +179,8 @@ def with_reference(data: SessionData, reference: str) -> SessionData:
     shifts = yaw_run_shifts(data.counts, data.yaw, data.valid, runs)
     lost = np.flatnonzero(~np.isfinite(shifts))
     if lost.size:
-        log.warning("%s: yaw run(s) %s have no readable counts in common with the first run and are not stitched (shift 0)",
-                    data.session.name, lost.tolist())
+        log.warning("%s: yaw run(s) %s are not stitched (shift 0): no readable counts in common with the first run, or "
+                    "turned more than 20 degrees against it", data.session.name, lost.tolist())
     shift = np.nan_to_num(shifts)[runs]
     return replace(data, yaw=data.yaw + shift, yaw_shift=shift, reference_run=None, run_shifts=np.nan_to_num(shifts))
 
@@ -384,10 +384,10 @@ __all__ = [
     "prepare_session",
     "prepared_sessions",
     "self_calibrate",
-    "with_reference",
-    "yaw_runs",
     "session_errors",
     "session_evectors",
     "simulate_session",
     "view_field",
+    "with_reference",
+    "yaw_runs",
 ]

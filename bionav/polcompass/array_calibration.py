@@ -154,7 +154,8 @@ def yaw_run_shifts(counts, yaw, valid, runs, *, n_bins: int = 360, max_shift_deg
     then a parabola through the three best; interpolating between bins would
     favour half-bin shifts, where it averages the noise):
     ``yaw + shift[run]`` puts every run in the first run's reference. No heading
-    truth and no decoder is used. A run sharing no ring bin with the first gets NaN.
+    truth and no decoder is used. A run sharing no ring bin with the first, or
+    whose best match lies at the search limit, gets NaN.
 
     Parameters
     ----------
@@ -195,8 +196,11 @@ def yaw_run_shifts(counts, yaw, valid, runs, *, n_bins: int = 360, max_shift_deg
             continue
         cost = np.where(n > 0, np.nansum(diff**2, axis=(1, 2, 3)) / np.maximum(n, 1), np.inf)
         j = int(np.argmin(cost))
+        if j in (0, cost.size - 1):  # best at the search limit: turned further than max_shift_deg, not placed
+            out[r] = np.nan
+            continue
         dj = 0.0
-        if 0 < j < cost.size - 1 and np.all(np.isfinite(cost[j - 1:j + 2])):
+        if np.all(np.isfinite(cost[j - 1:j + 2])):
             lo, mid, hi = cost[j - 1:j + 2]
             curv = lo - 2.0 * mid + hi
             dj = 0.5 * (lo - hi) / curv if curv > 0 else 0.0

@@ -68,6 +68,8 @@ def test_yaw_run_shifts_find_the_unlogged_turn_from_the_counts():
     valid = np.ones((1200, 8), bool)
     shifts = np.degrees(yaw_run_shifts(counts, yaw, valid, runs))
     assert shifts[0] == 0.0 and shifts[1:] == pytest.approx([7.0, -4.0], abs=0.1)
+    beyond = yaw_run_shifts(counts, yaw, valid, runs, max_shift_deg=5.0)  # run 1 turned further than searched
+    assert np.isnan(beyond[1]) and np.degrees(beyond[2]) == pytest.approx(-4.0, abs=0.1)
     valid[runs == 2] = False  # a run with nothing readable cannot be placed
     shifts = yaw_run_shifts(counts, yaw, valid, runs)
     assert np.degrees(shifts[1]) == pytest.approx(7.0, abs=0.1) and np.isnan(shifts[2])
