@@ -47,6 +47,7 @@ from bionav.experiments.pol_recordings_session import (
     self_calibrate,
     session_errors,
     simulate_session,
+    yaw_runs,
 )
 
 log = logging.getLogger(__name__)
@@ -225,15 +226,20 @@ class _Tally:
         self.n_rotations = 0
 
 
-def _reference_runs(data: SessionData) -> int:
-    """Runs of the logged yaw a session is scored over: with one offset each, or stitched into one."""
+def _reference_runs(data: SessionData) -> tuple[int, str]:
+    """Runs a session is scored over (with one offset each, or stitched into one) and the stitching shifts (degrees)."""
     if data.reference_run is not None:
-        return int(np.unique(data.reference_run).size)
-    return 1 if data.run_shifts is None else int(data.run_shifts.size)
+        return int(np.unique(data.reference_run).size), ""
+    if data.yaw_shift is None:
+        return 1, ""
+    runs = yaw_runs(data)
+    shifts = [float(np.degrees(data.yaw_shift[runs == r][0])) for r in range(int(runs.max()) + 1)]
+    return len(shifts), " ".join(f"{v:.2f}" for v in shifts)
 
 
 def _session_base(data: SessionData, cal_label: str) -> dict:
     session = data.session
+    runs, shifts = _reference_runs(data)
     return {
         "session": session.name,
         "day": session.day,
@@ -243,8 +249,8 @@ def _session_base(data: SessionData, cal_label: str) -> dict:
         "sun_elevation_deg": float(np.degrees(data.sun.elevation)),
         "sun_azimuth_deg": float(np.degrees(data.sun.azimuth)),
         "n_rotations": len(session.rotations),
-        "reference_runs": _reference_runs(data),
-        "yaw_run_shifts_deg": "" if data.run_shifts is None else " ".join(f"{v:.2f}" for v in np.degrees(data.run_shifts)),
+        "reference_runs": runs,
+        "yaw_run_shifts_deg": shifts,
         "excluded_units": " ".join(str(u) for u in data.excluded),
         "calibration": cal_label,
     }

@@ -99,7 +99,6 @@ class SessionData:
     pol_op_valid: np.ndarray | None = None  # (N, K, J): both photodiodes of the POL-OP usable, unit not dropped
     reference_run: np.ndarray | None = None  # (N,): runs of one yaw reference (recordings.reference); None: the session
     yaw_shift: np.ndarray | None = None  # (N,): radians added to the logged yaw (recordings.reference=stitched)
-    run_shifts: np.ndarray | None = None  # (R,): radians each yaw run was turned by (recordings.reference=stitched)
 
 
 def session_evectors(counts, array, pol_op_valid, excluded):
@@ -182,7 +181,7 @@ def with_reference(data: SessionData, reference: str) -> SessionData:
         log.warning("%s: yaw run(s) %s are not stitched (shift 0): no readable counts in common with the first run, or "
                     "turned more than 20 degrees against it", data.session.name, lost.tolist())
     shift = np.nan_to_num(shifts)[runs]
-    return replace(data, yaw=data.yaw + shift, yaw_shift=shift, reference_run=None, run_shifts=np.nan_to_num(shifts))
+    return replace(data, yaw=data.yaw + shift, yaw_shift=shift)
 
 
 def calibration_sessions(datas, rc) -> list:
