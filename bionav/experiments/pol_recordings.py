@@ -10,10 +10,11 @@ photodiodes each, on a robot turning in place; loader and format in
 
 with ``c`` one constant per session, the circular mean of ``decoded - yaw``
 over the session's rotations (the IMU yaw has an arbitrary zero, the sun moves
-little within a session); ``recordings.reference=stitched`` first turns the
-runs of the logged yaw between odometry restarts into one reference by the
-counts' sky ring, ``yaw_run`` fits one ``c`` per run, ``rotation`` one per
-rotation file (:func:`bionav.polcompass.recordings.yaw_restarts`). Each sample is decoded only from the units read at
+little within a session). By default (``recordings.reference=stitched``) the
+runs of the logged yaw between odometry restarts are first turned into one
+reference by the counts' sky ring; ``session`` takes the logged yaw as it is,
+``yaw_run`` fits one ``c`` per run, ``rotation`` one per rotation file
+(:func:`bionav.polcompass.recordings.yaw_restarts`). Each sample is decoded only from the units read at
 that moment; units found faulty from the session's counts are dropped with
 ``recordings.exclude_units=auto``.
 
@@ -109,7 +110,7 @@ def _fmt(v, digits=1):
     return "-" if v is None else f"{v:.{digits}f}"
 
 
-def summary_markdown(session_rows, pooled_rows, decoders, *, reference: str = "session") -> str:
+def summary_markdown(session_rows, pooled_rows, decoders, *, reference: str) -> str:
     """Per-session and pooled MAE tables (degrees) as Markdown; ``reference``: ``recordings.reference``."""
     lines = [f"Heading reference: `recordings.reference={reference}`", "",
              "Per session: MAE / RMSE (degrees) per decoder", ""]
@@ -332,7 +333,7 @@ def _pooled_rows(tally: _Tally) -> list[dict]:
     return rows
 
 
-def _write_outputs(ctx, exp, tally: _Tally, pooled_rows, chosen, reference: str = "session") -> None:
+def _write_outputs(ctx, exp, tally: _Tally, pooled_rows, chosen, reference: str) -> None:
     from bionav.experiments import pol_recordings_plots as plots
 
     _write_csv(ctx.dir / "sessions.csv", tally.session_rows)
@@ -376,7 +377,7 @@ def _sim_metrics(exp, tally: _Tally) -> dict:
     """The simulation's parameters and ``sim_<condition>_mae_deg``."""
     metrics = {"sim_repeats": exp.sim_repeats}
     for key in ("sim_gain_sigma", "sim_angle_sigma_deg", "sim_noise", "sim_canopy_cover", "sim_max_degree",
-                "sim_view_sigma", "sim_view_shared", "sim_tilt_sigma_deg", "sim_azimuth_sigma_deg"):
+                "sim_view_sigma", "sim_view_shared", "sim_gain_shared", "sim_tilt_sigma_deg", "sim_azimuth_sigma_deg"):
         metrics[key] = getattr(exp, key)
     for g in GROUPS:
         if tally.sim_err[g]:

@@ -176,7 +176,8 @@ def with_reference(data: SessionData, reference: str) -> SessionData:
     from bionav.polcompass.array_calibration import yaw_run_shifts
 
     shifts = yaw_run_shifts(data.counts, data.yaw, data.valid, runs)
-    lost = np.flatnonzero(~np.isfinite(shifts))
+    readable = np.array([data.valid[runs == r].any() for r in range(shifts.size)])
+    lost = np.flatnonzero(~np.isfinite(shifts) & readable)  # a run with nothing readable decodes nothing anyway
     if lost.size:
         log.warning("%s: yaw run(s) %s are not stitched (shift 0): no readable counts in common with the first run, or "
                     "turned more than 20 degrees against it", data.session.name, lost.tolist())
@@ -313,7 +314,8 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
 
     Photodiode counts from :func:`bionav.polcompass.array.stokes_from_sky`
     (point optics) scaled to the session's median count, through a device
-    drawn with a log-normal photodiode gain spread ``sim_gain_sigma`` and
+    drawn with a log-normal photodiode gain spread ``sim_gain_sigma`` (a share ``sim_gain_shared`` of its
+    variance common to a unit's photodiodes) and
     polarizer angle offsets ``sim_angle_sigma_deg`` (the decoder assumes the
     nominal device), with proportional noise and the same saturation; canopy
     sessions get a cloud field of ``sim_canopy_cover``.
@@ -334,7 +336,10 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     counts = counts_from_stokes(intensity, q, u, device)
     lit = data.counts[data.counts > 0]
     scale = (np.median(lit) if lit.size else 1000.0) / max(float(np.median(counts)), 1e-12)
-    gains = np.exp(exp.sim_gain_sigma * rng.standard_normal(counts.shape[1:]))
+    k, n_pd = counts.shape[1:]
+    common = rng.standard_normal((k, 1)) if exp.sim_gain_shared > 0 else 0.0
+    z = np.sqrt(exp.sim_gain_shared) * common + np.sqrt(1.0 - exp.sim_gain_shared) * rng.standard_normal((k, n_pd))
+    gains = np.exp(exp.sim_gain_sigma * z)
     counts = counts * scale * gains
     if exp.sim_view_sigma > 0:  # each photodiode's own smooth departure from the shared sky ring (world frame)
         counts = counts * np.exp(exp.sim_view_sigma * view_field(rng, mount + data.yaw, data.array.unit_azimuths,

@@ -152,11 +152,12 @@ class RecordingsConfig:
         not the default).
     calibration_solver : ``pol_op`` (the POL-OP chain, each pair at its mean calibrated orientation) or
         ``stokes`` (every photodiode at its own angle, linear least squares).
-    reference : the heading reference the errors are taken against (the same for every decoder):
-        ``session`` (default: the logged yaw, one offset per session; the authors align the yaw once per
-        session), ``stitched`` (the yaw's runs between odometry restarts, :func:`bionav.polcompass.recordings.yaw_restarts`,
-        turned into the first run's reference by the counts' sky ring alone, then one offset per session),
-        ``yaw_run`` (one offset per run) or ``rotation`` (one per file; a lower bound).
+    reference : the heading reference the errors are taken against (the same for every decoder), always one
+        offset per session unless said: ``stitched`` (default: the yaw's runs between odometry restarts,
+        :func:`bionav.polcompass.recordings.yaw_restarts`, turned into the first run's reference by the counts'
+        sky ring alone), ``session`` (the logged yaw as it is; the authors align it once per session),
+        ``yaw_run`` (one offset per run) or ``rotation`` (one per file; a lower bound). docs/polcompass.md,
+        "The reference: the logged yaw restarts".
     """
 
     path: Optional[str] = None
@@ -179,7 +180,7 @@ class RecordingsConfig:
     calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
     calibration_conditions: list[str] = bounded(
         ["tod_daylight", "tod_dusk", "canopy"], length=(0, 3), item=Range(choices=("tod_daylight", "tod_dusk", "canopy")))
-    reference: str = bounded("session", choices=("session", "stitched", "yaw_run", "rotation"))
+    reference: str = bounded("stitched", choices=("stitched", "session", "yaw_run", "rotation"))
 
     def validate(self) -> None:
         """``exclude_units`` is ``auto``, ``none`` or a list of unit numbers (called by ``typed_config``)."""
@@ -216,6 +217,11 @@ class PolRecordingsConfig:
         variance a unit's photodiodes have in common (it cancels in a POL-OP's log ratio; the ring residual cannot
         tell it): 0.8 is *fitted* on the daylight heading MAE (0 / 0.5 / 0.8 / 0.95 over seeds 0-3: simulated 4.7 /
         4.1 / 3.6 / 3.3 degrees against 3.6 real, means of the seeds) and checked on dusk and canopy (docs/polcompass.md).
+        With the gain split below and ``recordings.reference=stitched`` it still matches (2.77 simulated against
+        2.73 real by day). ``sim_gain_shared``: the fraction of the log-gain variance a unit's photodiodes have in
+        common (it cancels in a POL-OP's log ratio); 0.5 is *measured* on the counts: the healthy units'
+        self-calibrated log gains spread by 0.096, the log ratios of their POL-OP pairs by 0.094 rms, so each
+        photodiode's own part is 0.094 / sqrt(2) = 0.066 and the unit's common part 0.070 (a share of 0.53).
         ``sim_tilt_sigma_deg``, ``sim_azimuth_sigma_deg``:
         unit pointing tolerances (0: tilts up to 6 degrees gave ring residuals of 0.01-0.08 only).
     record_samples : every decoded sample of the chosen decoder into run.mcap.
@@ -235,4 +241,5 @@ class PolRecordingsConfig:
     sim_azimuth_sigma_deg: float = bounded(0.0, ge=0.0, le=45.0)
     sim_view_sigma: float = bounded(0.1, ge=0.0, le=2.0)
     sim_view_shared: float = bounded(0.8, ge=0.0, le=1.0)
+    sim_gain_shared: float = bounded(0.5, ge=0.0, le=1.0)
     record_samples: bool = True
