@@ -68,6 +68,22 @@ def wrap_axial(angle):
     return (np.asarray(angle) + np.pi / 2.0) % np.pi - np.pi / 2.0
 
 
+def parabolic_peak_offset(y_before, y_at, y_after):
+    """Sub-step position of a peak on an evenly spaced (e.g. angular) grid.
+
+    The vertex of the parabola through ``(-1, y_before)``, ``(0, y_at)`` and
+    ``(1, y_after)``, in grid steps from the middle sample, where the three
+    samples bend down (``y_at`` the largest: a maximum); 0 where they do not.
+    At a grid maximum the offset lies in ``[-0.5, 0.5]``; it is clipped there.
+    For a minimum pass the negated values. Shapes broadcast; returns an
+    ndarray (0-d for scalars).
+    """
+    y0, y1, y2 = (np.asarray(v, float) for v in (y_before, y_at, y_after))
+    den = y0 - 2.0 * y1 + y2
+    peaked = den < 0.0
+    return np.clip(np.where(peaked, 0.5 * (y0 - y2) / np.where(peaked, den, -1.0), 0.0), -0.5, 0.5)
+
+
 # --- ENU frame ---------------------------------------------------------------------------------
 
 

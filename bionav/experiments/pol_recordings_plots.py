@@ -128,7 +128,7 @@ def yaw_reference(path, per_session, decoder, reference: str) -> None:
     (:func:`bionav.polcompass.recordings.yaw_restarts`): steps of the mean there are the
     yaw reference moving, not the decoder (docs/polcompass.md, "The reference").
     """
-    from bionav.experiments.pol_recordings_session import yaw_runs
+    from bionav.experiments.pol_recordings_session import circular_offset, yaw_runs
 
     plt = pyplot()
     n_rot = sum(int(d.rotation_index.max()) + 1 for _s, d, *_ in per_session)
@@ -140,7 +140,7 @@ def yaw_reference(path, per_session, decoder, reference: str) -> None:
         means = []
         for j in range(r):
             e = err[(d.rotation_index == j) & decoded]  # undecoded samples (scored 90 degrees) left out
-            means.append(np.degrees(np.angle(np.mean(np.exp(1j * e)))) if e.size else np.nan)
+            means.append(np.degrees(circular_offset(e, 0.0)) if e.size else np.nan)
         run_of = np.array([runs[d.rotation_index == j][0] for j in range(r)])
         for run in np.unique(run_of):  # one line per run of the yaw: a step between lines is the reference moving
             js = np.flatnonzero(run_of == run)

@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from bionav.errors import UserError
-from bionav.geometry import wrap_axial
+from bionav.geometry import parabolic_peak_offset, wrap_axial
 
 SCHEMA = "bionav.pol_array_calibration/1"
 
@@ -199,11 +199,8 @@ def yaw_run_shifts(counts, yaw, valid, runs, *, n_bins: int = 360, max_shift_deg
         if j in (0, cost.size - 1):  # best at the search limit: turned further than max_shift_deg, not placed
             out[r] = np.nan
             continue
-        dj = 0.0
-        if np.all(np.isfinite(cost[j - 1:j + 2])):
-            lo, mid, hi = cost[j - 1:j + 2]
-            curv = lo - 2.0 * mid + hi
-            dj = 0.5 * (lo - hi) / curv if curv > 0 else 0.0
+        near = -cost[j - 1:j + 2]  # a minimum of the cost is a peak of its negative
+        dj = float(parabolic_peak_offset(*near)) if np.all(np.isfinite(near)) else 0.0
         out[r] = (steps[j] + dj) * 2.0 * np.pi / n_bins
     return out
 

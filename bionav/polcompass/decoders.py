@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.geometry import wrap_angle
+from bionav.geometry import parabolic_peak_offset, wrap_angle
 from bionav.polcompass.array import PolArray, UnitEvectors, stokes_from_sky
 
 
@@ -191,11 +191,8 @@ def _pick_pair(score, azimuths, total, margin):
     step = 2.0 * np.pi / g
 
     def refine(j):
-        y0, y1, y2 = score[rows, (j - 1) % g], score[rows, j], score[rows, (j + 1) % g]
-        den = y0 - 2.0 * y1 + y2
-        ok = np.abs(den) > 1e-15
-        shift = np.where(ok, 0.5 * (y0 - y2) / np.where(ok, den, 1.0), 0.0)
-        return wrap_angle(azimuths[j] + np.clip(shift, -0.5, 0.5) * step)
+        shift = parabolic_peak_offset(score[rows, (j - 1) % g], score[rows, j], score[rows, (j + 1) % g])
+        return wrap_angle(azimuths[j] + shift * step)
 
     gap = (score[rows, best] - score[rows, alt]) / np.maximum(total, 1e-12)
     return best, refine(best), refine(alt), gap

@@ -7,6 +7,7 @@ from bionav.geometry import (
     azimuth_to_compass,
     compass_to_azimuth,
     direction_from_angles,
+    parabolic_peak_offset,
     wrap_axial,
 )
 
@@ -41,3 +42,14 @@ def test_compass_bearings():
 def test_wrap_axial_period_pi():
     np.testing.assert_allclose(wrap_axial([0.0, np.pi, np.pi / 2, -np.pi / 2, 2.0]),
                                [0.0, 0.0, -np.pi / 2, -np.pi / 2, 2.0 - np.pi])
+
+
+def test_parabolic_peak_offset_is_the_vertex_of_three_samples():
+    """Samples of -(x - v)^2 + 2 at x = -1, 0, 1 put the vertex at v, for a scalar and for arrays."""
+    v = np.array([0.3, -0.45, 0.0, 0.5])
+    y = [-(x - v) ** 2 + 2.0 for x in (-1.0, 0.0, 1.0)]
+    np.testing.assert_allclose(parabolic_peak_offset(*y), v, atol=1e-12)
+    assert float(parabolic_peak_offset(1.0, 3.0, 2.0)) == 0.5 * (1.0 - 2.0) / (1.0 - 6.0 + 2.0)  # 1/6 by hand
+    assert float(parabolic_peak_offset(1.0, 1.0, 1.0)) == 0.0  # flat: no peak
+    assert float(parabolic_peak_offset(2.0, 1.0, 3.0)) == 0.0  # bends up: no peak (negate for a minimum)
+    assert float(parabolic_peak_offset(-2.0, -1.0, -3.0)) == 0.5 * (-2.0 + 3.0) / (-2.0 + 2.0 - 3.0)

@@ -32,7 +32,7 @@ from functools import lru_cache
 import numpy as np
 
 from bionav.errors import UserError
-from bionav.geometry import TWO_PI
+from bionav.geometry import TWO_PI, parabolic_peak_offset
 
 
 def zernike_indices(order: int) -> np.ndarray:
@@ -119,8 +119,6 @@ def rotation_from_moments(moments_current: np.ndarray, moments_snapshot: np.ndar
     # |Zc - Zs e^{im a}|^2 = |Zc|^2 + |Zs|^2 - 2 Re(conj(Zc) Zs e^{im a}); maximise the last sum
     score = np.real(np.exp(1j * np.outer(alphas, m[keep])) @ (np.conj(zc) * zs))
     k = int(np.argmax(score))
-    y0, y1, y2 = score[(k - 1) % n_angles], score[k], score[(k + 1) % n_angles]
-    den = y0 - 2 * y1 + y2
-    frac = 0.5 * (y0 - y2) / den if den < 0 else 0.0
+    frac = float(parabolic_peak_offset(score[(k - 1) % n_angles], score[k], score[(k + 1) % n_angles]))
     delta = (k + frac) * TWO_PI / n_angles
     return float((delta + np.pi) % TWO_PI - np.pi)
