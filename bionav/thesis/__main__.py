@@ -153,8 +153,10 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         jobs = 4096 if "slurm" in (args.launcher or "") else 1
     else:
         jobs = usable_cpus()
+    from bionav.thesis.plan import task_cpu_s
+
     runner = Runner(out=out, launcher=launcher, dry_run=args.dry_run, echo=lambda s: print(s, flush=True),
-                    env=tool_env(), jobs=jobs)
+                    env=tool_env(), jobs=jobs, cost=lambda spec: task_cpu_s(spec).cpu_s)
     all_specs = [s for ss in specs.values() for s in ss]
     if args.report_only:
         from bionav.thesis.runs import RunResult, index_runs, read_json

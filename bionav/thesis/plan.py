@@ -210,7 +210,7 @@ def _grid_shape(db: str) -> tuple[int, int, str]:
     """``db``'s grid shape from its preset, or :data:`ASSUMED_GRID` with a note where the preset
     gives none (an estimate must never stop a run)."""
     from bionav.errors import UserError
-    from bionav.thesis.items import db_meta
+    from bionav.thesis.databases import db_meta
 
     try:
         shape = db_meta(db)["grid_shape"]

@@ -316,3 +316,45 @@ def build_uni(seed: int = 0) -> World:
     world.capture_scene = lambda i, j: relit_at(world.scene, light, i, j)
     world.info["capture_light"] = light.describe()
     return world
+
+
+def campus_world(sky, *, seed: int) -> World:
+    """The campus (:func:`build_campus`) in five bands under a spectral sky (:class:`bionav.light.daylight.SkyState`).
+
+    Per-kind albedos are the campus' default five-band albedos
+    (:func:`bionav.light.materials.band_albedos`: the reflectances of the
+    kinds' materials), the sun and the hemispherical ambient light from
+    :func:`bionav.light.daylight.illumination` (``E/pi``, so that pixel values are
+    band radiances in the unit of the sensor model), rays that hit nothing from
+    :func:`bionav.light.daylight.band_sky_radiance`.
+    """
+    from bionav.light.bands import CHANNELS, band_integrate
+    from bionav.light.daylight import band_sky_radiance, illumination
+
+    ill = illumination(sky)
+    e_dir = band_integrate(ill.direct_normal) / np.pi
+    e_dif = band_integrate(ill.diffuse_horizontal) / np.pi
+    world = build_campus(seed, channels=CHANNELS, sky=lambda d: band_sky_radiance(sky, d),
+                         sun_elevation=float(sky.sun_elevation), sun_azimuth=float(sky.sun_azimuth),
+                         sun_irradiance=e_dir, sky_irradiance=e_dif, exposure=1.0)
+    return world
+
+
+def render_campus_counts(world, geometry, cells, *, sensor_model, rng, progress=None):
+    """Five-channel sensor counts ``(N, H, W, 5)`` and true sky masks ``(N, H, W)`` of a :func:`campus_world`.
+
+    ``cells`` ``(N, 2)`` are grid cells (may be fractional: :meth:`World.cell_position`); each
+    panorama is rendered at heading 0 without clipping and read by ``sensor_model``
+    (``read(radiance, rng=rng)``) with ``rng``; ``progress`` wraps the loop.
+    """
+    from bionav.world.render import render_depth, render_panorama
+
+    counts, skies = [], []
+    it = cells if progress is None else progress(cells, desc="render", total=len(cells))
+    for i, j in it:
+        pos = world.cell_position(float(i), float(j))
+        rad = render_panorama(world.scene, position=pos, geometry=geometry, clip=False, exposure=1.0)
+        depth, _, _ = render_depth(world.scene, position=pos, geometry=geometry)
+        counts.append(sensor_model.read(np.asarray(rad, float), rng=rng)[0, ..., :5].astype(np.float32))
+        skies.append(~np.isfinite(depth))
+    return np.stack(counts), np.stack(skies)
