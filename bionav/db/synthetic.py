@@ -226,6 +226,7 @@ def _cache_params(name: str, seed: int, noise: float, geometry, world, positions
 def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
     """The camera and pose errors of ``realism="camera"`` (resolved), their keys added to ``params``."""
     from bionav.db.camera import resolve_pose_error
+    from bionav.world.worlds.common import OpenSky, Windows
 
     camera, pose_error = _camera_configs(spec, camera, pose_error, geometry)
     pose_error = resolve_pose_error(pose_error, world)  # tilt_sigma_deg=None: the world's floor
@@ -235,15 +236,16 @@ def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
         del pose_key["heading_drift_deg"]
     params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
                   pose_error=pose_key, native_size=list(spec.native_size))
-    if getattr(world, "daylight", None) is not None:  # the recording session (bionav.db.camera.capture_scenes)
-        params["daylight"] = world.daylight.describe()
-        params["windows"] = dataclasses.asdict(world.windows)
+    light, aperture = getattr(world, "capture_light", None), getattr(world, "aperture", None)
+    if light is not None and isinstance(aperture, Windows):  # the light of a recording session through windows
+        params["daylight"] = light.describe()
+        params["windows"] = dataclasses.asdict(aperture)
     if getattr(world, "supervisor", None) is not None:
         params["supervisor"] = dataclasses.asdict(world.supervisor)
     if getattr(world, "light_level", 1.0) != 1.0:  # a dim scene; 1 keeps the key of the other worlds
         params["light_level"] = float(world.light_level)
-    if "capture_light" in world.info:  # light changing during the capture (sim_uni)
-        params["capture_light"] = world.info["capture_light"]
+    if light is not None and isinstance(aperture, OpenSky):  # light changing during the capture outdoors (sim_uni)
+        params["capture_light"] = light.describe()
         params.pop("sky", None)  # each capture's sky is the capture light's, not the scene's
     return camera, pose_error
 

@@ -14,14 +14,15 @@ class CrossDb(Experiment):
     Config = CrossDbConfig
     plugin_groups = ("homing", "signature")
 
-    def run(self, ctx) -> dict[str, Any]:
-        from bionav.experiments.cross_db.run import run
-
-        return run(self.config, ctx)
-
     @staticmethod
     def merge(task_dirs, out) -> dict[str, Any]:
         """Join the tasks (``experiment.block=[i,n]``) of one split run into ``out`` (``python -m bionav.experiments.merge``)."""
         from bionav.experiments.cross_db.merge import merge
 
         return merge(task_dirs, out)
+
+    def run(self, ctx) -> dict[str, Any]:
+        """One run, or one task of a split run (``experiment.block=[i,n]``: ``cross_db.run.task_units``)."""
+        from bionav.experiments.cross_db.run import run
+
+        return run(self.config, ctx)

@@ -62,29 +62,21 @@ from bionav.evaluation.route_setup import route_renderer
 from bionav.evaluation.route_tests import SnapshotFollower, closed_loop, open_loop
 from bionav.experiments.common import make_homing
 from bionav.experiments.route_homing.config import RouteHomingConfig
-from bionav.experiments.route_homing.shared import (
-    PATH_SCHEMA,
-    PATH_TOPIC,
-    check_step_budget,
-    route_setup,
-    routes_file,
-    with_protocol_step,
-    write_rows,
-)
+from bionav.experiments.route_homing import shared
 from bionav.plugins.signatures.zernike import Zernike
 
 
 def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     """Run ``experiment=route_homing`` (``protocol=bionav``) with the checked ``exp`` (the rest in ``ctx.cfg``)."""
     cfg = ctx.cfg
-    exp = with_protocol_step(exp)
+    exp = shared.with_protocol_step(exp)
     routes = exp.routes or [str(cfg.db.route)]
     if exp.closed_loop:  # open-loop runs take no agent steps
-        check_step_budget(routes, exp, routes_file(cfg))
+        shared.check_step_budget(routes, exp, shared.routes_file(cfg))
     rows = []
     per_route = {}
     for name in routes:
-        setup = route_setup(cfg, name)
+        setup = shared.route_setup(cfg, name)
         homing = make_homing(cfg, ctx, setup.geometry) if "homing" in exp.methods else None
         zernike = Zernike({"order": exp.zernike_order}) if "zernike" in exp.methods else None
         per_route[name] = {"setup": setup, "results": {}}
@@ -110,9 +102,9 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
                     give_up_m=exp.give_up_m, lookahead=exp.lookahead)
                 row.update({"completed": bool(completed), "route_distance_m": dist, "steps": len(path) - 1})
                 res["path"] = path
-                ctx.log.write(PATH_TOPIC, {"route": name, "method": method, "xy": path.tolist(),
+                ctx.log.write(shared.PATH_TOPIC, {"route": name, "method": method, "xy": path.tolist(),
                                            "completed": bool(completed)},
-                              schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
+                              schema_name="bionav.RoutePath", schema=shared.PATH_SCHEMA)
             per_route[name]["results"][method] = res
             rows.append(row)
     _write_csv(ctx.dir / "route_homing.csv", rows)
@@ -139,5 +131,5 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
 
 
 def _write_csv(path, rows):
-    write_rows(path, rows, ["route", "method", "n_snapshots", "heading_error", "heading_error_on_route",
-                            "catchment_width_m", "invalid", "completed", "route_distance_m", "steps"])
+    shared.write_rows(path, rows, ["route", "method", "n_snapshots", "heading_error", "heading_error_on_route",
+                                   "catchment_width_m", "invalid", "completed", "route_distance_m", "steps"])

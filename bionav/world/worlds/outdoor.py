@@ -24,7 +24,7 @@ from bionav.light.simple_sky import SKY_GAIN, SUN_GAIN, SimpleSky
 from bionav.world import textures as tx
 from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.scene import Scene, SkyFunction
-from bionav.world.worlds.common import World, lane_order, stream
+from bionav.world.worlds.common import OpenSky, World, lane_order, stream
 from bionav.world.worlds.furniture import tree
 
 GRID_SHAPE = (10, 17)
@@ -113,15 +113,6 @@ def uni_capture_light(cells: np.ndarray, seed: int) -> CaptureLight:
     """
     return CaptureLight(order=capture_order(cells), clouds=campus_clouds(seed), site_deg=SITE_DEG,
                         start_utc=CAPTURE_START_UTC, seconds_per_capture=SECONDS_PER_CAPTURE)
-
-
-def relit_at(scene: Scene, light: CaptureLight, i: int, j: int) -> Scene:
-    """``scene`` relit as at cell ``(i, j)``'s capture (:meth:`Scene.relit`; ambient below 0.4 of above)."""
-    cond = light.conditions(i, j)
-    up = np.asarray(cond["sky_irradiance"], float)
-    return scene.relit(lights=[DirectionalLight(tuple(float(v) for v in cond["sun"]),
-                                                tuple(float(v) for v in cond["sun_irradiance"]))],
-                       ambient=Ambient(up=tuple(up), down=tuple(0.4 * up)), sky=cond["sky"])
 
 
 def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
@@ -305,16 +296,16 @@ def _campus_props(seed: int, scene: Scene, mat: Callable[..., int], glass: int) 
 def build_uni(seed: int = 0) -> World:
     """The *uni* stand-in: :func:`build_campus` (grey) plus the light changing while the grid was captured.
 
-    ``World.capture_scene(i, j)`` gives the scene as lit at cell ``(i, j)``'s
-    capture time (:func:`uni_capture_light`, :func:`relit_at`); the camera model
-    (``db.realism=camera``) renders each capture with it. ``world.scene``
+    The capture light (:func:`uni_capture_light`) enters through the whole sky
+    (:class:`~bionav.world.worlds.common.OpenSky`): :meth:`World.capture_scenes
+    <bionav.world.worlds.common.World.capture_scenes>` gives the scene as lit at each cell's
+    capture time, which the camera model (``db.realism=camera``) renders. ``world.scene``
     itself (used by ``db.realism=ideal``) is the campus of :func:`build_campus`
     unchanged.
     """
     world = build_campus(seed)
-    light = uni_capture_light(world.cells, seed)
-    world.capture_scene = lambda i, j: relit_at(world.scene, light, i, j)
-    world.info["capture_light"] = light.describe()
+    world.capture_light, world.aperture = uni_capture_light(world.cells, seed), OpenSky()
+    world.info["capture_light"] = world.capture_light.describe()
     return world
 
 
