@@ -184,7 +184,9 @@ def _experiment_schema(group: str, name: str) -> tuple[Any, str] | None:
     if entry is None or group == EXPERIMENT_NODES_GROUP:
         return None
     cls = registry.load_plugin("experiment", experiment)
-    schema = cls.Config if group == EXPERIMENT_SCHEMA_GROUP else dict(cls.group_configs).get(name)
+    if group == EXPERIMENT_SCHEMA_GROUP:  # with its registry name, as a preset sets experiment.name
+        return plugin_node_class(name, cls.Config), entry.distribution
+    schema = dict(cls.group_configs).get(name)
     return None if schema is None else (schema, entry.distribution)
 
 
@@ -204,7 +206,7 @@ def register_configs() -> None:
 def _schemas() -> dict[str, tuple[Any, str]]:
     """The typed schemas of ``bionav.schemas``: config path -> (dataclass or instance, provider).
 
-    Keys are ``db_schema``, ``hydra/launcher/submitit_slurm``, ...; :class:`PluginConfigSource`
+    Keys are ``db_schema`` and what registration functions store without a package; :class:`PluginConfigSource`
     serves them. Read once per process, also in a launcher's worker process (joblib, submitit,
     SLURM), where Hydra restores its plugins but no bionav code has run yet.
     """

@@ -19,7 +19,7 @@ from typing import Any, ClassVar, Mapping
 
 #: config groups that select plugins (the default of :attr:`Experiment.plugin_groups`: a run that does not
 #: say which it reads records every selected one in run.mcap)
-PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
+DEFAULT_PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
 
 
 class Experiment:
@@ -49,7 +49,7 @@ class Experiment:
     """
 
     Config: ClassVar[type]
-    plugin_groups: ClassVar[tuple[str, ...]] = PLUGIN_GROUPS
+    plugin_groups: ClassVar[tuple[str, ...]] = DEFAULT_PLUGIN_GROUPS
     group_configs: ClassVar[Mapping[str, type]] = {}
 
     def __init__(self, config: Any) -> None:

@@ -56,14 +56,14 @@ def used_plugin_groups(cfg: DictConfig) -> tuple[str, ...]:
     (:meth:`Experiment.used_plugin_groups <bionav.experiments.base.Experiment.used_plugin_groups>`).
     """
     from bionav.errors import PluginError
-    from bionav.experiments.base import PLUGIN_GROUPS
+    from bionav.experiments.base import DEFAULT_PLUGIN_GROUPS
     from bionav.experiments.settings import experiment_class
 
     node = cfg.get("experiment")
     try:
         cls = experiment_class(str(OmegaConf.select(cfg, "experiment.name", default="") or ""))
     except PluginError:
-        return PLUGIN_GROUPS
+        return DEFAULT_PLUGIN_GROUPS
     return tuple(cls.used_plugin_groups(node))
 
 

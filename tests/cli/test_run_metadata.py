@@ -4,7 +4,7 @@ import pytest
 
 from bionav import registry
 from bionav.config import compose
-from bionav.experiments.base import PLUGIN_GROUPS
+from bionav.experiments.base import DEFAULT_PLUGIN_GROUPS
 from bionav.experiments.runner import plugin_versions
 
 
@@ -15,7 +15,7 @@ def test_every_builtin_experiment_declares_its_plugin_groups():
     assert len(builtin) >= 10
     for name, cls in builtin.items():
         assert "plugin_groups" in vars(cls), name
-        assert set(cls.plugin_groups) <= set(PLUGIN_GROUPS), name
+        assert set(cls.plugin_groups) <= set(DEFAULT_PLUGIN_GROUPS), name
 
 
 @pytest.mark.parametrize("overrides, recorded", [

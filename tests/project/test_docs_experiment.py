@@ -53,7 +53,7 @@ def _run(python, root, args, **kwargs):
 def test_the_page_writes_out_a_whole_package():
     files = docs_packages()[PACKAGE]
     assert {"pyproject.toml", "bionav_catchment/__init__.py", "bionav_catchment/config.py", "bionav_catchment/run.py",
-            "bionav_catchment/plots.py"} <= set(files)
+            "bionav_catchment/plots.py", "bionav_catchment/conf/experiment/catchment_wide.yaml"} <= set(files)
     commands = _documented_commands()
     assert commands[0][:3] == ["pip", "install", "-e"] and commands[0][3] == PACKAGE
     assert any(c[:3] == ["python", "-m", "bionav"] and "-m" not in c[3:] for c in commands)
@@ -90,7 +90,8 @@ def test_an_installed_experiment_runs_sweeps_and_reports_with_no_edit_to_bionav(
         assert abs(mean_error - metrics["aae"]) < 1e-12  # the metric is the logged errors' mean
         plugins = read_metadata(run_dir / "run.mcap")["plugins"]
         assert set(plugins) == {"bionav", "homing"}  # plugin_groups: only the homing method it reads
-    assert json.loads((root / "runs" / "1" / "metrics.json").read_text())["n_views"] == 3 * 16
+    views = [json.loads((root / "runs" / str(k) / "metrics.json").read_text())["n_views"] for k in range(len(single))]
+    assert views == [3 * 8, 3 * 16, 3 * 12]  # the defaults, the page's overrides, the preset (catchment_wide)
 
     # a sweep over the page's values, then its table
     sweep_dir = root / "sweep"
