@@ -150,9 +150,9 @@ def test_the_command_self_calibrates_leaving_one_day_out(tmp_path):
 @pytest.mark.slow  # over 5 s on two cores
 @needs_data
 def test_a_real_daylight_session_self_calibrates():
+    from bionav.polcompass.recordings import load_sessions
     from bionav.polcompass.recordings_config import RecordingsConfig
     from bionav.polcompass.sessions import prepare_session
-    from bionav.polcompass.recordings import load_sessions
 
     sessions, _ = load_sessions(COMPASS / "tod_data" / "Thursday_12-05-22" / "17-01__Thursday_12-05-22")
     data = prepare_session(sessions[0], RecordingsConfig())
