@@ -166,7 +166,9 @@ def yaw_run_shifts(counts, yaw, valid, runs, *, n_bins: int = 360, max_shift_deg
     runs : ndarray of int, shape ``(N,)``
         Run of each sample, ``0 .. R-1``.
     n_bins : int
-        Ring bins over the full turn (a run should fill them: about 400 samples per turn fill 360).
+        Ring bins over the full turn at most (a run should fill them: about 400 samples per turn fill 360);
+        fewer where the shortest run has fewer samples than that, so that its ring has no gaps between bins
+        (a ring with gaps matches the first run's only at whole-bin shifts that happen to interleave).
     max_shift_deg : float
         Largest shift searched, degrees.
 
@@ -177,6 +179,8 @@ def yaw_run_shifts(counts, yaw, valid, runs, *, n_bins: int = 360, max_shift_deg
     """
     runs = np.asarray(runs, int)
     counts, yaw, valid = np.asarray(counts), np.asarray(yaw, float), np.asarray(valid, bool)
+    if runs.size:
+        n_bins = int(max(36, min(int(n_bins), int(np.min(np.bincount(runs)[np.unique(runs)])))))
 
     def ring(sel):
         with warnings.catch_warnings():
