@@ -30,12 +30,13 @@ def test_self_calibration_under_the_logged_yaw_rule_recovers_offsets_despite_res
     from bionav.polcompass.sessions import prepared_sessions, self_calibrate
 
     device, offset = _device(4, gain_sigma=0.0)  # polarizer offsets only: what the default parts calibrate
-    folder = tmp_path / "tod_data" / "Thursday_12-05-22" / "17-00__Thursday_12-05-22"
+    rec = tmp_path / "rec"
+    folder = rec / "tod_data" / "Thursday_12-05-22" / "17-00__Thursday_12-05-22"
     # four rotations; the third and fourth restart the logged yaw at zero with the robot turned 12 and 18 degrees
     # (the stitching searches up to 20 degrees, bionav.polcompass.array_calibration.yaw_run_shifts)
     write_model_session(folder, rotations=4, samples=240, restarts={2: 12.0, 3: 6.0}, blind_unit=None, noise=0.01,
                         array=device)
-    rc = recordings_config({"path": str(tmp_path), "reference": "session", "exclude_units": "none"})
+    rc = recordings_config({"path": str(rec), "reference": "session", "exclude_units": "none"})
     prepared, bad = prepared_sessions(rc)
     assert not bad and len(prepared) == 1 and prepared[0].period == "tod_daylight"
     data = prepared[0]
@@ -50,22 +51,26 @@ def test_self_calibration_under_the_logged_yaw_rule_recovers_offsets_despite_res
     # stated tolerance, as without restarts: polarizer offsets within 0.75 degrees (the device's spread is 3)
     assert np.max(err) < 0.75 < np.max(np.degrees(np.abs(offset[f])))
     # the fit does not depend on the scoring rule: the same under recordings.reference=stitched
-    rc_stitched = recordings_config({"path": str(tmp_path), "reference": "stitched", "exclude_units": "none"})
+    rc_stitched = recordings_config({"path": str(rec), "reference": "stitched", "exclude_units": "none"})
     (_day, other), = self_calibrate(prepared_sessions(rc_stitched)[0], rc_stitched).values()
     np.testing.assert_array_equal(other.angle_offset, est.angle_offset)
     # through the command, under the published rule with the calibration learned and applied (angles and mount
     # tilt): the stitched error stays that of the model sky, the logged one is the restarts' share, no more
-    out = tmp_path / "run"
-    proc = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path}", "recordings.calibration=auto",
-                      "recordings.reference=session", "recordings.calibration_transfer=all", "experiment.simulate=false",
-                      "experiment.compare=[sky_fit]", f"hydra.run.dir={out}", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
-    metrics = json.loads((out / "metrics.json").read_text())
+    metrics, _rows = _pol_run(tmp_path, rec, tmp_path / "run", "recordings.calibration=auto",
+                              "recordings.reference=session", "recordings.calibration_transfer=all")
     assert metrics["heading_mae_deg_stitched"] < 0.45  # 0.59 uncalibrated, 0.33 calibrated when written
     shifts = np.deg2rad([0.0, 0.0, 12.0, 18.0])  # one offset per session: the circular mean of the four turns
     c = np.angle(np.mean(np.exp(1j * shifts)))
     assert metrics["heading_mae_deg"] == metrics["heading_mae_deg_logged"]
     assert metrics["heading_mae_deg_logged"] == pytest.approx(np.degrees(np.mean(np.abs(shifts - c))), abs=0.5)
+
+
+def _pol_run(tmp_path, path, out, *overrides):
+    """``python -m bionav experiment=pol_recordings`` on ``path`` (``sky_fit`` alone, no simulation): metrics and rows."""
+    proc = run_bionav("experiment=pol_recordings", f"recordings.path={path}", *overrides, "experiment.simulate=false",
+                      "experiment.compare=[sky_fit]", f"hydra.run.dir={out}", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads((out / "metrics.json").read_text()), list(csv.DictReader(open(out / "sessions.csv")))
 
 
 def _canopy_session(root, *, n=90):
@@ -77,23 +82,14 @@ def _canopy_session(root, *, n=90):
 def test_a_canopy_folder_given_as_the_path_is_canopy_and_never_self_calibrates(tmp_path):
     rec = tmp_path / "rec"
     _canopy_session(rec)
-    out = tmp_path / "canopy"
-    proc = run_bionav("experiment=pol_recordings", f"recordings.path={rec / 'canopy_data'}", "recordings.calibration=auto",
-                      "experiment.simulate=false", "experiment.compare=[sky_fit]", f"hydra.run.dir={out}", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
-    rows = list(csv.DictReader(open(out / "sessions.csv")))
+    metrics, rows = _pol_run(tmp_path, rec / "canopy_data", tmp_path / "canopy", "recordings.calibration=auto")
     assert [(r["condition"], r["period"]) for r in rows] == [("canopy", "canopy")]
     assert rows[0]["calibration"].startswith("none")  # canopy skies never self-calibrate
-    metrics = json.loads((out / "metrics.json").read_text())
     assert "canopy_mae_deg_logged" in metrics and "tod_daylight_mae_deg" not in metrics
     assert metrics["canopy_mae_deg_stitched"] < 0.5  # the model sky, the restart repaired
     # one session folder given as the path: the folder above it names the condition
-    one = tmp_path / "one"
-    proc = run_bionav("experiment=pol_recordings",
-                      f"recordings.path={rec / 'canopy_data' / 'Sunday_15-05-22' / '17-05__Sunday_15-05-22'}",
-                      "experiment.simulate=false", "experiment.compare=[sky_fit]", f"hydra.run.dir={one}", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
-    assert [r["condition"] for r in csv.DictReader(open(one / "sessions.csv"))] == ["canopy"]
+    _m, rows = _pol_run(tmp_path, rec / "canopy_data" / "Sunday_15-05-22" / "17-05__Sunday_15-05-22", tmp_path / "one")
+    assert [r["condition"] for r in rows] == ["canopy"]
 
 
 @pytest.mark.slow
@@ -106,14 +102,11 @@ def test_a_session_whose_condition_cannot_be_told_is_reported_so_and_never_self_
     rec = tmp_path / "field" / "Thursday_12-05-22"
     write_model_session(rec / "17-00__Thursday_12-05-22", samples=90)
     out = tmp_path / "run"
-    proc = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path / 'field'}", "recordings.calibration=auto",
-                      "experiment.simulate=false", "experiment.compare=[sky_fit]", f"hydra.run.dir={out}", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
-    rows = list(csv.DictReader(open(out / "sessions.csv")))
+    metrics, rows = _pol_run(tmp_path, tmp_path / "field", out, "recordings.calibration=auto")
     assert [(r["condition"], r["period"]) for r in rows] == [("unknown", "unknown")]
     assert rows[0]["calibration"].startswith("none")
     assert not (out / "calibration.json").exists()
-    assert "unknown_mae_deg_logged" in json.loads((out / "metrics.json").read_text())
+    assert "unknown_mae_deg_logged" in metrics
     assert "| unknown |" in (out / "summary.md").read_text()
 
 
@@ -129,9 +122,7 @@ def test_a_calibration_file_from_other_days_is_applied_through_the_command(tmp_p
     write_model_session(test / "canopy_data" / "Sunday_15-05-22" / "17-05__Sunday_15-05-22", samples=120,
                         noise=0.005, array=device, seed=4)
     learn = tmp_path / "learn"
-    proc = run_bionav("experiment=pol_recordings", f"recordings.path={train}", "recordings.calibration=auto",
-                      "experiment.simulate=false", "experiment.compare=[sky_fit]", f"hydra.run.dir={learn}", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
+    _pol_run(tmp_path, train, learn, "recordings.calibration=auto")
     cal_file = learn / "calibration.json"
     saved = json.loads(cal_file.read_text())
     # the file states what it was learned on: the training days only, and its transfer rule per condition
@@ -140,12 +131,8 @@ def test_a_calibration_file_from_other_days_is_applied_through_the_command(tmp_p
     assert saved["transfer"]["conditions"]["canopy"]["parts"] == []  # no canopy day to show that a part helps there
     runs = {}
     for how in ("none", str(cal_file)):
-        out = tmp_path / ("file" if how != "none" else "none")
-        proc = run_bionav("experiment=pol_recordings", f"recordings.path={test}", f"recordings.calibration={how}",
-                          "experiment.simulate=false", "experiment.compare=[sky_fit]", f"hydra.run.dir={out}",
-                          cwd=tmp_path)
-        assert proc.returncode == 0, proc.stderr
-        runs[how] = (json.loads((out / "metrics.json").read_text()), list(csv.DictReader(open(out / "sessions.csv"))))
+        runs[how] = _pol_run(tmp_path, test, tmp_path / ("file" if how != "none" else "none"),
+                             f"recordings.calibration={how}")
     (none, _), (filed, rows) = runs["none"], runs[str(cal_file)]
     assert filed["calibration"] == "file"
     by_period = {r["period"]: r["calibration"] for r in rows}

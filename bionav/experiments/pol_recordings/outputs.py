@@ -13,7 +13,7 @@ def _cell(value):
     return f"{value:.4g}" if isinstance(value, float) else value
 
 
-def write_csv(path: Path, rows: list[dict]) -> None:
+def _write_rows(path: Path, rows: list[dict]) -> None:
     """Rows of dicts through the one CSV writer (columns in order of first appearance; empty file for no rows)."""
     from bionav.files import write_atomic, write_csv_atomic
 
@@ -76,9 +76,9 @@ def write_outputs(ctx, exp, tally, pooled_rows, chosen, reference: str) -> None:
     """Every file and plot of the run."""
     from bionav.experiments.pol_recordings import plots
 
-    write_csv(ctx.dir / "sessions.csv", tally.session_rows)
-    write_csv(ctx.dir / "pooled.csv", pooled_rows)
-    write_csv(ctx.dir / "faults.csv", tally.fault_rows)
+    _write_rows(ctx.dir / "sessions.csv", tally.session_rows)
+    _write_rows(ctx.dir / "pooled.csv", pooled_rows)
+    _write_rows(ctx.dir / "faults.csv", tally.fault_rows)
     (ctx.dir / "summary.md").write_text(summary_markdown(tally.session_rows, pooled_rows, tally.names,
                                                          reference=reference, rules=tally.rules))
     plot_dir = ctx.plots
