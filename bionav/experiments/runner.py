@@ -219,6 +219,8 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
             log.error("%s interrupted after %.1f s", name, metrics["wall_time_s"])
             raise KeyboardInterrupt from None
         full = disk_full_error(exc, run_dir)
+        if isinstance(exc, UserError):  # nothing logged yet: a refusal at start (the command line removes the run)
+            exc.refused_at_start = mcap is None or mcap.n_messages == 0
         metrics["status"] = "failed"
         metrics["error"] = str(full or exc) if isinstance(full or exc, UserError) else f"{type(exc).__name__}: {exc}"
         if full is None and not isinstance(exc, (UserError, KeyboardInterrupt)):
