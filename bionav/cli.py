@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import logging
 import os
-import signal
 import sys
 import tempfile
 from pathlib import Path
@@ -67,6 +66,10 @@ def _precheck(argv: list[str]) -> list[tuple[Path, bool]]:
             groups.setdefault(group, [])
     for override in overrides:
         key = override.key_or_group
+        if key.startswith("hydra/") and isinstance(override.value(), str):
+            from bionav.clihelp import check_hydra_option
+
+            check_hydra_option(key, override.value())
         if key in groups and not override.is_delete():
             values = override.value()
             candidates = values if isinstance(values, list) else [values]
@@ -407,11 +410,6 @@ def _sweep_failures() -> None:
           f"or pass bionav.fail_on_job_error=false to exit with status 0 anyway.", 1)
 
 
-def _terminate(signum, frame) -> None:  # noqa: ARG001
-    """SIGTERM (``kill``, a cluster's time limit) ends a run like Ctrl-C: results so far are kept."""
-    raise KeyboardInterrupt
-
-
 def _completion_query(hydra_main) -> None:
     """Hydra's answer to a completion query, without bionav's internal groups."""
     import contextlib
@@ -510,23 +508,9 @@ def _check_records(argv: list[str], output_dirs: list[tuple[Path, bool]], cfg) -
             _STATE["show"] = path
 
 
-def _end_on_termination_signals() -> None:
-    """SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does.
-
-    A signal the caller chose to ignore stays ignored (``nohup python -m bionav ...`` survives the hangup).
-    """
-    for name in ("SIGTERM", "SIGHUP"):
-        try:
-            sig = getattr(signal, name)
-            if signal.getsignal(sig) != signal.SIG_IGN:
-                signal.signal(sig, _terminate)
-        except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
-            pass
-
-
 def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
-    from bionav.cli_main import guard_closed_pipe
+    from bionav.cli_main import end_on_termination_signals, guard_closed_pipe
 
     guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -560,7 +544,7 @@ def main(argv: list[str] | None = None) -> None:
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    _end_on_termination_signals()
+    end_on_termination_signals()
     try:
         if completion and any(a.startswith("query=") for a in argv):
             _completion_query(hydra_main)

@@ -190,7 +190,9 @@ def show_finished(run_dir: Path) -> None:
     metrics = read_metrics(run_dir) or {}
     metrics["resumed"] = True
     print(format_metrics(metrics))
-    print(f"run directory: {run_dir.absolute()} (finished before: shown, nothing was run or rewritten)")
+    print("(bionav.resume=true: this run had finished with the same configuration; its results are shown, "
+          "nothing was run or rewritten)")
+    print(f"run directory: {run_dir.absolute()}")
 
 
 def point_latest(target: Path) -> None:

@@ -420,7 +420,7 @@ class Runner:
         _move_aside(run_dir)
         run_dir.parent.mkdir(parents=True, exist_ok=True)
         cmd = [sys.executable, "-m", "bionav.experiments.merge", str(run_dir), *(str(p.dir) for p in parts)]
-        proc = subprocess.run(cmd, capture_output=True, text=True, env=self.env)
+        proc = subprocess.run(cmd, capture_output=True, text=True, errors="replace", env=self.env)
         metrics = read_json(run_dir / "metrics.json")
         if proc.returncode != 0 or not metrics or metrics.get("status") != "completed":
             return RunResult(spec, None, None, f"merging its {len(parts)} tasks failed: "
