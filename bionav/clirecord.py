@@ -234,12 +234,14 @@ def forget_refused(run_dir: Path, *, existed: bool, job_log: str) -> bool:
     if not names <= _START_FILES | {job_log}:
         return False
     shutil.rmtree(run_dir, ignore_errors=True)
-    for parent in (run_dir.parent, run_dir.parent.parent):  # an empty date folder goes too
+    outputs = Path.cwd() / "outputs"
+    date = run_dir.absolute().parent
+    if date.parent == outputs:  # the default outputs/<date>/<time>: an empty date folder goes too
         try:
-            parent.rmdir()
+            date.rmdir()
         except OSError:
-            break
-    link = Path.cwd() / "outputs" / LATEST
+            pass
+    link = outputs / LATEST
     if link.is_symlink() and not link.exists():
         runs = sorted(p for p in (Path.cwd() / "outputs").glob("*/*") if p.is_dir() and not p.is_symlink())
         if runs:

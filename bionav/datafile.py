@@ -142,7 +142,7 @@ class FileFields:
     def __init__(self, data: Any, *, source: str, fix: str) -> None:
         self.source, self.fix = source, fix
         if not isinstance(data, Mapping):
-            self.fail("<top level>", f"is a {type(data).__name__}, not an object of named fields")
+            self.fail("<top level>", f"is a JSON {type(data).__name__}, not an object of named fields")
         self.data = data
 
     def fail(self, field: str, problem: str, allowed: str | None = None) -> None:

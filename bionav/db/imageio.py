@@ -151,7 +151,13 @@ def read_image(path: Path) -> np.ndarray:
     ImageReadError
         The file is empty, truncated or not decodable (the message says which).
     """
+    from bionav.datafile import MAX_BYTES
+
     try:
+        size = Path(path).stat().st_size
+        if size > MAX_BYTES["image"]:  # refused before it is read (a 1 GiB image would not fit anyway)
+            raise ImageReadError(f"it is {size / 2**20:.0f} MiB, more than the {MAX_BYTES['image'] // 2**20} MiB "
+                                 "an image may have")
         data = Path(path).read_bytes()
     except OSError as exc:
         raise ImageReadError(f"the file cannot be read ({exc.strerror or exc})") from None

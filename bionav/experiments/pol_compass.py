@@ -64,6 +64,9 @@ def counts_of(readings: list[dict]) -> np.ndarray:
     """ADC counts of recorded compass readings, shape ``(N, K)``."""
     return np.asarray([r["counts"] for r in readings], dtype=float)
 
+#: the readings experiment=pol_compass reads: the compass' counts per line, recorded POL-OP arrays, a replayed log
+SENSOR_READINGS = ("bionav.PolCompassReading", "bionav.PolOpArrayReading", "bionav.ReplayedReading")
+
 
 def summarize(errors, *, axial: bool, n: int) -> dict[str, Any]:
     """The contract's metrics from a :class:`~bionav.polcompass.HeadingErrors`."""
@@ -527,6 +530,12 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         nodes["pantilt"] = None  # the recorded robot turned itself; its yaw is the reference
 
     classes = {role: registry.load_plugin("sensor", node["name"]) for role, node in nodes.items() if node is not None}
+    kind = getattr(classes.get("sensor"), "schema_name", None)
+    if kind not in SENSOR_READINGS:  # refused before the session, not after a whole rotation
+        raise UserError(f"sensor={(nodes['sensor'] or {}).get('name')} gives {kind} readings, but experiment=pol_compass reads "
+                        f"{' or '.join(SENSOR_READINGS[:2])} (counts per POL-OP line or unit); choose sensor="
+                        "polcompass_sim, polcompass_serial, recording or replay, or a plugin giving such readings "
+                        "(docs/plugins.md, 'Sensors').")
     simulated = any(getattr(c, "simulated", False) for c in classes.values())
     fake_devices = exp.fake_devices
     needs_scene = simulated or fake_devices or exp.mode == "partial_sky"
