@@ -108,6 +108,17 @@ def ensure_numba_cache() -> str | None:
     return None
 
 
+def numba_cached(kernel: Any) -> bool:
+    """True when numba has compiled code of ``kernel`` (a dispatcher) in this process or in its on-disk cache.
+
+    A cheap look (no compiling): before a long loop, whether its first call will compile first.
+    """
+    if getattr(kernel, "signatures", None):
+        return True
+    index = getattr(getattr(getattr(kernel, "_cache", None), "_cache_file", None), "_index_path", None)
+    return bool(index) and os.path.exists(index)
+
+
 def check_cache_dir(value: str | os.PathLike) -> Path:
     """The cache folder ``value`` (``~`` expanded) once it is known to be usable; checked before any work.
 

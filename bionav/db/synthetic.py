@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable
@@ -41,6 +42,8 @@ from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.files import cache_key, default_cache_dir, write_atomic
 from bionav.geometry import PanoramaGeometry
+
+log = logging.getLogger(__name__)
 
 #: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
 NATIVE_SIZE = (561, 81)
@@ -375,6 +378,8 @@ def _cached_or_rendered(path: Path, key: str, params: dict, world, positions, ge
     """The 8-bit images from the cache file ``path``, or rendered and written there; and whether cached."""
     images_u8 = read_cached_images(path, key)
     cached = images_u8 is not None
+    if not cached:
+        _prepare_renderer(spec, world)
     if not cached and realism == "camera":
         from bionav.db.camera import camera_images
 
@@ -392,6 +397,16 @@ def _cached_or_rendered(path: Path, key: str, params: dict, world, positions, ge
         except OSError:
             pass  # a read-only cache is not fatal: the database is still returned
     return images_u8, cached
+
+
+def _prepare_renderer(spec, world) -> None:
+    """Say what the first render waits for, and compile before the progress bar starts (its ETA is then honest)."""
+    from bionav.world.render import prepare_renderer, renderer_compiled
+
+    if not renderer_compiled():
+        log.info("rendering %s (%d views) for the first time: compiling the renderer first (numba, once per "
+                 "installation and cached; about half a minute on 2 idle cores) ...", spec.name, spec.n_images)
+    prepare_renderer(world.scene)
 
 
 def _float_images(images_u8: np.ndarray) -> np.ndarray:

@@ -208,7 +208,13 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
             cfg=cfg,
             show_progress=show_progress,
         )
-        result = module.run(cfg, ctx)
+        from bionav.experiments.warmup import start_warmup, stop_warmup
+
+        warmup = start_warmup(cfg, used_groups=used_plugin_groups(cfg))  # compiles later kernels beside the run
+        try:
+            result = module.run(cfg, ctx)
+        finally:
+            stop_warmup(warmup)
         metrics.update(result or {})
         metrics["status"] = "completed"
     except BaseException as exc:
