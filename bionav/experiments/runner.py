@@ -176,7 +176,25 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
             metrics = read_metrics(run_dir) or {}
             metrics["resumed"] = True
             return metrics
+        if resume:
+            _keep_attempt(run_dir)
         return _run_locked(cfg, run_dir, show_progress=show_progress)
+
+
+def _keep_attempt(run_dir: Path) -> None:
+    """A resumed run that did not finish: its earlier attempt's metrics.json and run.mcap are kept, renamed
+    ``metrics.attempt-<n>.json`` and ``run.attempt-<n>.mcap``, before the run starts again (nothing recorded
+    is lost)."""
+    if not (run_dir / METRICS_FILE).exists() and not (run_dir / LOG_FILE).exists():
+        return
+    n = 1
+    while (run_dir / f"metrics.attempt-{n}.json").exists() or (run_dir / f"run.attempt-{n}.mcap").exists():
+        n += 1
+    for name, kept in ((METRICS_FILE, f"metrics.attempt-{n}.json"), (LOG_FILE, f"run.attempt-{n}.mcap")):
+        if (run_dir / name).exists():
+            os.replace(run_dir / name, run_dir / kept)
+    log.info("resume: the earlier attempt in %s is kept as metrics.attempt-%d.json and run.attempt-%d.mcap",
+             run_dir, n, n)
 
 
 def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[str, Any]:
