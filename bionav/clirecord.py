@@ -89,13 +89,16 @@ def check_job(run_dir: Path, cfg: Any, *, resume: bool) -> None:
 
 
 def _pairs(overrides: Sequence[str]) -> set[tuple[str, str]]:
-    """Canonical ``(key, value)`` of overrides, without Hydra's own keys and ``bionav.resume``."""
+    """Canonical ``(key, value)`` of overrides, without Hydra's own keys and the keys that do not change results
+    (:data:`bionav.runrecord.NEUTRAL_KEYS`)."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    from bionav.runrecord import NEUTRAL_KEYS
 
     out = set()
     for o in OverridesParser.create().parse_overrides([str(o) for o in overrides]):
         key = o.key_or_group
-        if key.startswith(("hydra.", "hydra/")) or key in ("hydra", "bionav.resume"):
+        if key.startswith(("hydra.", "hydra/")) or any(key == n or key.startswith(f"{n}.") for n in NEUTRAL_KEYS):
             continue
         out.add((key, str(o.get_value_element_as_str())))
     return out
@@ -163,9 +166,13 @@ def keep_record(cfg: Any, run_dir: Path, *, multirun: bool) -> None:
     resume = bool(OmegaConf.select(cfg, "bionav.resume", default=False))
     if hc.output_subdir is None:  # `python -m bionav` sets hydra.output_subdir=null: the record is bionav's
         if resume and has_record(run_dir):
-            check_job(run_dir, cfg, resume=True)
             if read_status(run_dir) == "completed":
                 _detach_file_logs(run_dir)
+            try:
+                check_job(run_dir, cfg, resume=True)
+            except UserError:
+                _detach_file_logs(run_dir)  # another run's directory: not even its log is written to
+                raise
         else:
             write_record(run_dir, cfg, HydraConfig.instance().cfg, list(hc.overrides.task))
     point_latest(Path(str(hc.sweep.dir)) if multirun else run_dir)

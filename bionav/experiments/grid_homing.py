@@ -9,11 +9,12 @@ joins the tasks into the unsplit run's files (``python -m bionav.experiments.mer
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
 from bionav.evaluation.agent import evaluate_agents
@@ -26,6 +27,8 @@ from bionav.experiments.tasks import block_of, check_blocks, finish_merge, merge
 from bionav.files import write_csv_atomic
 from bionav.logs.reader import read_attachment, read_messages
 from bionav.logs.writer import McapLog
+
+log = logging.getLogger(__name__)
 
 HOME_VECTOR_SCHEMA = {
     "type": "object",
@@ -164,10 +167,15 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         snapshots = block_of(exp.block, range(len(db)) if snapshots is None else snapshots)
 
     log_row, log_partial = _row_loggers(ctx, db)
+    wanted = list(range(len(db))) if snapshots is None else [int(v) for v in snapshots]
+    done = _resumed_rows(ctx, cfg, db, wanted)
+    for si in (si for si in wanted if si in done):  # the new log holds every row, the earlier attempt's too
+        log_row(si, *done[si])
     hv = home_vector_matrix(
-        method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
-        cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial,
+        method, db, snapshot_index=[si for si in wanted if si not in done], workers=int(cfg.workers),
+        progress=ctx.progress, cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial,
     )
+    hv = _with_resumed_rows(hv, done, wanted)
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
     n_plots = min(exp.n_quiver_plots, len(hv.snapshot_index))
@@ -190,6 +198,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         "n_pairs": hv.n_pairs,
         "ms_per_home_vector": hv.ms_per_home_vector,
     }
+    if done:  # rows of the earlier attempt: their pairs count, the time per home vector is this attempt's
+        metrics.update(n_pairs=hv.n_pairs + len(done) * (len(db) - 1), resumed_rows=len(done))
     if exp.block is not None:
         metrics["block"] = [int(v) for v in exp.block]
     metrics.update({f"{k}_per_image": v for k, v in hv.prepared_stats.items()})
@@ -206,6 +216,52 @@ _TASK_SHARED = ("experiment", "homing", "db", "n_images")
 
 def _floats(values: Sequence[Any]) -> np.ndarray:
     return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
+
+
+def _resumed_rows(ctx, cfg, db, wanted: list[int]) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """With ``bionav.resume=true``: the snapshot rows an earlier attempt of this run logged (angles, compass error).
+
+    The runner kept that attempt's log as ``run.attempt-<n>.mcap`` (the newest counts); its complete
+    ``/grid_homing/snapshot_rows`` messages are read, also from a log a SIGKILL cut off. One row is always
+    left to compute (its per-image work gives the timing and the per-image statistics).
+    """
+    import re
+
+    from bionav.logs.reader import read_recorded_messages
+
+    if not bool(OmegaConf.select(cfg, "bionav.resume", default=False)):
+        return {}
+    attempts = sorted(ctx.dir.glob("run.attempt-*.mcap"), key=lambda p: int(re.sub(r"\D", "", p.name) or 0))
+    if not attempts:
+        return {}
+    cell = {tuple(p): i for i, p in enumerate(np.asarray(db.positions).tolist())}
+    rows = {}
+    for _topic, msg in read_recorded_messages(attempts[-1], ["/grid_homing/snapshot_rows"]):
+        si = cell.get(tuple(msg.get("snapshot") or ()))
+        angles = _floats(msg.get("angles") or [])
+        if si in wanted and angles.shape == (len(db),):
+            compass = msg.get("compass_error")
+            rows[si] = (angles, _floats(compass) if compass and len(compass) == len(db) else np.full(len(db), np.nan))
+    if len(rows) == len(wanted):  # every row was logged: the last one is computed again (timing, statistics)
+        rows.pop(wanted[-1])
+    if rows:
+        log.info("resume: %d of %d snapshot rows come from the earlier attempt (%s); computing the other %d",
+                 len(rows), len(wanted), attempts[-1].name, len(wanted) - len(rows))
+    return rows
+
+
+def _with_resumed_rows(hv, done: dict, wanted: list[int]):
+    """``hv`` (the rows computed now) with the resumed rows ``done``, in the order of ``wanted``."""
+    import dataclasses
+
+    if not done:
+        return hv
+    new = {int(si): k for k, si in enumerate(hv.snapshot_index)}
+    angles = np.stack([hv.angles[new[si]] if si in new else done[si][0] for si in wanted])
+    compass = None if hv.compass_error is None else np.stack(
+        [hv.compass_error[new[si]] if si in new else done[si][1] for si in wanted])
+    return dataclasses.replace(hv, snapshot_index=np.asarray(wanted, dtype=np.int64), angles=angles,
+                               compass_error=compass)
 
 
 def merge(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:

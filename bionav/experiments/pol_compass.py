@@ -517,6 +517,10 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     exp = experiment_config(cfg, "pol_compass")
     if cfg.get("sensor") is None or not cfg.sensor.get("name"):
         raise UserError("experiment=pol_compass needs a compass: sensor=polcompass_sim, polcompass_serial or replay.")
+    if exp.calibration == "file" and exp.calibration_path:  # a bad file is refused before the session, not after it
+        from bionav.polcompass import UnitCalibration
+
+        UnitCalibration.load(exp.calibration_path, units=len(exp.unit_angles_deg))
     nodes = {
         "sensor": _node_dict(cfg.sensor),
         "pantilt": _node_dict(cfg.get("pantilt")) if cfg.get("pantilt") and cfg.pantilt.get("name") else None,

@@ -49,6 +49,7 @@ along each route, heading-error maps).
 
 from __future__ import annotations
 
+import logging
 import math
 import zlib
 from dataclasses import dataclass
@@ -61,6 +62,8 @@ from bionav.errors import UserError
 from bionav.experiments.configs import RouteHomingConfig, experiment_config
 from bionav.files import write_csv_atomic
 from bionav.geometry import angular_difference, wrap_angle
+
+log = logging.getLogger(__name__)
 
 #: the agent's step of each protocol when ``experiment.agent_step_m`` is null, metres
 PROTOCOL_STEP_M = {"bionav": 0.05, "ardin2016": 0.1}
@@ -196,8 +199,11 @@ def open_loop(f: _Follower, render, exp: RouteHomingConfig, progress=None):
     return stations, err, est
 
 
-def closed_loop(f: _Follower, render, exp: RouteHomingConfig):
-    """Simulated agent from the displaced start; returns ``(path (T, 2), completed, mean distance)``."""
+def closed_loop(f: _Follower, render, exp: RouteHomingConfig, progress=None):
+    """Simulated agent from the displaced start; returns ``(path (T, 2), completed, mean distance)``.
+
+    ``progress(iterable, total=...)`` shows the steps (at most ``max_steps``; the bar ends when the agent does).
+    """
     from bionav.evaluation.route import distance_to_route, lateral_normals
 
     s = f.s
@@ -209,7 +215,7 @@ def closed_loop(f: _Follower, render, exp: RouteHomingConfig):
     k_last = 0
     heading = float(s.heading[0])
     completed = False
-    for _ in range(max_steps):
+    for _ in (progress or (lambda it, **_: it))(range(max_steps), total=max_steps):
         if f.method == "perfect_memory":
             heading, k_last = f.ridf_heading(render(pos, 0.0))
         elif f.method == "zernike":
@@ -301,6 +307,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
     rows = []
     per_route = {}
     for name in routes:
+        log.info("route %s: loading its world and route views (rendered once, then cached) ...", name)
         setup = _setup_route(cfg, name)
         homing = make_homing(cfg, ctx, setup.geometry) if "homing" in exp.methods else None
         per_route[name] = {"setup": setup, "results": {}}
@@ -320,7 +327,8 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                    "catchment_width_m": float(width.mean()), "invalid": int(np.isnan(err).sum())}
             res = {"stations": stations, "err": err, "est": est}
             if exp.closed_loop:
-                path, completed, dist = closed_loop(f, render, exp)
+                path, completed, dist = closed_loop(f, render, exp, progress=lambda it, n=name, m=method, **kw:
+                                                    ctx.progress(it, desc=f"{n} {m} closed loop (steps)", **kw))
                 row.update({"completed": bool(completed), "route_distance_m": dist, "steps": len(path) - 1})
                 res["path"] = path
                 ctx.log.write(PATH_TOPIC, {"route": name, "method": method, "xy": path.tolist(),

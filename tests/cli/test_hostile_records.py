@@ -288,3 +288,41 @@ def test_a_hydra_plugin_that_is_not_installed_names_its_install_line(tmp_path, g
     assert_fails_cleanly(proc, f"{group}={value} is not installed", install, code=2, max_seconds=REFUSAL_S,
                          absent=("Could not find", "Config search path"))
     assert not (tmp_path / "multirun").exists()
+
+
+def test_an_interrupted_single_run_continues_from_its_last_logged_row(finished, tiny, tmp_path):
+    """``bionav.resume=true`` into a run that stopped after some snapshot rows: those rows are read from its log
+    (kept as ``run.attempt-1.mcap``), only the others are computed, and the measures are the uninterrupted run's."""
+    import shutil
+
+    from bionav.logs.reader import read_recorded_messages
+    from bionav.logs.writer import McapLog
+
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished, run_dir)
+    rows = read_recorded_messages(run_dir / "run.mcap", ["/grid_homing/snapshot_rows"])
+    assert len(rows) == 9
+    with McapLog(run_dir / "run.mcap") as log:  # what a SIGKILL after five rows leaves (rows are logged as computed)
+        for topic, msg in rows[:5]:
+            log.write(topic, msg, schema_name="bionav.HomeVectorRow")
+    (run_dir / "metrics.json").write_text(json.dumps({"experiment": "grid_homing", "status": "running", "pid": 2**22}))
+    proc = run_tiny(tiny, f"hydra.run.dir={run_dir}", "bionav.resume=true", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "5 of 9 snapshot rows come from the earlier attempt" in proc.stdout + proc.stderr
+    resumed = json.loads((run_dir / "metrics.json").read_text())
+    full = json.loads((finished / "metrics.json").read_text())
+    assert resumed["resumed_rows"] == 5 and resumed["status"] == "completed"
+    assert {k: resumed[k] for k in ("aae", "mae", "rr", "n_pairs")} == {k: full[k] for k in ("aae", "mae", "rr", "n_pairs")}
+    assert (run_dir / "run.attempt-1.mcap").is_file() and (run_dir / "metrics.attempt-1.json").is_file()
+    assert len(read_recorded_messages(run_dir / "run.mcap", ["/grid_homing/snapshot_rows"])) == 9
+
+
+def test_the_table_names_the_thesis_measures_with_units_and_outputs_latest_points_at_the_run(tiny, tmp_path):
+    proc = run_tiny(tiny, cwd=tmp_path)  # the default run directory outputs/<date>/<time>
+    assert proc.returncode == 0, proc.stderr
+    for row in ("| AAE* (rad) |", "| MAE* (rad) |", "| RR* (fraction of agents home) |", "| metric | value | metrics.json |"):
+        assert row in proc.stdout, proc.stdout
+    run_dir = Path(proc.stdout.strip().splitlines()[-1].removeprefix("run directory: "))
+    latest = tmp_path / "outputs" / "latest"
+    assert latest.is_symlink() and latest.resolve() == run_dir.resolve()
+    assert (latest / "metrics.json").is_file() and (latest / "plots" / "per_snapshot.png").is_file()
