@@ -16,19 +16,8 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers import REPO, assert_fails_cleanly, run_bionav, source_copy, write_tiny_folder
+from helpers import REFUSAL_S, REPO, assert_fails_cleanly, run_bionav, run_tiny, source_copy
 
-#: a refusal comes before any work: Python, Hydra and the config composition only (a loaded 2-core machine)
-REFUSAL_S = 120
-
-
-@pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    return write_tiny_folder(tmp_path_factory.mktemp("db") / "tiny")
-
-
-def run_tiny(tiny, *args, cwd, env=None):
-    return run_bionav("homing=mfdid", "db=folder", f"db.path={tiny}", *args, cwd=cwd, env=env)
 
 
 def snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
