@@ -504,7 +504,7 @@ def _check_records(argv: list[str], output_dirs: list[tuple[Path, bool]], cfg) -
             check_sweep_dir(path, _override_words(argv), _STATE.get("sweeper_params"), resume=resume)
             continue
         _STATE["run_dir_existed"] = existed
-        if cfg is not None and check_run_dir(path, cfg, resume=resume):
+        if check_run_dir(path, cfg, resume=resume):
             _STATE["show"] = path
 
 

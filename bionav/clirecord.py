@@ -46,6 +46,8 @@ def _refuse_other(path: Path, diffs, *, key: str) -> UserError:
 def check_run_dir(path: Path, cfg: Any, *, resume: bool) -> bool:
     """Check a single run's directory before Hydra starts; True when it holds this finished run (show it).
 
+    ``cfg`` is the composed configuration (None when the command line was not composed here).
+
     Raises
     ------
     UserError
@@ -61,6 +63,8 @@ def check_run_dir(path: Path, cfg: Any, *, resume: bool) -> bool:
                 f"the run directory {path} holds a finished run (metrics.json says completed); a new run there "
                 f"would overwrite it. Choose another directory with hydra.run.dir=..., or add bionav.resume=true to "
                 f"keep it and show its results.")
+        return False
+    if cfg is None:  # not composed here (e.g. --config-dir): the job compares it (check_job)
         return False
     recorded = recorded_config(path)
     if recorded is None:

@@ -50,7 +50,8 @@ def test_per_snapshot_maps_have_whole_cell_ticks_and_named_axes(tmp_path, figure
     for ax in [*maps.axes[:2], field.axes[0]]:  # maps: two heatmaps, then their colour bars
         assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (grid cells)", "y (grid cells)")
         _whole_cell_ticks(ax)
-    assert [c.get_ylabel() for c in maps.axes[2:]] == ["AAE$_s$ (rad)", "RR$_s$"]
+    # AAE_s is capped at pi/2: its colour bar says what the overflow colour means (issue 45)
+    assert [c.get_ylabel() for c in maps.axes[2:]] == ["AAE$_s$ (rad), cyan > 1.57", "RR$_s$"]
 
 
 def test_world_routes_legend_names_every_line_and_the_title_matches(tmp_path, figures):
