@@ -68,9 +68,7 @@ def capped_colormap(name: str, *, over: str = OVER_COLOUR):
     """
     import matplotlib
 
-    cmap = matplotlib.colormaps[name].copy()
-    cmap.set_over(over)
-    return cmap
+    return matplotlib.colormaps[name].with_extremes(over=over)
 
 
 def capped_colorbar(fig, image, *, ax, label: str, **kwargs):

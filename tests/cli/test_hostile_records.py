@@ -75,6 +75,8 @@ def test_a_resumed_sweep_keeps_finished_jobs_and_refuses_another_sweep(tiny, tmp
     args = ("-m", "homing=mfdid,hiss", "db=folder", f"db.path={tiny}", f"hydra.sweep.dir={sweep}")
     proc = run_bionav(*args, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
+    # the sweep's figure: AAE* and RR* over the swept values, linked from summary.md
+    assert (sweep / "summary.png").stat().st_size > 0 and "](summary.png)" in (sweep / "summary.md").read_text()
     jobs = {job: snapshot(sweep / job) for job in ("0", "1")}
     proc = run_bionav(*args, "bionav.resume=true", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
