@@ -246,17 +246,18 @@ def forget_refused(run_dir: Path, *, existed: bool, job_log: str) -> bool:
         return False
     shutil.rmtree(run_dir, ignore_errors=True)
     outputs = Path.cwd() / "outputs"
-    date = run_dir.absolute().parent
-    if date.parent == outputs:  # the default outputs/<date>/<time>: an empty date folder goes too
-        try:
-            date.rmdir()
-        except OSError:
-            pass
     link = outputs / LATEST
-    if link.is_symlink() and not link.exists():
-        runs = sorted(p for p in (Path.cwd() / "outputs").glob("*/*") if p.is_dir() and not p.is_symlink())
+    if link.is_symlink() and not link.exists():  # it pointed here: back to the newest run left, if any
+        runs = sorted(p for p in outputs.glob("*/*") if p.is_dir() and not p.is_symlink())
         if runs:
             point_latest(runs[-1])
         else:
             link.unlink(missing_ok=True)
+    date = run_dir.absolute().parent
+    if date.parent == outputs:  # the default outputs/<date>/<time>: an empty date folder (and outputs/) goes too
+        for folder in (date, outputs):
+            try:
+                folder.rmdir()
+            except OSError:
+                break
     return True

@@ -247,6 +247,9 @@ def read_json_file(path: str | Path, *, what: str, fix: str, max_bytes: int = 25
         return json.loads(text, parse_int=_bounded_int)
     except ValueError as exc:
         raise UserError(f"{what} {path} is not valid JSON ({exc}). {fix}") from None
+    except RecursionError:  # "[[[[...": deeper than any data file bionav reads
+        raise UserError(f"{what} {path} nests lists or objects thousands of levels deep; no data file of bionav "
+                        f"does. {fix}") from None
 
 
 def cache_key(payload: Any, *arrays: np.ndarray) -> str:

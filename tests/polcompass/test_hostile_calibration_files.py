@@ -28,6 +28,7 @@ COMPASS_CASES = {
     "volts_beyond_the_rails": (json.dumps({**NOMINAL, "center_v": [2.5, 7.0, 2.5]}), ["field 'center_v' holds 7 at [1]"]),
     "text": (json.dumps({**NOMINAL, "center_v": "2.5"}), ["field 'center_v'"]),
     "list": ("[1, 2, 3]", ["is a JSON list, not an object"]),
+    "nested_deeply": ("[" * 100_000 + "]" * 100_000, ["nests lists or objects thousands of levels deep"]),
     "gigabytes": ("sparse", ["is 3 GiB, more than the 16 MiB"]),
     "dev_zero": ("/dev/zero", ["is a device, not a file"]),
 }
@@ -51,9 +52,9 @@ def test_a_bad_compass_calibration_file_is_refused_before_the_session(tmp_path, 
     text, needles = COMPASS_CASES[case]
     path = _file(tmp_path, text)
     proc = run_bionav("experiment=pol_compass", "mode=rotation", "experiment.calibration=file",
-                      f"experiment.calibration_path={path}", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+                      f"experiment.calibration_path={path}", cwd=tmp_path)  # into the default outputs/<date>/<time>
     assert_fails_cleanly(proc, path, *needles, code=2, max_seconds=120)
-    assert not (tmp_path / "run").exists()
+    assert not (tmp_path / "outputs").exists()  # no run directory, no empty outputs/ either
 
 
 def _array(**change) -> str:
