@@ -71,6 +71,12 @@ def run(argv: list[str]) -> int:
         parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     args.overrides = list(args.overrides) + extra
     composed = compose_database(args.db, args.overrides)
+    if args.command == "export" and args.resume:  # nothing to continue: said before the database loads
+        from bionav.db.export import SIDECAR
+
+        if not (user_path(args.dir) / SIDECAR).is_file():
+            raise UserError(f"--resume: {args.dir} holds no export of bionav to continue (no {SIDECAR}); export "
+                            "without --resume (into an empty folder, or with --force).")
     if args.command == "camera":
         return _camera(args, composed)
     db = load_database(composed.db, data_dir=composed.data_dir, cache_dir=composed.cache_dir)
