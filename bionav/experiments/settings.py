@@ -20,6 +20,7 @@ with zone.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass
 from typing import Any
@@ -142,8 +143,6 @@ def experiment_config(cfg: DictConfig) -> Any:
     node = cfg.get("experiment") if isinstance(cfg, DictConfig) else None
     if node is None:
         return None
-    import dataclasses
-
     name = str(node.get("name") or "")
     schema = experiment_class(name).Config
     root = cfg if "seed" in cfg else OmegaConf.merge(OmegaConf.create({"seed": 0}), cfg)
