@@ -10,7 +10,7 @@ Two kinds of rows (``"table"``):
   against the size before (min-warping's distances grow as ``W^2 H``, i.e. pixels^1.5 at a fixed
   aspect ratio). The warping methods keep ``--steps`` search steps at every size.
 * ``runs``: the whole command ``python -m bionav experiment=grid_homing homing=M db=DB`` (``--db``,
-  render cache as it is) with 1 snapshot and with ``--scaling-snapshots`` snapshots, for min-warping
+  ``--override KEY=VALUE`` added, render cache as it is) with 1 snapshot and with ``--scaling-snapshots`` snapshots, for min-warping
   and SIFT: CPU seconds of the process (``RUSAGE_CHILDREN``), home vectors, and the line through both
   points: ``cpu_ms_per_home_vector`` (its slope) and ``fixed_cpu_s`` (its intercept: start-up, the
   database, per-image work, agents and plots: what a run costs before its first home vector).
@@ -114,7 +114,7 @@ def run_scaling_rows(args) -> list[dict]:
             for k in (1, args.scaling_snapshots):
                 snaps = ",".join(str(i) for i in range(k))
                 command = ["experiment=grid_homing", f"homing={name}", f"db={args.db}", f"experiment.snapshots=[{snaps}]",
-                           "workers=1", f"hydra.run.dir={tmp / f'{name}{k}'}"]
+                           "workers=1", f"hydra.run.dir={tmp / f'{name}{k}'}", *args.override]
                 wall, cpu = _run(command, cwd=tmp, env=dict(os.environ))
                 points.append((_home_vectors(tmp / f"{name}{k}"), cpu, wall))
             (h1, c1, _), (h2, c2, w2) = points

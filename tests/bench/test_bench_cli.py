@@ -140,3 +140,32 @@ def test_bench_sweep_with_more_workers_than_cpus(tmp_path):
     assert row["workers"] == cpus + 2
     assert row["workers_used"] == [min(4, cpus)]  # 2 sizes x 2 preprocessings = 4 tasks
     assert row["configurations"] == 2 * 2 * 1  # [mean] at one ring count, per size and preprocessing
+
+
+def test_bench_scaling_prints_growth_and_fixed_cost_per_run(capsys, tmp_path):
+    """--method scaling (issue 42): CPU per home vector against the image size for every method (with the
+    growth exponent), and whole runs with 1 and N snapshots (slope and fixed part)."""
+    from helpers import write_tiny_folder
+
+    folder = write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
+    assert main(["--json", "--method", "scaling", "--scaling-sizes", "32x8,64x16", "--steps", "8", "--repeat", "1",
+                 "--batch", "1", "--db", "folder", "--override", f"db.path={folder}", "--scaling-snapshots", "2"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    pairs = [r for r in rows if r["table"] == "pairs"]
+    assert {r["method"] for r in pairs} == {"minwarping", "warping2d", "warping1d", "hiss", "sift"}
+    for r in pairs:
+        assert r["cpu_ms_min"] > 0 and r["pixels"] in (32 * 8, 64 * 16)
+        assert ("growth_exponent" in r) == (r["image"] == "64x16")
+    runs = {r["method"]: r for r in rows if r["table"] == "runs"}
+    assert set(runs) == {"minwarping", "sift"}
+    for r in runs.values():
+        assert r["home_vectors"] == [8, 16] and r["cpu_s"][1] > 0  # 9 cells: 8 other cells per snapshot
+        slope = (r["cpu_s"][1] - r["cpu_s"][0]) / 8
+        assert r["cpu_ms_per_home_vector"] == pytest.approx(1e3 * slope, abs=2.0)  # cpu_s rounded to 10 ms
+        assert r["fixed_cpu_s"] == pytest.approx(r["cpu_s"][0] - 8 * slope, abs=0.05)
+
+
+def test_bench_scaling_rejects_bad_sizes(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--method", "scaling", "--scaling-sizes", "288x50,abc"])
+    assert exc.value.code == 2 and "--scaling-sizes" in capsys.readouterr().err
