@@ -205,13 +205,16 @@ def diagonal_distances_u8(sq, cq2, sn, cn2, step, quantum, out, acc):
                 s1 = zero_i16()
                 s2 = zero_i16()
                 s3 = zero_i16()
-                for r in range(n_rows):
-                    x = load_i16(sqf, sbase + r * width + i)
-                    cb = cbase + r * w2 + d + i
+                xo = sbase + i  # running offsets of the two rows (no multiplication per row)
+                cb = cbase + d + i
+                for _ in range(n_rows):
+                    x = load_i16(sqf, xo)
                     s0 = add_absdiff_i16(s0, x, load_i16(cqf, cb))
                     s1 = add_absdiff_i16(s1, x, load_i16(cqf, cb + 1))
                     s2 = add_absdiff_i16(s2, x, load_i16(cqf, cb + 2))
                     s3 = add_absdiff_i16(s3, x, load_i16(cqf, cb + 3))
+                    xo += width
+                    cb += w2
                 ab = d * width + i
                 store_i16(accf, ab, s0)
                 store_i16(accf, ab + width, s1)
