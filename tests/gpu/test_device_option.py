@@ -32,3 +32,17 @@ def test_device_cuda_refuses_a_method_the_gpu_does_not_compute():
     check_method("minwarping")
     with pytest.raises(UserError, match="device=cuda computes homing=minwarping, warping2d, sift"):
         check_method("mfdid")
+
+
+def test_gpu_bench_script_is_valid_bash_and_stops_without_a_gpu(tmp_path):
+    """scripts/gpu-bench.sh (run on a GPU machine by a later session): parses, and says why it stops here."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[2] / "scripts" / "gpu-bench.sh"
+    assert subprocess.run(["bash", "-n", str(script)], capture_output=True).returncode == 0
+    if shutil.which("nvidia-smi"):
+        pytest.skip("an NVIDIA driver is installed here: the script would run")
+    proc = subprocess.run(["bash", str(script), str(tmp_path / "out")], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 3 and "needs an NVIDIA GPU" in proc.stderr

@@ -12,7 +12,8 @@ import os
 import numpy as np
 import pytest
 
-os.environ["NUMBA_ENABLE_CUDASIM"] = "1"  # before numba.cuda is imported (numba's config is read again)
+if os.environ.get("BIONAV_GPU_DEVICE_TESTS") != "1":  # scripts/gpu-bench.sh runs them on the GPU itself
+    os.environ["NUMBA_ENABLE_CUDASIM"] = "1"  # before numba.cuda is imported (numba's config is read again)
 from numba.core import config as _numba_config  # noqa: E402
 
 _numba_config.reload_config()
