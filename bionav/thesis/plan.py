@@ -11,7 +11,8 @@ time on one core of the reference machine (:data:`bionav.thesis.calibration.REFE
 * grid homing and the cross-database test: home vectors x the method's CPU ms per home vector
   (:data:`HOME_VECTOR_MS`, measured with ``python -m bionav.bench``, scaled with the image's pixels
   where the method works on the database's own size; SIFT by its keypoints, :func:`sift_costs`),
-  plus rendering its databases once (:data:`RENDER_S_PER_MPX`); a task of a split run holds every
+  plus loading its databases (:data:`DB_LOAD_S_PER_MPX`) and rendering them once
+  (:data:`RENDER_S_PER_IMAGE`, :data:`RENDER_S_PER_MPX`); a task of a split run holds every
   n-th snapshot (or (snapshot, database pair) unit) from the i-th, exactly as the experiment splits;
 * the parameter sweep: its jobs x the CPU of one job (:data:`RUN_CPU_S`);
 * every other experiment: the CPU of one run (:data:`RUN_CPU_S`), measured or assumed as the
@@ -41,55 +42,66 @@ from bionav.thesis.runs import RunSpec
 #: when the method resizes to its own size, basis)); "measured" figures are the minimum CPU time over the
 #: rounds of ``python -m bionav.bench`` (native code), which other processes change little
 HOME_VECTOR_MS: dict[str, tuple[float, int | None, str]] = {
-    "minwarping": (3.0, None, "measured 2026-11-28: python -m bionav.bench --method minwarping, single search at "
-                              "288x50, 96x96 steps, CPU ms per home vector (minimum over the rounds)"),
-    "minwarping_cleaning": (3.0, None, "as minwarping"),
-    "warping2d": (16.7, None, "measured 2026-11-28: python -m bionav.bench --method warping2d, single search "
-                              "at 288x50 (minimum over the rounds)"),
-    "warping1d": (23.6, None, "measured 2026-11-28: python -m bionav.bench --method warping1d"),
-    "hiss": (1.0, None, "measured 2026-11-28: python -m bionav.bench --method hiss"),
-    "minwarping_thesis": (28.0, None, "measured 2026-11-28: CPU ms per home vector of homing=minwarping_thesis on "
-                                      "the bench's pairs"),
-    "warping2d_thesis": (65.0, None, "measured 2026-11-28: CPU ms per home vector of homing=warping2d_thesis on "
-                                     "the bench's pairs"),
+    "minwarping": (3.2, None, "measured 2026-11-28: min-warping single search at 288x50, 96x96 steps, CPU ms per home "
+                              "vector on the bench's pairs (python -m bionav.bench --method scaling, minimum)"),
+    "minwarping_cleaning": (3.2, None, "as minwarping"),
+    "warping2d": (19.1, None, "measured 2026-11-28: 2D-warping single search at 288x50 (bench pairs, minimum)"),
+    "warping1d": (23.2, None, "measured 2026-11-28: python -m bionav.bench --method scaling, warping1d at 288x50"),
+    "hiss": (0.8, None, "measured 2026-11-28: python -m bionav.bench --method scaling, hiss at 288x50"),
+    "minwarping_thesis": (7.6, None, "measured 2026-11-28: homing=minwarping_thesis (346x50, double and fine "
+                                     "search) on the bench's pairs, CPU ms per home vector (minimum)"),
+    "warping2d_thesis": (30.4, None, "measured 2026-11-28: homing=warping2d_thesis (346x50) on the bench's pairs"),
     "mfdid": (0.05, 288 * 50, "assumed: an image difference and two shifts per pair (not timed)"),
     "parameter": (0.02, None, "assumed: signature distances (not timed)"),
 }
-#: CPU seconds of starting one ``python -m bionav`` run (imports, Hydra, numba's cache, writing the run's
-#: files), measured 2026-11-28: 3.9-4.2 s for a grid_homing run of one mfdid snapshot at 64x16 (warm caches)
-RUN_START_S = 4.0
+#: per-image work (CPU ms per image) of the methods that resize to their own size (measured with the figures above)
+PREPARE_MS = {"minwarping": 1.0, "minwarping_cleaning": 1.0, "warping2d": 1.0, "warping1d": 0.3, "hiss": 18.0,
+              "minwarping_thesis": 2.0, "warping2d_thesis": 2.0}
+#: CPU seconds of starting one ``python -m bionav`` run (imports, Hydra, numba's cache, agents, plots, the run's
+#: files), measured 2026-11-28: 3.9-4.2 s for a grid_homing run of one mfdid snapshot on sim_original at 64x16
+RUN_START_S = 3.9
+#: loading a database from the render cache, per million pixels of its images (measured 2026-11-28 with the
+#: same one-snapshot mfdid run: sim_hall1 at 561x81, 7.7 Mpx, 5.8-6.1 s; sim_roeben1, 18 Mpx, 8.0 s)
+DB_LOAD_S_PER_MPX = 0.22
 #: SIFT's matching per home vector grows with the keypoints of both images (the candidates within the
-#: radius, 22 % of the width, of each current keypoint); detection per image with the pixels. Measured
-#: 2026-11-28 on sim_original (python -m bionav.bench --method sift --sift-size W H, 561x81 and 1122x162)
-SIFT_PAIR_NS_PER_KP2 = 1.5
-SIFT_IMAGE_MS_PER_MPX = 300.0
-SIFT_KEYPOINTS = {"plain": 350.0, "histeq": 700.0}
+#: radius, 22 % of the width, of each current keypoint), its detection per image with the pixels (less than
+#: linearly); the keypoints per image hardly grow with the image size. Measured 2026-11-28 on sim_original
+#: (python -m bionav.bench --method sift --sift-size W H at 561x81 and 1122x162, plain and histeq): 313 / 349
+#: plain and 490 / 697 histeq keypoints, 2.3-3.5 ns per home vector and keypoint^2, 17.6 / 39.7 ms (plain) and
+#: 24.9 / 52.8 ms (histeq) per image
+SIFT_PAIR_NS_PER_KP2 = 2.9
+SIFT_IMAGE_MS = {"plain": 39.7, "histeq": 52.8}
+SIFT_IMAGE_EXPONENT = 0.6
+SIFT_KEYPOINTS = {"plain": 349.0, "histeq": 697.0}
 SIFT_REF_SIZE = (1122, 162)
-SIFT_KEYPOINTS_EXPONENT = 0.5
+SIFT_KEYPOINTS_EXPONENT = 0.15
 SIFT_BASIS = "measured on sim_original at 561x81 and 1122x162 (python -m bionav.bench --method sift)"
-#: rendering a stand-in: CPU seconds per million pixels of all its images (measured: sim_original at
-#: 1122x162, 170 images, about 24 s; docs/performance.md section 0)
-RENDER_S_PER_MPX = 0.78
+#: rendering a stand-in: CPU seconds per image plus per million pixels (fitted 2026-11-28 to the quick preset's first
+#: runs of each database on this machine, which render it: fig. 5.6's six databases at 346x50 in 108 s, sim_hall1
+#: at 561x81 in about 25 s; worlds of other kinds, e.g. sim_roeben1's, take up to twice as long)
+RENDER_S_PER_IMAGE = 0.1
+RENDER_S_PER_MPX = 0.3
 #: default image size of the stand-ins when a run names none (W, H)
 DEFAULT_SIZE = (561, 81)
 #: CPU seconds of one run of the experiments without home-vector counts (experiment -> (s, basis)); the
-#: "measured" ones are the process CPU (os.wait4) of the quick preset's runs, ``python -m bionav.thesis
-#: --preset quick --jobs 2`` on this machine, 2026-11-27 (render caches warm), start-up included
+#: "measured" ones are the process CPU (os.wait4) of the quick preset's runs on the reference machine,
+#: ``python -m bionav.thesis --preset quick --jobs 2``, 2026-11-28 (main at 3e0c917), start-up included
 RUN_CPU_S: dict[str, tuple[float, str]] = {
-    "param_sweep_job": (1.3, "measured: 17-25 s CPU for the 19 jobs of one ci-grid sweep (quick preset)"),
-    "param_sweep_job_full": (1.7, "measured: 1.3 s per job on the ci grid plus 393 s CPU for the 15,606 "
-                                  "configurations of three stand-ins (docs/performance.md section 6) over 3 x 342 "
-                                  "jobs"),
-    "cleaning_start": (10.0, "measured: 13-14 s CPU for 2 runs (quick preset), minus the runs"),
+    "param_sweep_job": (1.7, "measured: 28-37 s CPU for the 19 jobs of one ci-grid sweep (quick preset)"),
+    "param_sweep_job_full": (2.1, "measured: 1.7 s per job on the ci grid plus 393 s CPU (AMD EPYC, scaled by its "
+                                  "ratio to this machine, about 1.0) for the 15,606 configurations of three "
+                                  "stand-ins (docs/performance.md section 6) over 3 x 342 jobs"),
+    "cleaning_start": (13.0, "measured: 19-21 s CPU for 2 runs (quick preset), minus the runs"),
     "cleaning_run": (3.5, "measured: 35.3 s CPU for 10 runs of long_lanes (docs/performance.md section 0)"),
-    "pol_compass": (5.0, "measured: 3-5 s CPU per mode (quick preset; the full preset's runs are the same)"),
-    "contrast_lda_start": (3.0, "measured: 7-8 s CPU at 1000 resamples (quick preset): about 3 s of start-up"),
-    "contrast_lda_resample": (0.005, "and 5 ms per resample"),
-    "contrast_scan_start": (3.0, "measured: 8-9 s CPU for one cloudy 57 x 13 scan and 20 s for 14 clear "
-                                 "38 x 9 scans (quick preset): about 3 s of start-up"),
-    "contrast_scan_direction": (0.008, "and at most 8 ms per scan direction (the cloudy ones; clear 3.5 ms)"),
-    "skyline_homing_start": (3.0, "measured: 42 s CPU at snapshot_stride=4 (quick preset): about 3 s of start-up"),
-    "skyline_homing_stride4": (39.0, "and 39 s at stride 4, scaled by the snapshots (1 / stride^2)"),
+    "pol_compass": (5.0, "measured: 4-7 s CPU per mode (quick preset; the full preset's runs are the same)"),
+    "contrast_lda_start": (3.9, "measured: 10-12 s CPU at 1000 resamples (quick preset): the start-up"),
+    "contrast_lda_resample": (0.007, "and 7 ms per resample"),
+    "contrast_scan_start": (3.9, "measured: 10-11 s CPU for one cloudy 57 x 13 scan and 26 s for 14 clear 38 x 9 "
+                                 "scans (quick preset): the start-up"),
+    "contrast_scan_direction": (0.0046, "and 4.6 ms per scan direction (the 14 scans of 38 x 9; the single 57 x 13 "
+                                        "scans took 8.9 ms per direction: the plan is 30 % low for them)"),
+    "skyline_homing_start": (3.9, "measured: 68 s CPU at snapshot_stride=4 (quick preset): the start-up"),
+    "skyline_homing_stride4": (64.0, "and 64 s at stride 4, scaled by the snapshots (1 / stride^2)"),
     "standins": (60.0, "assumed"),
 }
 #: jobs of one parameter-sweep multirun per grid (19 signatures x sizes x preprocessings)
@@ -163,9 +175,10 @@ def sift_costs(size: tuple[int, int], *, histeq: bool = False) -> tuple[float, f
     (detection: grows with the pixels), and their basis."""
     kp = keypoints_per_image(size, histeq=histeq)
     pair_ms = SIFT_PAIR_NS_PER_KP2 * kp * kp / 1e6
-    image_ms = SIFT_IMAGE_MS_PER_MPX * size[0] * size[1] / 1e6
+    ratio = size[0] * size[1] / (SIFT_REF_SIZE[0] * SIFT_REF_SIZE[1])
+    image_ms = SIFT_IMAGE_MS["histeq" if histeq else "plain"] * ratio ** SIFT_IMAGE_EXPONENT
     return pair_ms, image_ms, (f"SIFT: {kp:.0f} keypoints per image expected, {SIFT_PAIR_NS_PER_KP2:g} ns per home "
-                               f"vector and keypoint^2, {SIFT_IMAGE_MS_PER_MPX:g} ms per Mpx per image; {SIFT_BASIS}")
+                               f"vector and keypoint^2, {image_ms:.1f} ms per image; {SIFT_BASIS}")
 
 
 def _hv_ms(homing: str, size: tuple[int, int], ov: dict[str, str]) -> tuple[float, float, str]:
@@ -175,7 +188,7 @@ def _hv_ms(homing: str, size: tuple[int, int], ov: dict[str, str]) -> tuple[floa
     ms, ref, basis = HOME_VECTOR_MS.get(homing, (10.0, None, f"assumed for the unknown method {homing!r}"))
     if ref is not None:
         ms *= size[0] * size[1] / ref
-    return ms, 0.0, basis
+    return ms, PREPARE_MS.get(homing, 0.0), basis
 
 
 def task_cpu_s(spec: RunSpec, factors: dict | None = None) -> TaskEstimate:
@@ -221,10 +234,12 @@ def _pairs_task(experiment: str, ov: dict[str, str], command: str, start: float,
         gx, gy, assumed = _grid_shape(db)
         n = gx * gy
         snaps = block_share(len(_ints(ov["experiment.snapshots"])) if "experiment.snapshots" in ov else n, block)
-        render = n * size[0] * size[1] / 1e6 * RENDER_S_PER_MPX * render_f
-        cpu = start + (snaps * n * ms + n * image_ms) / 1e3 * f
-        return TaskEstimate(command, experiment, cpu, f"start-up {start:.1f} s; {snaps} x {n} home vectors{assumed}; "
-                            f"{basis}", (db, f"{size[0]}x{size[1]}"), render)
+        mpx = n * size[0] * size[1] / 1e6
+        load = mpx * DB_LOAD_S_PER_MPX * render_f
+        render = (n * RENDER_S_PER_IMAGE + mpx * RENDER_S_PER_MPX) * render_f
+        cpu = start + load + (snaps * n * ms + n * image_ms) / 1e3 * f
+        return TaskEstimate(command, experiment, cpu, f"start-up {start:.1f} s, database {load:.1f} s; {snaps} x {n} "
+                            f"home vectors{assumed}; {basis}", (db, f"{size[0]}x{size[1]}"), render)
     family = _items(ov.get("experiment.family", "[sim_original]"))
     stride = int(ov.get("experiment.snapshot_stride", 2))
     gx, gy, assumed = _grid_shape(family[0])
@@ -235,10 +250,12 @@ def _pairs_task(experiment: str, ov: dict[str, str], command: str, start: float,
     else:  # every n-th (snapshot, pair) unit
         units = block_share(snaps * n_pairs, block)
         hv, what = units * n, f"{units} (snapshot, database pair) units"
-    render = len(family) * n * size[0] * size[1] / 1e6 * RENDER_S_PER_MPX * render_f
-    cpu = start + (hv * ms + len(family) * n * image_ms) / 1e3 * f
-    return TaskEstimate(command, experiment, cpu, f"start-up {start:.1f} s; {what} x {n} home vectors{assumed}; "
-                        f"{basis}", tuple(sorted(family)) + (f"{size[0]}x{size[1]}",), render)
+    mpx = len(family) * n * size[0] * size[1] / 1e6
+    load = mpx * DB_LOAD_S_PER_MPX * render_f
+    render = (len(family) * n * RENDER_S_PER_IMAGE + mpx * RENDER_S_PER_MPX) * render_f
+    cpu = start + load + (hv * ms + len(family) * n * image_ms) / 1e3 * f
+    return TaskEstimate(command, experiment, cpu, f"start-up {start:.1f} s, databases {load:.1f} s; {what} x {n} home "
+                        f"vectors{assumed}; {basis}", tuple(sorted(family)) + (f"{size[0]}x{size[1]}",), render)
 
 
 def _scaled_run_cpu_s(experiment: str, ov: dict[str, str]) -> tuple[float, str] | None:
