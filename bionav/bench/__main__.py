@@ -86,11 +86,12 @@ def _parser():
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all", "scaling") + RUN_METHODS,
+    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all", "scaling", "stages") + RUN_METHODS,
                         default="minwarping",
                         help="method to time (default: minwarping; all = the pair methods, not sift); "
                              "sweep and cleaning time whole runs; scaling: CPU per home vector against image "
-                             "and grid size for each method")
+                             "and grid size for each method; stages: min-warping's stages against the arithmetic "
+                             "floor")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -148,6 +149,8 @@ def _parser():
                          help="snapshots of the larger whole run (the smaller has 1; default: 4)")
     scaling.add_argument("--scaling-runs", type=int, default=1, choices=(0, 1),
                          help="1: also time whole grid-homing runs on --db (default); 0: the pair table only")
+    scaling.add_argument("--clock-ghz", type=float, default=None, metavar="F",
+                         help="--method stages: the core clock of the floor (default: measured)")
     add_arguments(parser)
     return parser
 
@@ -199,6 +202,9 @@ def _check_args(parser, args) -> None:
         except ValueError as exc:
             parser.error(f"--scaling-sizes: {exc}; e.g. --scaling-sizes 144x25,288x50")
         bounded_int(parser, "--scaling-snapshots", args.scaling_snapshots, 2, 1000)
+    if args.clock_ghz is not None and not 0.1 <= args.clock_ghz <= 10.0:
+        parser.error(f"--clock-ghz {args.clock_ghz} is out of range: give the core clock in GHz, 0.1..10; e.g. "
+                     "--clock-ghz 2.6")
 
 
 def _run_for_cpu(parser, args, argv: list[str]) -> int:
@@ -237,11 +243,15 @@ def main(argv=None) -> int:
             print(json.dumps(row) if args.json else "  ".join(f"{k}={v}" for k, v in row.items()))
         return 0
     if args.repeat is None:
-        args.repeat = 1 if args.method in GRID_METHODS else 5 if args.method == "scaling" else 15
+        args.repeat = 1 if args.method in GRID_METHODS else 5 if args.method in ("scaling", "stages") else 15
     if args.method == "scaling":
         from bionav.bench.scaling import scaling_rows
 
         return _print_scaling(scaling_rows(args), args)
+    if args.method == "stages":
+        from bionav.bench.stages import stage_rows
+
+        return _print_stages(stage_rows(args), args)
     batch = args.batch if args.batch is not None else 6 * args.threads
     if args.grid is not None:
         if args.method != "minwarping":
@@ -314,6 +324,20 @@ def _print_scaling(rows: list[dict], args) -> int:
                          f"{r['cpu_ms_per_home_vector']:.3f}", f"{r['fixed_cpu_s']:.2f}") for r in runs])
     print(f"numba target CPU {rows[0]['cpu']} ({rows[0]['isa']}); load average (1 min) {rows[0]['loadavg_1min'][0]} -> "
           f"{rows[0]['loadavg_1min'][1]}, {rows[0]['machine']}")
+    return 0
+
+
+def _print_stages(rows: list[dict], args) -> int:
+    if args.json:
+        for row in rows:
+            print(json.dumps(row))
+        return 0
+    _print_aligned(("stage", "byte-lane ops", "floor ms", "CPU ms (min)", "fraction of the floor"),
+                   [(r["stage"], "-" if r["byte_lane_ops"] is None else f"{r['byte_lane_ops'] / 1e6:.1f} M",
+                     f"{r['floor_ms']:.3f}", f"{r['cpu_ms']:.3f}", f"{100 * r['fraction_of_floor']:.1f} %")
+                    for r in rows])
+    print(f"min-warping at {rows[0]['image']}, {rows[0]['steps']} x {rows[0]['steps']} steps; floor: 2 x 64 byte lanes "
+          f"per cycle at {rows[0]['clock_ghz']} GHz; load average (1 min) {rows[0]['loadavg_1min']}")
     return 0
 
 

@@ -169,3 +169,23 @@ def test_bench_scaling_rejects_bad_sizes(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["--method", "scaling", "--scaling-sizes", "288x50,abc"])
     assert exc.value.code == 2 and "--scaling-sizes" in capsys.readouterr().err
+
+
+def test_bench_stages_sets_every_stage_against_its_floor(capsys):
+    """--method stages (issue 42): byte-lane operations counted from the sizes, floor at the given clock."""
+    assert main(["--json", "--method", "stages", "--size", "48", "16", "--steps", "16", "--repeat", "1", "--batch", "1",
+                 "--clock-ghz", "2.0"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    by = {r["stage"]: r for r in rows}
+    assert {"home vector, single", "home vector, compass", "home vector, double_fine"} <= set(by)
+    per_ms = 64 * 2 * 2.0e6  # byte lanes per ms at 2 GHz, two 512-bit instructions per cycle
+    d = by["distances (sums + normalisation)"]
+    # K = 9 planes, R = 15 rows (16 - 1 for the edge filter), W = 48: 3 ops x 2 bytes per term, 6 x 4 per entry
+    k, w = 9, 48
+    r = (d["byte_lane_ops"] - k * w * w * 24) // (k * w * w * 6)
+    assert d["byte_lane_ops"] == k * r * w * w * 6 + k * w * w * 24 and 8 <= r <= 16
+    for row in rows:
+        assert row["cpu_ms"] > 0 and row["clock_ghz"] == 2.0
+        if row["byte_lane_ops"] is not None:
+            assert row["floor_ms"] == pytest.approx(row["byte_lane_ops"] / per_ms, abs=1e-4)
+        assert row["fraction_of_floor"] == pytest.approx(row["floor_ms"] / row["cpu_ms"], rel=0.01, abs=1e-3)
