@@ -86,12 +86,12 @@ def _parser():
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all", "scaling", "stages") + RUN_METHODS,
+    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all", "scaling", "stages", "calibrate") + RUN_METHODS,
                         default="minwarping",
                         help="method to time (default: minwarping; all = the pair methods, not sift); "
                              "sweep and cleaning time whole runs; scaling: CPU per home vector against image "
                              "and grid size for each method; stages: min-warping's stages against the arithmetic "
-                             "floor")
+                             "floor; calibrate: the plan's calibration workloads (python -m bionav.thesis --plan)")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -248,6 +248,12 @@ def main(argv=None) -> int:
         from bionav.bench.scaling import scaling_rows
 
         return _print_scaling(scaling_rows(args), args)
+    if args.method == "calibrate":
+        from bionav.bench.calibration import run_calibration
+
+        cal = run_calibration()
+        print(json.dumps(cal) if args.json else "  ".join(f"{k}={v}" for k, v in cal.items()))
+        return 0
     if args.method == "stages":
         from bionav.bench.stages import stage_rows
 

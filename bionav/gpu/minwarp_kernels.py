@@ -1,8 +1,8 @@
 """CUDA kernels of min-warping (numba-cuda), one thread per output value, a batch of pairs at once.
 
 The layouts are those of the CPU kernels (:mod:`bionav.homing.warping.kernels`): per pair ``b`` the
-window table ``lev[b, j, k, d, i % step, i // step]``. Every kernel but :func:`distances` is integer
-arithmetic and gives the CPU kernels' values bit for bit; :func:`distances` divides in IEEE float32
+window table ``lev[b, j, k, d, i % step, i // step]``. Every kernel but :func:`mw_distances` is integer
+arithmetic and gives the CPU kernels' values bit for bit; :func:`mw_distances` divides in IEEE float32
 (the CPU kernel's compiled division may use a refined reciprocal), see :mod:`bionav.gpu.minwarp`.
 Imported only when device=cuda is used (:mod:`bionav.gpu.pairs`), so bionav never needs numba-cuda otherwise.
 """
@@ -30,7 +30,7 @@ def rint32(v):
     return f
 
 @cuda.jit
-def quantise(snaps, curs, ps, pc, scale, sq, sn, cq, cn):
+def mw_quantise(snaps, curs, ps, pc, scale, sq, sn, cq, cn):
     """sq/cq[b, k, r, w] = rint(scale[b] * stack[k, r, w]) (int16), sn/cn[b, k, w] their column norms."""
     b, k, w = cuda.grid(3)
     if b >= ps.shape[0] or k >= sq.shape[1] or w >= sq.shape[3]:
@@ -49,7 +49,7 @@ def quantise(snaps, curs, ps, pc, scale, sq, sn, cq, cn):
     cn[b, k, w] = nc
 
 @cuda.jit
-def distances(sq, cq, sn, cn, qf, lev):
+def mw_distances(sq, cq, sn, cn, qf, lev):
     """lev[b, 0, k, d, i % step, i // step] = uint8(float32(sum_r |sq - cq|) * q / norms + 0.5)."""
     b, kd, i = cuda.grid(3)
     n_planes, width, step = sq.shape[1], sq.shape[3], lev.shape[4]
@@ -69,7 +69,7 @@ def distances(sq, cq, sn, cn, qf, lev):
     lev[b, 0, k, d, i % step, i // step] = val
 
 @cuda.jit
-def window_level(lev, j, h):
+def mw_window_level(lev, j, h):
     """lev[b, j, k, d, x] = min(lev[b, j - 1, k, d, x], lev[b, j - 1, k, (d + h) % W, x])."""
     b, kd, x = cuda.grid(3)
     n_planes, width, step, n = lev.shape[2], lev.shape[3], lev.shape[4], lev.shape[5]
@@ -83,7 +83,7 @@ def window_level(lev, j, h):
     lev[b, j, k, d, rr, m] = min(lev[b, j - 1, k, d, rr, m], lev[b, j - 1, k, d2, rr, m])
 
 @cuda.jit
-def swap_roles(lev, out):
+def mw_swap_roles(lev, out):
     """The swapped pair's level 0: ``E'[k, d, j] = E[K-1-k, -d, j + d]`` (indices modulo W)."""
     b, kd, j = cuda.grid(3)
     n_planes, width, step, n = lev.shape[2], lev.shape[3], lev.shape[4], lev.shape[5]
@@ -95,7 +95,7 @@ def swap_roles(lev, out):
     out[b, 0, k, d, j % step, j // step] = lev[b, 0, n_planes - 1 - k, (width - d) % width, i % step, i // step]
 
 @cuda.jit
-def compass(lev, p_cols, out):
+def mw_compass(lev, p_cols, out):
     """out[b, ip] = sum over columns of the smallest plane distance along rotation p_cols[ip]."""
     b, ip = cuda.grid(2)
     n_planes, width, step, n = lev.shape[2], lev.shape[3], lev.shape[4], lev.shape[5]
@@ -112,7 +112,7 @@ def compass(lev, p_cols, out):
     out[b, ip] = total
 
 @cuda.jit
-def search(lev, p_sel, start, w_plane, w_level, w_v, out):
+def mw_search(lev, p_sel, start, w_plane, w_level, w_v, out):
     """out[b, ip, a] = sum_u min over u's windows of the table at rotation p_sel[b, ip] (uint16)."""
     b, ip, a = cuda.grid(3)
     width, step, n = lev.shape[3], lev.shape[4], lev.shape[5]
@@ -131,7 +131,7 @@ def search(lev, p_sel, start, w_plane, w_level, w_v, out):
     out[b, ip, a] = acc & 0xFFFF
 
 @cuda.jit
-def runs(lev, a_first, p_cols, start, w_plane, w_level, w_v, out):
+def mw_runs(lev, a_first, p_cols, start, w_plane, w_level, w_v, out):
     """out[b, t, a] = sum_u min over windows at rotation p_cols[b, t], direction a_first[b, t] + a (float64)."""
     b, t, a = cuda.grid(3)
     width, step, n = lev.shape[3], lev.shape[4], lev.shape[5]
@@ -151,8 +151,8 @@ def runs(lev, a_first, p_cols, start, w_plane, w_level, w_v, out):
 
 def kernels():
     """The compiled kernels."""
-    return SimpleNamespace(quantise=quantise, distances=distances, window_level=window_level,
-                           swap_roles=swap_roles, compass=compass, search=search, runs=runs)
+    return SimpleNamespace(quantise=mw_quantise, distances=mw_distances, window_level=mw_window_level,
+                           swap_roles=mw_swap_roles, compass=mw_compass, search=mw_search, runs=mw_runs)
 
 
 def grid(shape, block=(1, 8, 32)):

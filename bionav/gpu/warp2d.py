@@ -21,7 +21,7 @@ cuda = cuda_module()
 
 
 @cuda.jit
-def distances(snaps, curs, snorm, cnorm, ps, pc, dist):
+def w2_distances(snaps, curs, snorm, cnorm, ps, pc, dist):
     """dist[b, k, d, i % step, i // step] = NSAD of snapshot column i and current column i + d (float32)."""
     b, kd, i = cuda.grid(3)
     n_planes, width, step = snaps.shape[1], snaps.shape[3], dist.shape[3]
@@ -37,7 +37,7 @@ def distances(snaps, curs, snorm, cnorm, ps, pc, dist):
     dist[b, k, d, i % step, i // step] = acc / den if den > 0 else np.float32(0.0)
 
 @cuda.jit
-def compass(dist, p_cols, out):
+def w2_compass(dist, p_cols, out):
     b, ip = cuda.grid(2)
     n_planes, width, step, n = dist.shape[1], dist.shape[2], dist.shape[3], dist.shape[4]
     if b >= dist.shape[0] or ip >= p_cols.shape[0]:
@@ -55,7 +55,7 @@ def compass(dist, p_cols, out):
     out[b, ip] = total
 
 @cuda.jit
-def search(dist, p_sel, v_tab, k_tab, out):
+def w2_search(dist, p_sel, v_tab, k_tab, out):
     """out[b, il * P + ip, a]: sum over u of the predicted column pair's distance (float32, u in order)."""
     b, lp, a = cuda.grid(3)
     width, step, n = dist.shape[2], dist.shape[3], dist.shape[4]
@@ -74,7 +74,7 @@ def search(dist, p_sel, v_tab, k_tab, out):
 
 def _kernels():
     """The compiled kernels."""
-    return SimpleNamespace(distances=distances, compass=compass, search=search)
+    return SimpleNamespace(distances=w2_distances, compass=w2_compass, search=w2_search)
 
 
 class Warp2dGPU:

@@ -1,19 +1,13 @@
-"""How fast this machine runs bionav's kernels, relative to the machine the plan's figures come from.
+"""How fast a machine runs bionav's kernels, relative to the machine the plan's figures come from.
 
 The plan's unit costs (:mod:`bionav.thesis.plan`) are CPU times measured on one machine, the
 *reference machine* (:data:`REFERENCE`). Another machine runs the same work faster or slower, and
 not by one factor: the warping kernels follow the vector units, SIFT matching the float32 dot
 products, the Python parts the scalar core. A **calibration** times four short workloads (about
-two seconds of CPU in all) on the machine at hand:
-
-* ``minwarping``: min-warping home vectors of a synthetic pair at 288 x 50 (96 x 96 steps);
-* ``warping2d``: 2D-warping home vectors of the same pair;
-* ``sift``: neighbourhood matching of two synthetic sets of 700 keypoints (integer descriptors);
-* ``python``: a loop of small NumPy operations (the start-up and bookkeeping of a run);
-
-each the minimum CPU time (``time.process_time``) over a few repetitions, so that other processes
-on the machine change it little. A family's **factor** is its time here over the reference
-machine's; a task's cost in the plan is the reference cost times the factor of its family.
+two seconds of CPU in all) on the machine at hand, one per family: ``python -m bionav.bench --method
+calibrate --json`` (:mod:`bionav.bench.calibration`), run as a command like the thesis' other runs.
+A family's **factor** is its time there over the reference machine's; a task's cost in the plan is
+the reference cost times the factor of its family.
 
 The calibration is cached per CPU (model name, numba's target CPU and a digest of the kernels'
 sources) as JSON in ``<cache dir>/calibration/`` (``$BIONAV_CACHE`` or ``~/.cache/bionav``), so a
@@ -26,12 +20,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import re
-import time
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 #: the calibration workloads' CPU ms on the reference machine, where the plan's unit costs were measured
 #: (the minimum of three calibrations, 2026-11-28, numba 0.68.1, native code, load average 15-17 from other work)
@@ -49,89 +43,43 @@ FAMILIES = ("minwarping", "warping2d", "sift", "python")
 VERSION = 1
 
 
-def _pair():
-    """Two synthetic 288 x 50 panoramas (smooth random texture, the second one shifted and rolled)."""
-    from bionav.geometry import PanoramaGeometry
-
-    rng = np.random.default_rng(42)
-    noise = rng.random((50, 288 + 16)).astype(np.float32)
-    kernel = np.ones(9, np.float32) / 9.0
-    smooth = np.apply_along_axis(lambda r: np.convolve(r, kernel, mode="valid"), 1, noise)[:, :288]
-    snap = (smooth - smooth.min()) / np.ptp(smooth)
-    cur = np.roll(snap, 17, axis=1) * 0.8 + 0.1
-    return snap, cur, PanoramaGeometry.square_pixels(288, 50)
-
-
-def _min_cpu_ms(fn, repeat: int) -> float:
-    fn()  # warm-up: compilation, caches
-    best = float("inf")
-    for _ in range(repeat):
-        c0 = time.process_time()
-        fn()
-        best = min(best, time.process_time() - c0)
-    return 1e3 * best
-
-
-def _workloads():
-    from bionav.homing.features import SiftFeatures
-    from bionav.homing.sift_homing import column_index, match_in_neighbourhood
-    from bionav.homing.warping import minwarping, scale_plane_stack, warping2d
-
-    snap, cur, geo = _pair()
-    s, c = scale_plane_stack(snap, geometry=geo), scale_plane_stack(cur, geometry=geo)
-    rng = np.random.default_rng(7)
-
-    def features(n=700):
-        xy = np.column_stack([rng.random(n) * 1122, rng.random(n) * 162]).astype(np.float32)
-        d = rng.integers(0, 256, (n, 128)).astype(np.float32)
-        return column_index(SiftFeatures(xy, d, (d * d).sum(axis=1), width=np.asarray(1122)))
-
-    fa, fb = features(), features()
-    small = rng.random(64)
-
-    def python_loop():
-        total = 0.0
-        for i in range(2000):
-            total += float(np.sum(small * i)) + len(str(i))
-        return total
-
-    return {
-        "minwarping": (lambda: minwarping(s, c), 8),
-        "warping2d": (lambda: warping2d(s, c), 3),
-        "sift": (lambda: match_in_neighbourhood(fa, fb, radius=247.0, width=1122), 5),
-        "python": (python_loop, 5),
-    }
-
-
-def run_calibration() -> dict[str, Any]:
-    """Time the workloads on this machine: ``{family: CPU ms, ..., "machine", "cpu", "version"}``."""
-    from bionav.bench.cpu import numba_target
-    from bionav.machine import cpu_model, machine_label
-
-    out: dict[str, Any] = {f: round(_min_cpu_ms(fn, n), 4) for f, (fn, n) in _workloads().items()}
-    out.update(machine=f"{cpu_model()}, {machine_label()}", cpu=numba_target()["cpu"], version=VERSION)
-    return out
-
-
 def _kernels_digest() -> str:
-    """A digest of the kernels' sources: a calibration is stale once they change."""
-    from bionav.homing import sift_kernels
-    from bionav.homing.warping import distance, kernels, vkernels
-
+    """A digest of the kernels' sources (read as files): a calibration is stale once they change."""
+    root = Path(__file__).resolve().parents[1]
     h = hashlib.sha256()
-    for mod in (kernels, vkernels, distance, sift_kernels):
-        h.update(Path(mod.__file__).read_bytes())
+    for rel in ("homing/warping/kernels.py", "homing/warping/vkernels.py", "homing/warping/distance.py",
+                "homing/sift_kernels.py", "bench/calibration.py"):
+        try:
+            h.update((root / rel).read_bytes())
+        except OSError:
+            h.update(rel.encode())
     return h.hexdigest()[:10]
 
 
 def cache_path() -> Path:
     """This machine's calibration file: ``<cache dir>/calibration/<cpu model>-<numba cpu>-<kernels>.json``."""
-    from bionav.bench.cpu import numba_target
     from bionav.files import default_cache_dir
     from bionav.machine import cpu_model
 
     slug = re.sub(r"[^A-Za-z0-9._-]+", "_", cpu_model()).strip("_")[:80] or "cpu"
-    return default_cache_dir() / "calibration" / f"{slug}-{numba_target()['cpu']}-v{VERSION}-{_kernels_digest()}.json"
+    target = re.sub(r"[^A-Za-z0-9._-]+", "_", os.environ.get("NUMBA_CPU_NAME") or "host")
+    return default_cache_dir() / "calibration" / f"{slug}-{target}-v{VERSION}-{_kernels_digest()}.json"
+
+
+def measure_machine() -> dict[str, Any]:
+    """Time the workloads on this machine (``python -m bionav.bench --method calibrate --json``)."""
+    from bionav.errors import UserError
+
+    proc = subprocess.run([sys.executable, "-m", "bionav.bench", "--method", "calibrate", "--json"],
+                          capture_output=True, text=True, timeout=600)
+    try:
+        if proc.returncode != 0:
+            raise ValueError(f"status {proc.returncode}")
+        return check_calibration(json.loads(proc.stdout.strip().splitlines()[-1]), "the calibration")
+    except (ValueError, IndexError):
+        tail = (proc.stderr.strip().splitlines() or ["no message"])[-1]
+        raise UserError(f"calibrating this machine failed ({tail}); plan with --cpu-factor F instead, or run "
+                        "`python -m bionav.bench --method calibrate` to see why.") from None
 
 
 def machine_calibration(*, refresh: bool = False) -> dict[str, Any]:
@@ -144,7 +92,7 @@ def machine_calibration(*, refresh: bool = False) -> dict[str, Any]:
             return check_calibration(json.loads(path.read_text(encoding="utf-8")), str(path))
         except (OSError, ValueError):
             pass  # none yet, or unreadable: measure
-    cal = run_calibration()
+    cal = measure_machine()
     try:
         write_json_atomic(path, cal)
     except OSError:  # a read-only cache only costs the next plan two seconds

@@ -18,7 +18,7 @@ def test_calibration_is_measured_once_and_cached_per_cpu(tmp_path, monkeypatch):
         calls.append(1)
         return {**{f: 2.0 * cal.REFERENCE[f] for f in cal.FAMILIES}, "machine": "test", "cpu": "x", "version": 1}
 
-    monkeypatch.setattr(cal, "run_calibration", fake)
+    monkeypatch.setattr(cal, "measure_machine", fake)
     first = cal.machine_calibration()
     again = cal.machine_calibration()
     assert first == again and len(calls) == 1
@@ -31,7 +31,7 @@ def test_calibration_is_measured_once_and_cached_per_cpu(tmp_path, monkeypatch):
 
 
 def test_a_real_calibration_times_every_family():
-    out = cal.run_calibration()
+    out = cal.measure_machine()
     assert all(0 < out[f] < 10_000 for f in cal.FAMILIES) and out["machine"] and out["cpu"]
 
 
