@@ -281,15 +281,24 @@ def main(argv=None) -> int:
     return _print_rows(pair_rows(args, batch), args)
 
 
+def _load_line(row: dict) -> str:
+    return f"load average (1 min) {row['loadavg_1min'][0]} -> {row['loadavg_1min'][1]}"
+
+
+def _json_lines(rows: list[dict]) -> int:
+    """Print one JSON object per row (``--json``); status 0."""
+    for row in rows:
+        print(json.dumps(row))
+    return 0
+
+
 def _fmt(x) -> str:
     return "-" if x is None else f"{x:.2f}"
 
 
 def _print_rows(rows: list[dict], args) -> int:
     if args.json:
-        for row in rows:
-            print(json.dumps(row))
-        return 0
+        return _json_lines(rows)
     last, key = (("workers speedup", "workers_speedup") if args.grid is not None
                  else ("prepare CPU ms/image", "prepare_cpu_ms_per_image"))
     header = ("method", "variant", "image", "steps", "threads", "CPU ms/hv (median)", "CPU ms (min)",
@@ -304,16 +313,13 @@ def _print_rows(rows: list[dict], args) -> int:
                  for c, r in zip(cells, rows)]
     _print_aligned(header, cells)
     print(f"numba target CPU {rows[0]['cpu']} ({rows[0]['isa']})")
-    print(f"load average (1 min) {rows[0]['loadavg_1min'][0]} -> {rows[0]['loadavg_1min'][1]}, "
-          f"background load {args.background_load}, {rows[0]['machine']}")
+    print(_load_line(rows[0]) + f", background load {args.background_load}, {rows[0]['machine']}")
     return 0
 
 
 def _print_scaling(rows: list[dict], args) -> int:
     if args.json:
-        for row in rows:
-            print(json.dumps(row))
-        return 0
+        return _json_lines(rows)
     pairs = [r for r in rows if r["table"] == "pairs"]
     _print_aligned(("method", "image", "pixels", "CPU ms/hv (min)", "CPU ms/hv (median)", "growth exponent",
                     "prepare CPU ms/image"),
@@ -328,16 +334,13 @@ def _print_scaling(rows: list[dict], args) -> int:
                        [(r["method"], r["db"], " / ".join(map(str, r["snapshots"])),
                          " / ".join(map(str, r["home_vectors"])), " / ".join(map(str, r["cpu_s"])),
                          f"{r['cpu_ms_per_home_vector']:.3f}", f"{r['fixed_cpu_s']:.2f}") for r in runs])
-    print(f"numba target CPU {rows[0]['cpu']} ({rows[0]['isa']}); load average (1 min) {rows[0]['loadavg_1min'][0]} -> "
-          f"{rows[0]['loadavg_1min'][1]}, {rows[0]['machine']}")
+    print(f"numba target CPU {rows[0]['cpu']} ({rows[0]['isa']}); " + _load_line(rows[0]) + f", {rows[0]['machine']}")
     return 0
 
 
 def _print_stages(rows: list[dict], args) -> int:
     if args.json:
-        for row in rows:
-            print(json.dumps(row))
-        return 0
+        return _json_lines(rows)
     _print_aligned(("stage", "byte-lane ops", "floor ms", "CPU ms (min)", "fraction of the floor"),
                    [(r["stage"], "-" if r["byte_lane_ops"] is None else f"{r['byte_lane_ops'] / 1e6:.1f} M",
                      f"{r['floor_ms']:.3f}", f"{r['cpu_ms']:.3f}", f"{100 * r['fraction_of_floor']:.1f} %")
@@ -349,9 +352,7 @@ def _print_stages(rows: list[dict], args) -> int:
 
 def _print_sift(rows: list[dict], args) -> int:
     if args.json:
-        for row in rows:
-            print(json.dumps(row))
-        return 0
+        return _json_lines(rows)
     header = ("variant", "image", "images", "keypoints/image", "threads", "grid wall s", "grid CPU s",
               "SIFT CPU ms/image", "pairs wall s", "pairs CPU s", "CPU ms/hv", "speedup", "db load s")
     cells = [(r["variant"], r["image"], str(r["n_images"]), f"{r['keypoints_per_image']['mean']:.0f}",

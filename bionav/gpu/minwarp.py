@@ -101,10 +101,10 @@ class MinWarpGPU:
         b, cfg, p_all = lev.shape[0], self.cfg, self.p_all
         if not cfg.compass_acceleration or cfg.compass_fraction >= 1.0:
             return np.tile(p_all, (b, 1))
-        measure = self.cuda.device_array((b, p_all.size), np.int64)
+        measure = self.cuda.device_array((b, p_all.size), np.float64)
         blocks, threads = grid(measure.shape, block=(8, 32))
-        self.k.compass[blocks, threads](lev, self.cuda.to_device(p_all), measure)
-        measure = measure.copy_to_host().astype(np.float64)
+        self.k.compass[blocks, threads](lev[:, 0], self.cuda.to_device(p_all), measure)
+        measure = measure.copy_to_host()
         n_sel = max(1, int(np.ceil(cfg.compass_fraction * p_all.size)))
         keep = np.sort(np.argsort(measure, axis=1, kind="stable")[:, :n_sel], axis=1)
         return p_all[keep]

@@ -21,6 +21,13 @@ cuda = cuda_module()
 
 
 @cuda.jit(device=True)
+def plane_diagonal(kd, width):
+    """Plane ``k`` and diagonal ``d`` of the flat thread index ``kd = k * W + d``."""
+    k = kd // width
+    return k, kd - k * width
+
+
+@cuda.jit(device=True)
 def rint32(v):
     # round half to even, as numpy.rint (v: float32, |v| < 2**23; v - floor(v) is exact)
     f = math.floor(v)
@@ -28,6 +35,7 @@ def rint32(v):
     if r > 0.5 or (r == 0.5 and f % 2 != 0):
         f += 1
     return f
+
 
 @cuda.jit
 def mw_quantise(snaps, curs, ps, pc, scale, sq, sn, cq, cn):
@@ -48,6 +56,7 @@ def mw_quantise(snaps, curs, ps, pc, scale, sq, sn, cq, cn):
     sn[b, k, w] = ns
     cn[b, k, w] = nc
 
+
 @cuda.jit
 def mw_distances(sq, cq, sn, cn, qf, lev):
     """lev[b, 0, k, d, i % step, i // step] = uint8(float32(sum_r |sq - cq|) * q / norms + 0.5)."""
@@ -55,8 +64,7 @@ def mw_distances(sq, cq, sn, cn, qf, lev):
     n_planes, width, step = sq.shape[1], sq.shape[3], lev.shape[4]
     if b >= sq.shape[0] or kd >= n_planes * width or i >= width:
         return
-    k = kd // width
-    d = kd - k * width
+    k, d = plane_diagonal(kd, width)
     j = i + d
     if j >= width:
         j -= width
@@ -68,6 +76,7 @@ def mw_distances(sq, cq, sn, cn, qf, lev):
     val = int(np.float32(ac) * qf / np.float32(den) + np.float32(0.5))
     lev[b, 0, k, d, i % step, i // step] = val
 
+
 @cuda.jit
 def mw_window_level(lev, j, h):
     """lev[b, j, k, d, x] = min(lev[b, j - 1, k, d, x], lev[b, j - 1, k, (d + h) % W, x])."""
@@ -75,12 +84,12 @@ def mw_window_level(lev, j, h):
     n_planes, width, step, n = lev.shape[2], lev.shape[3], lev.shape[4], lev.shape[5]
     if b >= lev.shape[0] or kd >= n_planes * width or x >= step * n:
         return
-    k = kd // width
-    d = kd - k * width
+    k, d = plane_diagonal(kd, width)
     d2 = (d + h) % width
     rr = x // n
     m = x - rr * n
     lev[b, j, k, d, rr, m] = min(lev[b, j - 1, k, d, rr, m], lev[b, j - 1, k, d2, rr, m])
+
 
 @cuda.jit
 def mw_swap_roles(lev, out):
@@ -89,27 +98,31 @@ def mw_swap_roles(lev, out):
     n_planes, width, step, n = lev.shape[2], lev.shape[3], lev.shape[4], lev.shape[5]
     if b >= lev.shape[0] or kd >= n_planes * width or j >= width:
         return
-    k = kd // width
-    d = kd - k * width
+    k, d = plane_diagonal(kd, width)
     i = (j + d) % width
     out[b, 0, k, d, j % step, j // step] = lev[b, 0, n_planes - 1 - k, (width - d) % width, i % step, i // step]
 
+
 @cuda.jit
-def mw_compass(lev, p_cols, out):
-    """out[b, ip] = sum over columns of the smallest plane distance along rotation p_cols[ip]."""
+def plane_compass(table, p_cols, out):
+    """out[b, ip] = sum over columns of the smallest plane distance along rotation p_cols[ip] (float64, summed
+    per phase as :func:`~bionav.homing.warping.kernels.compass_measure`); ``table[b, k, d, rr, m]``."""
     b, ip = cuda.grid(2)
-    n_planes, width, step, n = lev.shape[2], lev.shape[3], lev.shape[4], lev.shape[5]
-    if b >= lev.shape[0] or ip >= p_cols.shape[0]:
+    n_planes, width, step, n = table.shape[1], table.shape[2], table.shape[3], table.shape[4]
+    if b >= table.shape[0] or ip >= p_cols.shape[0]:
         return
     d = (width - p_cols[ip]) % width
-    total = 0
+    total = 0.0
     for rr in range(step):
+        s = 0.0
         for m in range(n):
-            best = 255
-            for k in range(n_planes):
-                best = min(best, lev[b, 0, k, d, rr, m])
-            total += int(best)
+            best = table[b, 0, d, rr, m]
+            for k in range(1, n_planes):
+                best = min(best, table[b, k, d, rr, m])
+            s += np.float64(best)
+        total += s
     out[b, ip] = total
+
 
 @cuda.jit
 def mw_search(lev, p_sel, start, w_plane, w_level, w_v, out):
@@ -129,6 +142,7 @@ def mw_search(lev, p_sel, start, w_plane, w_level, w_v, out):
             best = min(best, lev[b, w_level[e], w_plane[e], d, rr, m])
         acc += int(best)
     out[b, ip, a] = acc & 0xFFFF
+
 
 @cuda.jit
 def mw_runs(lev, a_first, p_cols, start, w_plane, w_level, w_v, out):
@@ -152,7 +166,7 @@ def mw_runs(lev, a_first, p_cols, start, w_plane, w_level, w_v, out):
 def kernels():
     """The compiled kernels."""
     return SimpleNamespace(quantise=mw_quantise, distances=mw_distances, window_level=mw_window_level,
-                           swap_roles=mw_swap_roles, compass=mw_compass, search=mw_search, runs=mw_runs)
+                           swap_roles=mw_swap_roles, compass=plane_compass, search=mw_search, runs=mw_runs)
 
 
 def grid(shape, block=(1, 8, 32)):

@@ -15,6 +15,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from bionav.gpu import cuda_module
+from bionav.gpu.minwarp_kernels import plane_compass, plane_diagonal
 
 #: numba.cuda (or its simulator): module level, so that the simulator finds the kernels' ``cuda``
 cuda = cuda_module()
@@ -27,8 +28,7 @@ def w2_distances(snaps, curs, snorm, cnorm, ps, pc, dist):
     n_planes, width, step = snaps.shape[1], snaps.shape[3], dist.shape[3]
     if b >= ps.shape[0] or kd >= n_planes * width or i >= width:
         return
-    k = kd // width
-    d = kd - k * width
+    k, d = plane_diagonal(kd, width)
     j = (i + d) % width
     acc = np.float32(0.0)
     for r in range(snaps.shape[2]):
@@ -36,23 +36,6 @@ def w2_distances(snaps, curs, snorm, cnorm, ps, pc, dist):
     den = snorm[ps[b], k, i] + cnorm[pc[b], k, j]
     dist[b, k, d, i % step, i // step] = acc / den if den > 0 else np.float32(0.0)
 
-@cuda.jit
-def w2_compass(dist, p_cols, out):
-    b, ip = cuda.grid(2)
-    n_planes, width, step, n = dist.shape[1], dist.shape[2], dist.shape[3], dist.shape[4]
-    if b >= dist.shape[0] or ip >= p_cols.shape[0]:
-        return
-    d = (width - p_cols[ip]) % width
-    total = 0.0
-    for rr in range(step):
-        s = 0.0
-        for m in range(n):
-            best = dist[b, 0, d, rr, m]
-            for k in range(1, n_planes):
-                best = min(best, dist[b, k, d, rr, m])
-            s += np.float64(best)
-        total += s
-    out[b, ip] = total
 
 @cuda.jit
 def w2_search(dist, p_sel, v_tab, k_tab, out):
@@ -74,7 +57,7 @@ def w2_search(dist, p_sel, v_tab, k_tab, out):
 
 def _kernels():
     """The compiled kernels."""
-    return SimpleNamespace(distances=w2_distances, compass=w2_compass, search=w2_search)
+    return SimpleNamespace(distances=w2_distances, compass=plane_compass, search=w2_search)
 
 
 class Warp2dGPU:

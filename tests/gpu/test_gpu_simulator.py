@@ -44,20 +44,26 @@ def _method(cls, **options):
 PAIRS = (np.array([0, 1, 2]), np.array([1, 2, 0]))
 
 
+def _assert_cpu_hypotheses(method, preps, best_a, best_p, *, abs_tol):
+    """The GPU's (alpha, psi) columns give the CPU plugin's home angle and compass for every pair of PAIRS."""
+    from bionav.homing.warping.search import _result
+
+    for k, (s, c) in enumerate(zip(*PAIRS)):
+        cpu = method.home_vector(preps[s], preps[c])
+        gpu = _result(int(best_a[k]), int(best_p[k]), np.nan, 0.0, W)
+        assert gpu.home_angle == pytest.approx(cpu.angle, abs=abs_tol)
+        assert gpu.psi == pytest.approx(cpu.compass, abs=abs_tol)
+
+
 @pytest.mark.parametrize("options", [{}, {"compass_acceleration": True, "compass_fraction": 0.5},
                                      {"double_search": True, "fine_search": True, "n_alpha": 4, "n_psi": 4}])
 def test_gpu_minwarping_chooses_the_cpu_hypothesis(options):
     from bionav.gpu.minwarp import MinWarpGPU
-    from bionav.homing.warping.search import _result
 
     m = _method(MinWarping, **options)
     preps = [m.prepare(img) for img in _images()]
     ps, pc = PAIRS
-    best_a, best_p = MinWarpGPU(m, preps, preps).best(ps, pc)
-    for k in range(len(ps)):
-        cpu = m.home_vector(preps[ps[k]], preps[pc[k]])
-        gpu = _result(int(best_a[k]), int(best_p[k]), np.nan, 0.0, W)
-        assert (gpu.home_angle, gpu.psi) == (cpu.angle, cpu.compass)
+    _assert_cpu_hypotheses(m, preps, *MinWarpGPU(m, preps, preps).best(ps, pc), abs_tol=0.0)
 
 
 def test_gpu_table_and_search_equal_the_cpu_kernels():
@@ -86,17 +92,11 @@ def test_gpu_table_and_search_equal_the_cpu_kernels():
 
 def test_gpu_warping2d_chooses_the_cpu_hypothesis():
     from bionav.gpu.warp2d import Warp2dGPU
-    from bionav.homing.warping.search import _result
 
     m = _method(Warping2D, n_rho=3)
     preps = [m.prepare(img) for img in _images()]
     ps, pc = PAIRS
-    best_a, best_p = Warp2dGPU(m, preps, preps).best(ps, pc)
-    for k in range(len(ps)):
-        cpu = m.home_vector(preps[ps[k]], preps[pc[k]])
-        gpu = _result(int(best_a[k]), int(best_p[k]), np.nan, 0.0, W)
-        assert gpu.home_angle == pytest.approx(cpu.angle, abs=1e-12)
-        assert gpu.psi == pytest.approx(cpu.compass, abs=1e-12)
+    _assert_cpu_hypotheses(m, preps, *Warp2dGPU(m, preps, preps).best(ps, pc), abs_tol=1e-12)
 
 
 def test_gpu_sift_matches_equal_the_cpu_all_pairs_path():
