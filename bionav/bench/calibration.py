@@ -1,7 +1,8 @@
 """``python -m bionav.bench --method calibrate``: the plan's calibration workloads, timed on this machine.
 
 Four short workloads (about two seconds of CPU in all), each the minimum CPU time
-(``time.process_time``) over a few repetitions, so that other processes change it little:
+(``time.process_time``) over 12 rounds in which every workload runs once (interleaved), so that other
+processes change it little:
 
 * ``minwarping``: min-warping home vectors of a synthetic pair at 288 x 50 (96 x 96 steps);
 * ``warping2d``: 2D-warping home vectors of the same pair;
@@ -33,14 +34,22 @@ def _pair():
     return snap, cur, PanoramaGeometry.square_pixels(288, 50)
 
 
-def _min_cpu_ms(fn, repeat: int) -> float:
-    fn()  # warm-up: compilation, caches
-    best = float("inf")
-    for _ in range(repeat):
-        c0 = time.process_time()
-        fn()
-        best = min(best, time.process_time() - c0)
-    return 1e3 * best
+#: interleaved rounds: every round times each workload once, the minimum over the rounds is kept, so that a burst
+#: of other work on the machine spoils a round of every family, not all rounds of one
+ROUNDS = 12
+
+
+def _interleaved_min_ms(workloads: dict, rounds: int = ROUNDS) -> dict[str, float]:
+    for fn, _ in workloads.values():
+        fn()  # warm-up: compilation, caches
+    best = {name: float("inf") for name in workloads}
+    for _ in range(rounds):
+        for name, (fn, calls) in workloads.items():
+            c0 = time.process_time()
+            for _ in range(calls):
+                fn()
+            best[name] = min(best[name], (time.process_time() - c0) / calls)
+    return {name: 1e3 * t for name, t in best.items()}
 
 
 def _workloads():
@@ -66,11 +75,11 @@ def _workloads():
             total += float(np.sum(small * i)) + len(str(i))
         return total
 
-    return {
-        "minwarping": (lambda: minwarping(s, c), 8),
-        "warping2d": (lambda: warping2d(s, c), 3),
-        "sift": (lambda: match_in_neighbourhood(fa, fb, radius=247.0, width=1122), 5),
-        "python": (python_loop, 5),
+    return {  # family: (workload, calls per round)
+        "minwarping": (lambda: minwarping(s, c), 3),
+        "warping2d": (lambda: warping2d(s, c), 1),
+        "sift": (lambda: match_in_neighbourhood(fa, fb, radius=247.0, width=1122), 4),
+        "python": (python_loop, 1),
     }
 
 
@@ -79,6 +88,6 @@ def run_calibration() -> dict[str, Any]:
     from bionav.bench.cpu import numba_target
     from bionav.machine import cpu_model, machine_label
 
-    out: dict[str, Any] = {f: round(_min_cpu_ms(fn, n), 4) for f, (fn, n) in _workloads().items()}
+    out: dict[str, Any] = {f: round(ms, 4) for f, ms in _interleaved_min_ms(_workloads()).items()}
     out.update(machine=f"{cpu_model()}, {machine_label()}", cpu=numba_target()["cpu"])
     return out
