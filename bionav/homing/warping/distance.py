@@ -145,8 +145,8 @@ def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     """8-bit NSAD in diagonal layout from 16-bit stacks.
 
     ``sq`` (K, R, W) and ``sn`` (K, W): quantised snapshot planes and column
-    norms; ``cq2`` (K, R, 2 W + 1) and ``cn2`` (K, 2 W + 1): the current view's,
-    twice side by side (and one more column), so that the columns ``i + d`` of
+    norms; ``cq2`` (K, R, >= 2 W + 1) and ``cn2`` (K, >= 2 W + 1): the current view's,
+    twice side by side (and more columns), so that the columns ``i + d`` of
     all snapshot columns ``i`` are one contiguous run. The sums of a plane are kept for all diagonals
     (``W x W`` 16-bit, in L2 cache) and built eight rows at a time, so that
     those rows stay in L1 cache while every diagonal visits them; the inner
@@ -313,11 +313,17 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
         # per-thread scratch arrays: fresh ones would be new pages (page faults) on every call
         sq = _scratch("sq", (n_planes, n_rows, width), np.int16)
         sn = _scratch("sn", (n_planes, width), np.int32)
-        cq2 = _scratch("cq2", (n_planes, n_rows, 2 * width + 1), np.int16)
-        cn2 = _scratch("cn2", (n_planes, 2 * width + 1), np.int32)
+        cq2 = _scratch("cq2", (n_planes, n_rows, 2 * width + 4), np.int16)
+        cn2 = _scratch("cn2", (n_planes, 2 * width + 4), np.int32)
         _quantise(snap, scale, sq, sn)
         _quantise(cur, scale, cq2, cn2)
-        _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
+        if width >= 32:  # the vector kernel (same result; its blocks are 32 columns wide)
+            from bionav.homing.warping.vkernels import diagonal_distances_u8
+
+            acc = _scratch("acc", (width + 4, width), np.uint16)
+            diagonal_distances_u8(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out, acc)
+        else:
+            _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
         return out
     cur_norm = np.asarray(current["cur_norm"], dtype=np.float32)
     _diagonal_distances(
