@@ -314,38 +314,7 @@ def _stability_item(fig: str):
             ax.set_title(f"{measure}{' after skyline separation' if separated else ''} (thesis {fig_name})", fontsize=9)
             save_figure(fig_, ctx.figure(f"{fig}.png"), dpi=100)
             out.figures.append(f"{fig}.png")
-            ok = {k: v for k, v in means.items() if v is not None}
-            uv = [ok.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
-            if fig == "fig6_10":
-                s = [ok[f] for f in SINGLES if f in ok]
-                d = [ok[f] for f in DUALS if f in ok]
-                out.checks.append(Check("every single channel above every dual contrast (time means)",
-                                        bool(s and d and min(s) > max(d)) if s and d else None,
-                                        f"min single {min(s):.2f}, max dual {max(d):.2f}" if s and d else ""))
-            elif fig in ("fig6_11", "fig6_12"):
-                for first in ("UV", "B", "G"):
-                    fam = [f for f in DUALS if f.startswith(first + "-")]
-                    vals = [ok.get(f) for f in fam]
-                    rho = spearman(list(range(len(fam))), vals) if len(fam) > 2 else (
-                        None if None in vals or len(fam) < 2 else (1.0 if vals[1] > vals[0] else -1.0))
-                    out.checks.append(Check(f"{first} contrasts ordered by wavelength difference (|rho| = 1)",
-                                            None if rho is None else abs(rho) > 0.999,
-                                            ", ".join(f"{f} {fmt(v, 2)}" for f, v in zip(fam, vals))))
-            elif fig == "fig6_13":
-                spread = [float(np.ptp(_series(stab, f, True, measure))) for f in DUALS
-                          if len(_series(stab, f, True, measure)) > 1]
-                out.checks.append(Check("dual contrasts nearly constant over time after separation "
-                                        "(max - min over the day <= 0.5 for every contrast)",
-                                        bool(max(spread) <= 0.5) if spread else None,
-                                        f"largest range {max(spread):.2f}" if spread else "no finite values"))
-            else:
-                raw = _stability_means(stab, measure, False)
-                uv_raw = [raw.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
-                r1 = spearman([0, 1, 2, 3], uv_raw)
-                r2 = spearman([0, 1, 2, 3], uv)
-                out.checks.append(Check("order of UV-B, UV-G, UV-R, UV-IR reversed by the separation",
-                                        None if r1 is None or r2 is None else bool(abs(r1) > 0.999 and r2 == -r1),
-                                        f"rho before {fmt(r1, 2)}, after {fmt(r2, 2)}"))
+            out.checks += _stability_checks(fig, stab, means, measure)
             return out
 
     return _S
@@ -360,10 +329,71 @@ def _stability_means(stab, measure: str, separated: bool) -> dict[str, float]:
     return out
 
 
+def _stability_checks(fig: str, stab, means: dict, measure: str) -> list[Check]:
+    """The claims of 6.4.4 on the day means (``means``: feature -> mean of ``measure``), one figure's checks."""
+    ok = {k: v for k, v in means.items() if v is not None}
+    uv = [ok.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
+    if fig == "fig6_10":
+        s = [ok[f] for f in SINGLES if f in ok]
+        d = [ok[f] for f in DUALS if f in ok]
+        return [Check("every single channel above every dual contrast (time means)",
+                      bool(min(s) > max(d)) if s and d else None,
+                      f"min single {min(s):.2f}, max dual {max(d):.2f}" if s and d else "")]
+    if fig in ("fig6_11", "fig6_12"):
+        return wavelength_order_checks(ok)
+    if fig == "fig6_13":
+        spread = [float(np.ptp(_series(stab, f, True, measure))) for f in DUALS
+                  if len(_series(stab, f, True, measure)) > 1]
+        return [Check("dual contrasts nearly constant over time after separation "
+                      "(max - min over the day <= 0.5 for every contrast)",
+                      bool(max(spread) <= 0.5) if spread else None,
+                      f"largest range {max(spread):.2f}" if spread else "no finite values")]
+    raw = _stability_means(stab, measure, False)
+    uv_raw = [raw.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
+    r1 = spearman([0, 1, 2, 3], uv_raw)
+    r2 = spearman([0, 1, 2, 3], uv)
+    return [Check("order of UV-B, UV-G, UV-R, UV-IR reversed by the separation",
+                  None if r1 is None or r2 is None else bool(abs(r1) > 0.999 and abs(r1 + r2) < 1e-9),
+                  f"rho before {fmt(r1, 2)}, after {fmt(r2, 2)}")]
+
+
+def wavelength_order_checks(means: dict) -> list[Check]:
+    """6.4.4: "contrasts with the same first channel are ordered by the difference of the wavelength".
+
+    One check per first channel (UV: 4 contrasts, B: 3, G: 2), each against
+    the wavelength gap (the channels' order UV, B, G, R, IR). The claim is one
+    order for every first channel, so the UV family (four contrasts) sets the
+    direction: UV passes when monotone (|rho| = 1), B and G when monotone in
+    UV's direction. Two contrasts (G-R, G-IR) are always monotone one way or
+    the other, so without a direction their check could not fail.
+    """
+    checks, direction = [], None
+    for first in ("UV", "B", "G"):
+        fam = [f for f in DUALS if f.startswith(first + "-")]
+        vals = [means.get(f) for f in fam]
+        detail = ", ".join(f"{f} {fmt(v, 2)}" for f, v in zip(fam, vals))
+        if any(v is None for v in vals):
+            checks.append(Check(f"{first} contrasts ordered by wavelength difference", None, detail))
+            continue
+        steps = np.sign(np.diff(vals))
+        sign = int(steps[0]) if len(set(steps)) == 1 and steps[0] != 0 else 0  # +1 rising, -1 falling, 0 neither
+        if first == "UV":
+            rho = spearman(list(range(len(fam))), vals)
+            direction = None if rho is None or rho == 0 else (1 if rho > 0 else -1)
+            checks.append(Check("UV contrasts ordered by wavelength difference (|rho| = 1); their direction sets "
+                                "the other channels'", sign != 0, detail + f" (rho {fmt(rho, 2)})"))
+            continue
+        word = {1: "rising", -1: "falling", None: "undefined"}[direction]
+        checks.append(Check(f"{first} contrasts ordered by wavelength difference in the UV contrasts' direction "
+                            f"({word})", None if direction is None else sign == direction, detail))
+    return checks
+
+
 _STAB_RULES = {
     "fig6_10": "logNRMSD averaged over the day: every single channel above every dual-channel contrast",
     "fig6_11": "logMSEstd averaged over the day: the contrasts with first channel UV, B, G each ordered by their "
-               "wavelength difference (|Spearman rho| = 1), one check per first channel",
+               "wavelength difference, one check per first channel: UV's four monotone (|Spearman rho| = 1), B's "
+               "three and G's two monotone in UV's direction (a pair is monotone one way or the other)",
     "fig6_12": "as fig. 6.11 for logMSEvar",
     "fig6_13": "logNRMSD after separation: every dual contrast nearly constant (max - min over the day <= 0.5)",
     "fig6_14": "logMSEstd: the order of UV-B, UV-G, UV-R, UV-IR (day means) is monotone before separation and "
