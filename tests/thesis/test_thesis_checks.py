@@ -119,3 +119,26 @@ def test_wavelength_order_of_the_g_contrasts_can_fail(tmp_path, g_rising):
     (g,) = _checks(out, "G contrasts ordered")
     assert uv.passed is True and b.passed is True
     assert g.passed is (not g_rising) and "falling" in g.rule
+
+
+@pytest.mark.parametrize("singles_tied", [True, False])
+def test_table6_3_does_not_check_a_claim_the_thesis_own_table_refutes(tmp_path, singles_tied):
+    """Table 6.3: "the single channels do not differ significantly in J" is shown, not evaluated.
+
+    The thesis' own table 6.2 gives the single channels J from 4.36 (UV) to 0.11 (IR) on 472 samples, which
+    differ at 0.1 % under any bootstrap (scripts/thesis_diagnoses.py table6_3). Before issue 44 the claim was a
+    check: bionav reproducing table 6.2 would have failed it. The other three claims stay checks.
+    """
+    from bionav.thesis.items import FEATURES
+
+    singles = ("UV", "B", "G", "R", "IR")
+    with open(tmp_path / "significance_J.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["J", *FEATURES])
+        for a in FEATURES:
+            tied = singles_tied and a in singles
+            w.writerow([a, *("" if a == b or (tied and b in singles) else "0.001" for b in FEATURES)])
+    out = _evaluate("table6_3", tmp_path, lambda spec: {})
+    (single,) = _checks(out, "UV, B, G, R, IR do not differ")
+    assert single.passed is None and "table 6.2" in single.detail
+    assert [c.passed for c in out.checks if c is not single] == [False, False, False]
