@@ -6,7 +6,10 @@ This script computes the few pieces of evidence no bionav command prints::
 
     python scripts/thesis_diagnoses.py table6_3              # bootstrap of table 6.3 (seconds)
     python scripts/thesis_diagnoses.py table6_3 --resamples 1000
+    python scripts/thesis_diagnoses.py fig5_6                # how much each lab variant changes the views
     python scripts/thesis_diagnoses.py fig6_26               # square test with the thesis' capture (minutes)
+    python scripts/thesis_diagnoses.py checks fig6_10 RUN    # an item's checks on any run directory
+    python scripts/thesis_diagnoses.py leaf_plateau 0.55 RUN # the quick scan with another leaf NIR plateau
 
 Each prints Markdown tables to stdout. Nothing here is imported by bionav.
 """
@@ -203,17 +206,110 @@ def fig6_26(*, seed: int, draws: int) -> str:
     return "\n".join(rows)
 
 
+def fig5_6(*, size: tuple[int, int] = (346, 50)) -> str:
+    """How much each variant of the lab changes the panoramas against ``sim_original``, cell by cell.
+
+    The stand-ins are rendered with the same pose errors and camera draws per
+    cell, so a difference is the variant's change to the room: the fraction of
+    pixels that differ by more than 10 % of full scale, and the mean absolute
+    difference, averaged over the cells (databases at ``size``, from the render
+    cache as the runs use them).
+    """
+    from bionav.config import compose
+    from bionav.experiments.common import load_configured_database
+
+    def images(name):
+        cfg = compose([f"db={name}", f"db.image_size=[{size[0]},{size[1]}]"])
+        db = load_configured_database(cfg)
+        return {tuple(int(v) for v in p): np.asarray(db.images[i], float) for i, p in enumerate(db.positions)}
+
+    base = images("sim_original")
+    scale = max(float(np.max(im)) for im in base.values())
+    rows = ["| variant (current views) | pixels changed > 10 % of full scale | mean absolute change (% of full scale) |",
+            "|---|---|---|"]
+    for name in ("sim_arboreal", "sim_chairs", "sim_screen", "sim_doorlit", "sim_winlit"):
+        other = images(name)
+        cells = [c for c in base if c in other]
+        diff = [np.abs(other[c] - base[c]) / scale for c in cells]
+        rows.append(f"| {name.removeprefix('sim_')} | {100 * np.mean([np.mean(d > 0.1) for d in diff]):.1f} % | "
+                    f"{100 * np.mean([d.mean() for d in diff]):.2f} |")
+    return "\n".join(rows)
+
+
+def item_checks(item_id: str, run_dir: str, preset: str = "quick") -> str:
+    """The checks of a one-run item (figs. 6.10-6.15, 6.26, tables 6.2-6.5) evaluated on any run directory.
+
+    For runs the thesis command does not make: the same experiment under other
+    settings (a stand-in closer to the thesis' scene, another seed).
+    """
+    import json
+    import tempfile
+    from pathlib import Path
+
+    from bionav.thesis.items import REGISTRY, Context
+    from bionav.thesis.presets import PRESETS
+    from bionav.thesis.reference import load_reference
+    from bionav.thesis.runs import RunResult
+
+    item = REGISTRY[item_id]
+    specs = item.runs(PRESETS[preset])
+    if len(specs) != 1:
+        raise SystemExit(f"{item_id} needs {len(specs)} runs; give an item of one run")
+    run = Path(run_dir)
+    res = RunResult(specs[0], run, json.loads((run / "metrics.json").read_text()))
+    with tempfile.TemporaryDirectory() as tmp:
+        out = item.evaluate(Context(PRESETS[preset], Path(tmp), load_reference().get(item_id, {}),
+                                    {specs[0].key: res}, ref_id=item_id), specs)
+    lines = [f"{item.label} on {run}: {out.verdict} ({out.score[0]} of {out.score[1]} checks pass)", "",
+             "| check | result | detail |", "|---|---|---|"]
+    lines += [f"| {c.rule} | {'n/a' if c.passed is None else 'pass' if c.passed else 'fail'} | {c.detail} |"
+              for c in out.checks]
+    lines += [f"| {r.quantity} | {r.verdict or '(shown)'} | thesis {r.thesis}, bionav {r.bionav} |"
+              for r in out.rows if r.tolerance is not None]
+    return "\n".join(lines)
+
+
+#: the quick preset's scan (bionav.thesis.presets.QUICK.scan) as overrides
+QUICK_SCAN = ("experiment=contrast_scan", "experiment.n_pan=38", "experiment.pan_step_deg=6.0", "experiment.n_tilt=9",
+              "experiment.tilt_step_deg=9.0")
+
+
+def leaf_plateau_scan(plateau: float, run_dir: str) -> int:
+    """The quick preset's one-day scan with the leaves' near-infrared plateau at ``plateau`` (bionav: 0.48).
+
+    The plateau beyond 700 nm is an extrapolation (docs/spectral.md); fresh leaves
+    reflect 0.45-0.55 at 800 nm. Runs ``python -m bionav`` in a child process with
+    ``bionav.light.measured_spectra.LEAF_NIR_PLATEAU`` set before anything reads it.
+    """
+    import subprocess
+    import sys
+
+    code = ("import sys, bionav.light.measured_spectra as m; m.LEAF_NIR_PLATEAU = float(sys.argv[1]); "
+            "sys.argv = ['bionav'] + sys.argv[2:]; from bionav.cli_main import run_main; from bionav.cli import main; "
+            "run_main(main, 'bionav')")
+    return subprocess.call([sys.executable, "-c", code, str(plateau), *QUICK_SCAN, f"hydra.run.dir={run_dir}"])
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python scripts/thesis_diagnoses.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("item", choices=("table6_3", "fig6_26"))
+    p.add_argument("item", help="table6_3, fig5_6, fig6_26, or 'checks ITEM RUN_DIR' (an item's checks on any run)")
+    p.add_argument("args", nargs="*", help="checks: ITEM RUN_DIR; leaf_plateau: VALUE RUN_DIR")
     p.add_argument("--resamples", type=int, default=10_000, help="bootstrap resamples (thesis: 10000)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--draws", type=int, default=10, help="fig6_26: capture draws per case with random headings")
     args = p.parse_args(argv)
     if args.item == "table6_3":
         print(table6_3(resamples=args.resamples, seed=args.seed))
-    else:
+    elif args.item == "fig5_6":
+        print(fig5_6())
+    elif args.item == "fig6_26":
         print(fig6_26(seed=args.seed, draws=args.draws))
+    elif args.item == "checks" and len(args.args) == 2:
+        print(item_checks(*args.args))
+    elif args.item == "leaf_plateau" and len(args.args) == 2:
+        return leaf_plateau_scan(float(args.args[0]), args.args[1])
+    else:
+        p.error("give table6_3, fig5_6, fig6_26, checks ITEM RUN_DIR or leaf_plateau VALUE RUN_DIR")
     return 0
 
 

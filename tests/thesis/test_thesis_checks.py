@@ -142,3 +142,52 @@ def test_table6_3_does_not_check_a_claim_the_thesis_own_table_refutes(tmp_path, 
     (single,) = _checks(out, "UV, B, G, R, IR do not differ")
     assert single.passed is None and "table 6.2" in single.detail
     assert [c.passed for c in out.checks if c is not single] == [False, False, False]
+
+
+# --------------------------------------------------------------------------- why an item does not hold
+def _section(verdict_checks, diagnosis=None):
+    from bionav.thesis.outcome import Check
+    from bionav.thesis.report import Section
+
+    o = Outcome(checks=[Check(f"c{k}", v) for k, v in enumerate(verdict_checks)])
+    return Section("table6_3", "Table 6.3", "Table 6.3: significances", "table 6.3, p. 76", "a rule", o, [], [],
+                   diagnosis)
+
+
+def test_every_item_not_holding_says_why_in_the_report_and_items_csv(tmp_path):
+    """A section that does not hold carries its diagnosis (kind, reason, evidence link) in report.md, report.html
+    and items.csv; one that holds says nothing; one without a diagnosis says so."""
+    from bionav.thesis.diagnoses import load_diagnoses
+    from bionav.thesis.report import CSV_COLUMNS, csv_rows, markdown_to_html, report_markdown
+
+    d = load_diagnoses()["table6_3"]
+    secs = [_section([True, False, False], d), _section([True, True]), _section([False], None)]
+    secs[1].id, secs[2].id = "fig5_4", "fig5_5"
+    md = report_markdown(secs, preset=PRESETS["quick"], out=tmp_path, wall_s=1.0, command="x")
+    assert f"*Why ({d.kind_words}; diagnosed on the quick preset):*" in md
+    assert f"docs/thesis.md#{d.evidence}" in md
+    assert "not diagnosed (no entry in bionav/thesis/diagnoses.yaml)" in md
+    assert md.count("*Why") == 2  # the item that holds has no why line
+    page = markdown_to_html(md, tmp_path)
+    assert f'thesis.md#{d.evidence}"' in page and "<i>Why (" in page
+    assert CSV_COLUMNS[:9] == ("item", "label", "quantity", "thesis", "bionav", "difference", "tolerance", "verdict",
+                               "level") and CSV_COLUMNS[9:] == ("why", "evidence")
+    items = {r["item"]: r for r in csv_rows(secs) if r["level"] == "item"}
+    assert items["table6_3"]["why"] == d.line() and items["table6_3"]["evidence"] == f"docs/thesis.md#{d.evidence}"
+    assert items["fig5_4"]["why"] == "" and items["fig5_5"]["why"].startswith("not diagnosed")
+
+
+def test_diagnoses_name_known_items_kinds_and_evidence_in_the_docs():
+    """Every diagnosis names a registered item, a kind, a reason, and an anchor that docs/thesis.md has."""
+    import re
+
+    from bionav.thesis.diagnoses import KINDS, load_diagnoses
+
+    docs = (Path(__file__).resolve().parents[2] / "docs" / "thesis.md").read_text()
+    anchors = {re.sub(r"[^a-z0-9 -]", "", h.strip().lower()).replace(" ", "-")
+               for h in re.findall(r"^#+ (.*)$", docs, flags=re.M)}
+    diagnoses = load_diagnoses()
+    assert diagnoses
+    for item_id, d in diagnoses.items():
+        assert item_id in REGISTRY and all(k in KINDS for k in d.kinds) and len(d.why) > 40
+        assert d.evidence in anchors, f"{item_id}: no section #{d.evidence} in docs/thesis.md"
