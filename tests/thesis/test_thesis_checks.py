@@ -191,3 +191,18 @@ def test_diagnoses_name_known_items_kinds_and_evidence_in_the_docs():
     for item_id, d in diagnoses.items():
         assert item_id in REGISTRY and all(k in KINDS for k in d.kinds) and len(d.why) > 40
         assert d.evidence in anchors, f"{item_id}: no section #{d.evidence} in docs/thesis.md"
+
+
+def test_the_full_preset_runs_the_thesis_sizes_of_figs_5_6_and_6_10_to_6_15():
+    """The full preset scans the one-day series on its own grid and runs fig. 5.6's SIFT at 1122 x 162.
+
+    Before issue 44 it scanned 113 x 26 points in 2 and 3 degree steps for 20 minutes (the example data
+    sets' grid, experiment=contrast_scan's defaults; thesis 6.4.1: the one-day series 200 x 51 in 1 and 2
+    degree steps, 40 minutes) and ran fig. 5.6 at the stand-ins' 561 x 81 (thesis 5.3: 1122 x 162).
+    """
+    full = PRESETS["full"]
+    (scan,) = REGISTRY["fig6_10"].runs(full)
+    assert {"experiment.n_pan=200", "experiment.pan_step_deg=1.0", "experiment.n_tilt=51",
+            "experiment.tilt_step_deg=2.0", "experiment.scan_minutes=40.0"} <= set(scan.overrides)
+    for spec in REGISTRY["fig5_6"].runs(full):
+        assert "db.image_size=[1122,162]" in spec.overrides
