@@ -206,3 +206,14 @@ def test_the_full_preset_runs_the_thesis_sizes_of_figs_5_6_and_6_10_to_6_15():
             "experiment.tilt_step_deg=2.0", "experiment.scan_minutes=40.0"} <= set(scan.overrides)
     for spec in REGISTRY["fig5_6"].runs(full):
         assert "db.image_size=[1122,162]" in spec.overrides
+
+
+def test_an_ordering_at_the_threshold_passes():
+    """One swap of neighbours over four values (or two over five) is rho = 0.8, the threshold: it passes.
+
+    Before issue 44 scipy's 0.7999999999999999 failed "rho >= 0.8" (hall2's AAE* over appendix B's four
+    sizes in the diagnose preset: "rho = 0.80", fail).
+    """
+    assert rho_check("x", [1, 2, 3, 4], [1, 2, 4, 3]).passed is True
+    assert rho_check("x", [1, 2, 3, 4, 5], [2, 1, 3, 5, 4]).passed is True
+    assert rho_check("x", [1, 2, 3, 4], [2, 1, 4, 3]).passed is False  # rho 0.6
