@@ -82,10 +82,17 @@ def load_diagnoses() -> dict[str, Diagnosis]:
     return out
 
 
-def evidence_link(diagnosis: Diagnosis, out: Path) -> str:
-    """A Markdown link to the evidence: relative to ``out`` where the docs are on disk, else the repository path."""
-    target = f"{EVIDENCE_DOC}#{diagnosis.evidence}"
+def evidence_href(diagnosis: Diagnosis, out: Path) -> str | None:
+    """The evidence's address relative to the report directory ``out``; None where bionav's docs are not on disk
+    (an installed wheel)."""
     docs = Path(__file__).resolve().parents[2] / EVIDENCE_DOC
-    if docs.is_file():
-        return f"[{target}]({os.path.relpath(docs, out)}#{diagnosis.evidence})"
-    return f"`{target}` (in bionav's source)"
+    return f"{os.path.relpath(docs, out)}#{diagnosis.evidence}" if docs.is_file() else None
+
+
+def evidence_link(diagnosis: Diagnosis, out: Path, text: str | None = None) -> str:
+    """A Markdown link to the evidence (``text``, default its repository path), or the path where no docs are."""
+    target = f"{EVIDENCE_DOC}#{diagnosis.evidence}"
+    href = evidence_href(diagnosis, out)
+    if href is None:
+        return f"{text} (`{target}` in bionav's source)" if text else f"`{target}` (in bionav's source)"
+    return f"[{text or target}]({href})"

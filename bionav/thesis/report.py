@@ -159,10 +159,11 @@ def _why_lines(s: Section, out: Path) -> list[str]:
             f"Evidence: {evidence_link(d, out)}.  "]
 
 
-def _why_cell(s: Section) -> str:
+def _why_cell(s: Section, out: Path) -> str:
+    """The summary table's reason: its kinds, linked to the evidence."""
     if not s.needs_why:
         return ""
-    return "not diagnosed" if s.diagnosis is None else md_text(s.diagnosis.kind_words)
+    return "not diagnosed" if s.diagnosis is None else evidence_link(s.diagnosis, out, md_text(s.diagnosis.kind_words))
 
 
 def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, wall_s: float, command: str,
@@ -185,7 +186,7 @@ def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, w
     head += ["| item | verdict | checks | why |", "|---|---|---|---|"]
     head += [f"| [{s.label}](#{_anchor(s)}) | {s.outcome.verdict} | "
              + (f"{s.outcome.score[0]}/{s.outcome.score[1]} |" if s.outcome.produced else "no run completed |")
-             + f" {_why_cell(s)} |" for s in sections]
+             + f" {_why_cell(s, out)} |" for s in sections]
     head.append("")
     return "\n".join(head + [section_markdown(s, out) for s in sections])
 
