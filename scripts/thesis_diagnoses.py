@@ -10,6 +10,7 @@ This script computes the few pieces of evidence no bionav command prints::
     python scripts/thesis_diagnoses.py fig6_26               # square test with the thesis' capture (minutes)
     python scripts/thesis_diagnoses.py checks fig6_10 RUN    # an item's checks on any run directory
     python scripts/thesis_diagnoses.py leaf_plateau 0.55 RUN # the quick scan with another leaf NIR plateau
+    python scripts/thesis_diagnoses.py lab_ambient 3 DIR sift # fig. 5.6's lab with 3 times the bounce light
 
 Each prints Markdown tables to stdout. Nothing here is imported by bionav.
 """
@@ -290,10 +291,36 @@ def leaf_plateau_scan(plateau: float, run_dir: str) -> int:
     return subprocess.call([sys.executable, "-c", code, str(plateau), *QUICK_SCAN, f"hydra.run.dir={run_dir}"])
 
 
+def lab_ambient_cross_db(factor: float, out_dir: str, homing: str = "sift") -> int:
+    """Fig. 5.6's cross-database run on original, doorlit and winlit with the lab's bounce light times ``factor``.
+
+    The stand-in lab's inter-reflected light is a uniform ambient term kept small
+    against a light band's direct light (``bionav.world.worlds.lab.AMBIENT_PER_BAND``,
+    0.07 up and 0.045 down per band that is on), so that switching a band off
+    reverses the shading of faces. The quick preset's settings (4 snapshots per
+    database, 346 x 50), into ``out_dir``/``homing``; the stand-ins render into
+    ``out_dir``/cache, never into the shared render cache (the cache key does not
+    see the patched constant).
+    """
+    import os
+    import subprocess
+    import sys
+
+    code = ("import sys, bionav.world.worlds.lab as lab; f = float(sys.argv[1]); "
+            "lab.AMBIENT_PER_BAND = tuple(f * a for a in lab.AMBIENT_PER_BAND); "
+            "sys.argv = ['bionav'] + sys.argv[2:]; from bionav.cli_main import run_main; from bionav.cli import main; "
+            "run_main(main, 'bionav')")
+    env = dict(os.environ, BIONAV_CACHE=os.path.join(out_dir, "cache"))
+    return subprocess.call([sys.executable, "-c", code, str(factor), "experiment=cross_db", f"homing={homing}",
+                            "experiment.family=[sim_original,sim_doorlit,sim_winlit]", "experiment.snapshot_stride=9",
+                            "db.image_size=[346,50]", f"hydra.run.dir={out_dir}/{homing}"], env=env)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python scripts/thesis_diagnoses.py", description=__doc__.split("\n\n")[0])
     p.add_argument("item", help="table6_3, fig5_6, fig6_26, or 'checks ITEM RUN_DIR' (an item's checks on any run)")
-    p.add_argument("args", nargs="*", help="checks: ITEM RUN_DIR; leaf_plateau: VALUE RUN_DIR")
+    p.add_argument("args", nargs="*", help="checks: ITEM RUN_DIR; leaf_plateau: VALUE RUN_DIR; "
+                                           "lab_ambient: FACTOR DIR [HOMING]")
     p.add_argument("--resamples", type=int, default=10_000, help="bootstrap resamples (thesis: 10000)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--draws", type=int, default=10, help="fig6_26: capture draws per case with random headings")
@@ -308,8 +335,11 @@ def main(argv: list[str] | None = None) -> int:
         print(item_checks(*args.args))
     elif args.item == "leaf_plateau" and len(args.args) == 2:
         return leaf_plateau_scan(float(args.args[0]), args.args[1])
+    elif args.item == "lab_ambient" and len(args.args) in (2, 3):
+        return lab_ambient_cross_db(float(args.args[0]), *args.args[1:])
     else:
-        p.error("give table6_3, fig5_6, fig6_26, checks ITEM RUN_DIR or leaf_plateau VALUE RUN_DIR")
+        p.error("give table6_3, fig5_6, fig6_26, checks ITEM RUN_DIR, leaf_plateau VALUE RUN_DIR or "
+                "lab_ambient FACTOR DIR [HOMING]")
     return 0
 
 
