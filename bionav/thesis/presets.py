@@ -210,13 +210,15 @@ STANDINS = dataclasses.replace(
 )
 
 #: the quick preset with the thesis' sizes and counts where the quick reduction could decide a verdict (issue 44,
-#: docs/thesis.md "Why"): appendix B's four image sizes, the one-day scans' grid, 10,000 bootstrap resamples,
+#: docs/thesis.md "Why"): appendix B's four image sizes, fig. 5.4's 17 cutoffs, the one-day scans' grid, 10,000
+#: bootstrap resamples,
 #: fig. 5.6's SIFT homing on all eight databases at the thesis' 1122 x 162 (its 2D-warping claims hold in quick)
 DIAGNOSE = dataclasses.replace(
     QUICK,
     name="diagnose",
     summary="quick with the thesis' sizes where the reduction could decide a verdict (issue 44)",
     b_sizes=FULL.b_sizes,
+    fig54_cutoffs=THESIS_CUTOFFS,
     lda_resamples=FULL.lda_resamples,
     scan=ONE_DAY_SCAN,
     cross_db_family=CROSS_DB_FAMILY,
@@ -225,7 +227,7 @@ DIAGNOSE = dataclasses.replace(
     cross_db_blocks={"sift": 4},
     reductions=(
         "grid homing: 6 snapshots per database (evenly spread over the images) instead of all (as quick); "
-        "appendix B at the thesis' four image sizes",
+        "appendix B at the thesis' four image sizes; fig. 5.4 at the thesis' 17 cutoffs (346 x 50 and 561 x 81)",
         "fig. 5.6: SIFT homing only, on all eight databases at the thesis' 1122 x 162, 4 snapshots per database "
         "(stride 9, as quick)",
         "figs. 6.10-6.15: the thesis' one-day grid (200 x 51 points, 1 and 2 degree steps, 40 minutes per scan)",
