@@ -421,7 +421,9 @@ _STAB_RULES = {
                "wavelength difference, one check per first channel: UV's four monotone (|Spearman rho| = 1), B's "
                "three and G's two monotone in UV's direction (a pair is monotone one way or the other)",
     "fig6_12": "as fig. 6.11 for logMSEvar",
-    "fig6_13": "logNRMSD after separation: every dual contrast nearly constant (max - min over the day <= 0.5)",
+    "fig6_13": "logNRMSD after separation: every dual contrast nearly constant (max - min over the day <= 0.5, "
+               "bionav's reading: on sky/object images logNRMSD is half the log of the fraction of pixels changing "
+               "class, so that fraction varies by less than a factor 10)",
     "fig6_14": "logMSEstd: the order of UV-B, UV-G, UV-R, UV-IR (day means) is monotone before separation and "
                "reversed after it",
     "fig6_15": "as fig. 6.14 for logMSEvar",
