@@ -240,3 +240,33 @@ def test_table6_5_does_not_check_marks_the_thesis_own_table_refutes(tmp_path):
         assert ir.passed is None and "table 6.4" in ir.detail
     (j_ir,) = _checks(out, "J: IR vs All marked ***")
     assert j_ir.passed is True
+
+
+def _diagnoses_script():
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "thesis_diagnoses.py"
+    spec = importlib.util.spec_from_file_location("thesis_diagnoses", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_evidence_script_marks_and_item_checks(tmp_path):
+    """scripts/thesis_diagnoses.py: the percentile rule of bionav's significance tables, one pair at a time, and an
+    item's checks evaluated on any run directory (here a hand-made fig. 6.11 run)."""
+    import json
+
+    import numpy as np
+
+    script = _diagnoses_script()
+    rng = np.random.default_rng(0)
+    assert script.percentile_mark(rng.normal(0.0, 1.0, 10_000)) == "o"
+    assert script.percentile_mark(rng.normal(2.5, 1.0, 10_000)) == "*"  # 0.6 % of the draws below 0
+    assert script.percentile_mark(rng.normal(5.0, 1.0, 10_000)) == "***"
+    means = {"UV-B": 0.4, "UV-G": 0.3, "UV-R": 0.2, "UV-IR": 0.1, "B-G": 0.3, "B-R": 0.2, "B-IR": 0.1,
+             "G-R": 0.2, "G-IR": 0.1}
+    _write_stability(tmp_path, means, "logMSEstd")
+    (tmp_path / "metrics.json").write_text(json.dumps({"status": "completed"}))
+    text = script.item_checks("fig6_11", str(tmp_path))
+    assert "holds (3 of 3 checks pass)" in text and "| G contrasts ordered" in text
