@@ -149,6 +149,7 @@ def run(args) -> int:
 
 def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> int:
     from bionav.machine import usable_cpus
+    from bionav.thesis.diagnoses import load_diagnoses
     from bionav.thesis.items import Context
     from bionav.thesis.outcome import Outcome
     from bionav.thesis.reference import load_reference
@@ -184,6 +185,7 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         return 0
 
     sections = []
+    diagnoses = load_diagnoses()
     for it in items:
         ref = ref_all.get(it.id, {})
         ctx = Context(preset=preset, out=out, ref=ref, results=results, ref_id=it.id)
@@ -200,7 +202,8 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         if it.id.startswith("tableB"):
             claims += list(ref_all.get("appendix_b_claims", []))
         sections.append(Section(it.id, it.label, ref.get("title", it.label), ref.get("source", ""), it.rule,
-                                outcome, [results[s.key] for s in {s.key: s for s in specs[it.id]}.values()], claims))
+                                outcome, [results[s.key] for s in {s.key: s for s in specs[it.id]}.values()], claims,
+                                diagnoses.get(it.id)))
     wall = time.time() - started
     command = "python -m bionav.thesis " + " ".join(argv_for_display(args))
     cpu = sum(r.cpu_seconds or 0.0 for r in results.values())
