@@ -25,6 +25,8 @@ import threading
 import numpy as np
 from numba import njit
 
+from bionav.homing.warping.normalise import _normalise_plane
+
 
 def column_distance_matrix(snapshot, current):
     """Reference column distances, plain numpy.
@@ -105,39 +107,6 @@ def _add_row_distances(af, a0, c0, width):
         for i in range(width):
             ui = np.uint64(i)
             af[ab + ui] += np.uint16(abs(np.int16(a0[ui] - c0[ud + ui])))
-
-
-@njit(nogil=True, fastmath=True, cache=True, inline="always")
-def _normalise_plane(acc, na, cn2, qf, t, out_k, step):
-    """One plane's diagonal sums ``acc`` (W, W) to 8-bit NSAD, de-interleaved into
-    ``out_k[d, i % step, i // step]``; ``t`` (W,) is scratch."""
-    width = na.shape[0]
-    n = width // step
-    for d in range(width):
-        nb = cn2[d:d + width]
-        ac = acc[d]
-        for i in range(width):
-            # the norms' sum in 32 bits (AVX2 has no packed 64-bit integer to float
-            # conversion, so an int64 sum kept this loop scalar there); a zero sum
-            # means two zero columns, whose distance sum is 0 as well: dividing it by 1
-            # gives the old 0.5 without a branch
-            den = np.float32(max(np.int32(na[i] + nb[i]), np.int32(1)))
-            t[i] = np.uint8(np.float32(ac[i]) * qf / den + np.float32(0.5))
-        o = out_k[d]
-        if step == 1:
-            o0 = o[0]
-            for m in range(n):
-                o0[m] = t[m]
-        elif step == 3:  # constant stride, one phase at a time: byte shuffles
-            for rr in range(3):
-                orr = o[rr]
-                for m in range(n):
-                    orr[m] = t[3 * m + rr]
-        else:
-            for rr in range(step):
-                orr = o[rr]
-                for m in range(n):
-                    orr[m] = t[m * step + rr]
 
 
 @njit(nogil=True, fastmath=True, cache=True)

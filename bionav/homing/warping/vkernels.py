@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from bionav.homing.warping.distance import _normalise_plane
+from bionav.homing.warping.normalise import _normalise_plane
 from bionav.homing.warping.simd import (
     LANES,
     add_absdiff_i16,
