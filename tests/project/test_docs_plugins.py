@@ -12,6 +12,20 @@ def _snippets() -> list[str]:
     return re.findall(r"```python\n(.*?)```", DOC.read_text(), flags=re.DOTALL)
 
 
+def _package_classes() -> dict[str, set[str]]:
+    """Module -> the classes it defines, of the packages this page writes out as ``file=`` blocks."""
+    import ast
+
+    from helpers import DOCS_FILE_BLOCK
+
+    out: dict[str, set[str]] = {}
+    for path, text in DOCS_FILE_BLOCK.findall(DOC.read_text()):
+        if path.endswith(".py"):
+            module = ".".join(path.split("/")[1:]).removesuffix(".py").removesuffix(".__init__")
+            out[module] = {n.name for n in ast.parse(text).body if isinstance(n, ast.ClassDef)}
+    return out
+
+
 def test_plugin_docs_snippets_run():
     snippets = _snippets()
     assert len(snippets) == 12  # a plugin and its test, per kind
@@ -38,7 +52,7 @@ def test_plugin_docs_example_rejects_bad_values():
     cls = namespace["HorizonWarpHoming"]
     with pytest.raises(UserError, match="homing.band_deg"):
         cls(cls.Config(band_deg=0.0), geometry=PanoramaGeometry.square_pixels(64, 16))
-    with pytest.raises(UserError, match="homing.directions must be 4..720, not 2"):
+    with pytest.raises(UserError, match=r"homing.directions=2: .*>= 4 and <= 720"):
         cls(cls.Config(directions=2), geometry=PanoramaGeometry.square_pixels(64, 16))
 
 
@@ -79,9 +93,13 @@ def test_plugin_docs_complete_pyproject_names_the_documented_plugins():
     namespace: dict = {"__name__": "docs_plugins"}
     for snippet in _snippets():
         exec(compile(snippet, str(DOC), "exec"), namespace)
+    packages = _package_classes()  # the experiment's package, written out file by file
     for group, entries in eps.items():
         for name, target in entries.items():
             module, _, attr = target.partition(":")
+            if module in packages:
+                assert attr in packages[module], f"{group} {name} = {target}: no such class in {module}"
+                continue
             assert module.startswith("my_package"), target
             if group != CONFIG_GROUP:
                 assert attr in namespace, f"{group} {name} = {target}: no such class in the snippets"
@@ -99,6 +117,18 @@ def _install_docs_plugins(site):
     return install_plugin_dist(site, "my-bionav-plugins", {
         "bionav.homing": {"horizon_warp": "my_homing:HorizonWarpHoming"},
         "bionav.sensors": {"noisy_compass": "my_sensors:NoisyCompass"}}, {"my_homing": homing, "my_sensors": sensor})
+
+
+def test_the_docs_homing_example_refuses_a_bad_range_before_the_run(tmp_path):
+    """`homing=horizon_warp homing.directions=2`: its `bounded` range refuses the value before Hydra makes a run
+    directory, one message naming the key and the range (issue 39: the check used to come after the start)."""
+    from helpers import assert_fails_cleanly, pythonpath_with, run_bionav
+
+    site = _install_docs_plugins(tmp_path / "site")
+    proc = run_bionav("homing=horizon_warp", "homing.directions=2", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path,
+                      env=pythonpath_with(site))
+    assert_fails_cleanly(proc, "homing.directions=2", ">= 4 and <= 720", code=2)
+    assert not (tmp_path / "run").exists()
 
 
 @pytest.mark.slow
