@@ -6,12 +6,12 @@ import csv
 import math
 import shutil
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
+from bionav.thesis.databases import db_meta  # noqa: F401  (its home is thesis/databases.py; the chapters use it from here)
 from bionav.thesis.outcome import Check, Outcome, Row, fmt
 from bionav.thesis.presets import Preset
 from bionav.thesis.runs import RunResult, RunSpec
@@ -110,18 +110,6 @@ def select_items(only: str | None) -> list[Item]:
 # ---------------------------------------------------------------------------
 # helpers: run specs
 # ---------------------------------------------------------------------------
-@lru_cache(maxsize=None)
-def db_meta(db: str) -> dict:
-    """Grid shape, spacing and the other settings of a database preset (composed through Hydra)."""
-    from omegaconf import OmegaConf
-
-    from bionav.config import compose
-
-    cfg = compose([f"db={db}"])
-    node = OmegaConf.to_container(cfg.db, resolve=False)
-    return {k: node.get(k) for k in ("name", "grid_shape", "spacing_m", "horizon_row", "image_size", "source")}
-
-
 def snapshot_list(db: str, k: int | None) -> list[int] | None:
     """``k`` snapshot indices spread evenly over a database's images (None: all).
 
