@@ -92,7 +92,8 @@ def stitch_shifts(counts, yaw, valid, rotation_index, sun_azimuth):
     """The stitched reference: per sample the shift (radians) that turns its yaw run into the first run's.
 
     Runs from :func:`yaw_runs`; each run's shift from the counts alone
-    (:func:`bionav.polcompass.array_calibration.yaw_run_shifts`) on the yaw against the sky
+    (:func:`bionav.polcompass.array_calibration.yaw_run_shifts`, 1 degree bins or as many as the shortest run
+    has samples) on the yaw against the sky
     (:func:`sky_frame_yaw`). A run that cannot be matched (nothing readable in common with the first,
     or turned further than the search) keeps shift 0.
 
@@ -108,7 +109,10 @@ def stitch_shifts(counts, yaw, valid, rotation_index, sun_azimuth):
 
     valid = np.asarray(valid, bool)
     runs = yaw_runs(yaw, rotation_index)
-    shifts = yaw_run_shifts(counts, sky_frame_yaw(yaw, sun_azimuth), valid, runs)
+    # rings no finer than the shortest run fills (1 degree for the recorded ~412 samples per turn): a ring with gaps
+    # between its bins matches the first run's only at the whole-bin shifts that happen to interleave
+    n_bins = int(max(36, min([360, *np.bincount(runs)[np.unique(runs)].tolist()])))
+    shifts = yaw_run_shifts(counts, sky_frame_yaw(yaw, sun_azimuth), valid, runs, n_bins=n_bins)
     readable = np.array([valid[runs == r].any() for r in range(shifts.size)])
     lost = np.flatnonzero(~np.isfinite(shifts) & readable).tolist()  # nothing readable: nothing decoded either
     return np.nan_to_num(shifts)[runs], runs, lost

@@ -195,10 +195,11 @@ def save_calibration(path, calibration, transfer: Transfer | None = None, proven
 def load_calibration(path):
     """``(ArrayCalibration, Transfer or None, learned_on or None)`` from a calibration file."""
     from bionav.errors import UserError
+    from bionav.files import user_path
     from bionav.polcompass.array_calibration import ArrayCalibration
 
-    cal = ArrayCalibration.load(path)
-    data = json.loads(Path(path).read_text())
+    cal = ArrayCalibration.load(path)  # size-capped, every field checked: what follows reads a valid file again
+    data = json.loads(user_path(path).read_text())
     transfer = None
     if isinstance(data.get("transfer"), dict):
         try:

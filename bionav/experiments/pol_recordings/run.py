@@ -124,7 +124,11 @@ def run(exp: PolRecordingsConfig, ctx) -> dict[str, Any]:
             "(e.g. recordings.path=../shared/data/celestial-compass)."
         )
     chosen, decoders = _decoders(cfg, ctx, exp)
-    prepared, bad_files = prepared_sessions(rc)
+    if rc.calibration not in ("none", "auto"):  # a bad calibration file is refused before the recordings load
+        from bionav.polcompass.transfer import load_calibration
+
+        load_calibration(rc.calibration)
+    prepared, bad_files = prepared_sessions(rc, progress=ctx.progress)
     tally = _score_all(ctx, exp, rc, prepared, calibration_for(prepared, rc, ctx, decoders[chosen], chosen), decoders,
                        chosen)
     if not tally.session_rows:
