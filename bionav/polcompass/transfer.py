@@ -181,7 +181,7 @@ def learned_on(datas, estimates, rc, decoder_name: str, days) -> dict:
     }
 
 
-def save_calibration(path, calibration, transfer: Transfer | None = None, provenance: dict | None = None) -> None:
+def save_pol_calibration(path, calibration, transfer: Transfer | None = None, provenance: dict | None = None) -> None:
     """Write ``calibration.json``: :meth:`ArrayCalibration.to_dict` plus the additive keys ``transfer`` and
     ``learned_on`` (schema ``bionav.pol_array_calibration/1`` unchanged; older readers ignore them)."""
     data = calibration.to_dict()
@@ -192,7 +192,7 @@ def save_calibration(path, calibration, transfer: Transfer | None = None, proven
     Path(path).write_text(json.dumps(data, indent=2))
 
 
-def load_calibration(path):
+def load_pol_calibration(path):
     """``(ArrayCalibration, Transfer or None, learned_on or None)`` from a calibration file."""
     from bionav.errors import UserError
     from bionav.files import user_path
@@ -210,4 +210,4 @@ def load_calibration(path):
     return cal, transfer, data.get("learned_on")
 
 
-__all__ = ["CalibrationLearner", "Transfer", "candidate_parts", "learned_on", "load_calibration", "save_calibration"]
+__all__ = ["CalibrationLearner", "Transfer", "candidate_parts", "learned_on", "load_pol_calibration", "save_pol_calibration"]

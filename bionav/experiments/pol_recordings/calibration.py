@@ -41,7 +41,7 @@ def applied(rc, cal, transfer, period: str, label: str):
 
 def _auto(prepared, rc, ctx, decoder, decoder_name: str):
     from bionav.polcompass.sessions import self_calibrate
-    from bionav.polcompass.transfer import CalibrationLearner, learned_on, save_calibration
+    from bionav.polcompass.transfer import CalibrationLearner, learned_on, save_pol_calibration
 
     estimates = self_calibrate(prepared, rc, progress=ctx.progress)
     learner = CalibrationLearner(prepared, rc, estimates, decoder)
@@ -49,7 +49,7 @@ def _auto(prepared, rc, ctx, decoder, decoder_name: str):
     evidence = rc.calibration_transfer == "evidence"
     if estimates:
         cal = learner.calibration(days, rc.calibration_parts)
-        save_calibration(ctx.dir / "calibration.json", cal, learner.transfer(days) if evidence else None,
+        save_pol_calibration(ctx.dir / "calibration.json", cal, learner.transfer(days) if evidence else None,
                          learned_on(prepared, estimates, rc, decoder_name, days))
     cache = {}
 
@@ -76,9 +76,9 @@ def calibration_for(prepared, rc, ctx, decoder, decoder_name: str):
         return _auto(prepared, rc, ctx, decoder, decoder_name)
     if rc.calibration == "none":
         return lambda day, period: (None, (), "none")
-    from bionav.polcompass.transfer import load_calibration
+    from bionav.polcompass.transfer import load_pol_calibration
 
-    cal, transfer, _learned = load_calibration(rc.calibration)
+    cal, transfer, _learned = load_pol_calibration(rc.calibration)
     if rc.calibration_transfer == "all" or transfer is None:
         transfer = None
         if "tilt" in rc.calibration_parts and cal.mount_tilt is None:

@@ -125,9 +125,9 @@ def run(exp: PolRecordingsConfig, ctx) -> dict[str, Any]:
         )
     chosen, decoders = _decoders(cfg, ctx, exp)
     if rc.calibration not in ("none", "auto"):  # a bad calibration file is refused before the recordings load
-        from bionav.polcompass.transfer import load_calibration
+        from bionav.polcompass.transfer import load_pol_calibration
 
-        load_calibration(rc.calibration)
+        load_pol_calibration(rc.calibration)
     prepared, bad_files = prepared_sessions(rc, progress=ctx.progress)
     tally = _score_all(ctx, exp, rc, prepared, calibration_for(prepared, rc, ctx, decoders[chosen], chosen), decoders,
                        chosen)
