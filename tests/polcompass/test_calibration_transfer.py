@@ -87,6 +87,11 @@ def test_a_canopy_folder_given_as_the_path_is_canopy_and_never_self_calibrates(t
     assert rows[0]["calibration"].startswith("none")  # canopy skies never self-calibrate
     assert "canopy_mae_deg_logged" in metrics and "tod_daylight_mae_deg" not in metrics
     assert metrics["canopy_mae_deg_stitched"] < 0.5  # the model sky, the restart repaired
+    # both rules, each named, in every output: the restart's 5 degrees cost the logged rule, not the stitched one
+    assert float(rows[0]["mae_deg_logged"]) > float(rows[0]["mae_deg_stitched"]) + 1.0
+    assert rows[0]["mae_deg"] == rows[0]["mae_deg_logged"]  # the default reference is the published rule
+    summary = (tmp_path / "canopy" / "summary.md").read_text()
+    assert "Pooled under the `logged` rule" in summary and "Pooled under the `stitched` rule" in summary
     # one session folder given as the path: the folder above it names the condition
     _m, rows = _pol_run(tmp_path, rec / "canopy_data" / "Sunday_15-05-22" / "17-05__Sunday_15-05-22", tmp_path / "one")
     assert [r["condition"] for r in rows] == ["canopy"]
