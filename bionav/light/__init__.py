@@ -39,7 +39,7 @@ from bionav.light.rayleigh import (
     rayleigh_polarization,
     scattering_angle,
 )
-from bionav.light.sun import SunPosition, parse_time, sun_position
+from bionav.light.sun import SunPosition, parse_time, sun_position, sun_track
 
 __all__ = [
     "CloudLayer",
@@ -58,4 +58,5 @@ __all__ = [
     "rayleigh_polarization",
     "scattering_angle",
     "sun_position",
+    "sun_track",
 ]

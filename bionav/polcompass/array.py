@@ -209,6 +209,13 @@ class UnitEvectors:
     pair_total: np.ndarray | None = None
     pol_op_valid: np.ndarray | None = None
 
+    def rows(self, index) -> "UnitEvectors":
+        """The samples ``index`` (an integer index or boolean mask over ``N``) of every field."""
+        pt = None if self.pair_total is None else self.pair_total[index]
+        ok = None if self.pol_op_valid is None else self.pol_op_valid[index]
+        return UnitEvectors(self.x[index], self.angle[index], self.degree[index], self.intensity[index],
+                            self.evector[index], pt, ok)
+
 
 def stokes_evector(counts, array: PolArray):
     """E-vector angle and degree of each unit from all its photodiodes (``solver="stokes"``).

@@ -292,12 +292,12 @@ def sun_from_sky_fit(ev: UnitEvectors, valid, *, table: SkyTable, array: PolArra
     fallback = _pol_op_rows(ev, usable) if pol_op_fallback else np.zeros_like(usable)
     if fallback.any():
         rows = np.flatnonzero(fallback)
-        sub = _rows(ev, rows)
+        sub = ev.rows(rows)
         f_score, f_total, f_ok = _pol_op_scores(sub, np.asarray(valid, bool)[rows], table=table, array=array,
                                                 noise_counts=noise_counts, model_error=model_error, min_units=min_units)
         rows, f_score, f_total = rows[f_ok], f_score[f_ok], f_total[f_ok]  # too few POL-OPs: the whole units' fit stays
         score[rows], total[rows] = f_score, f_total
-        bright[rows] = brightness_azimuth(_rows(ev, rows), np.isfinite(ev.intensity[rows]), array)
+        bright[rows] = brightness_azimuth(ev.rows(rows), np.isfinite(ev.intensity[rows]), array)
         usable = usable.copy()
         usable[rows] = True
     _, first, second, gap = _pick_pair(score, table.azimuths, total, margin)
@@ -313,13 +313,6 @@ def _pol_op_rows(ev: UnitEvectors, usable):
     if ev.pol_op_valid is None:
         return ~usable
     return ~usable | np.any(np.sum(ev.pol_op_valid, axis=-1) == 1, axis=-1)
-
-
-def _rows(ev: UnitEvectors, rows) -> UnitEvectors:
-    """Some samples of ``ev``."""
-    pt = None if ev.pair_total is None else ev.pair_total[rows]
-    ok = None if ev.pol_op_valid is None else ev.pol_op_valid[rows]
-    return UnitEvectors(ev.x[rows], ev.angle[rows], ev.degree[rows], ev.intensity[rows], ev.evector[rows], pt, ok)
 
 
 def pol_op_table(table: SkyTable, array: PolArray):

@@ -39,7 +39,7 @@ def fourier_basis(phi, n_harmonics: int):
     return np.stack([np.cos(ang), np.sin(ang)], axis=-1).reshape(phi.size, -1)
 
 
-def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2, scale: float = 1.0,
+def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2, scale=1.0,
                           max_error: float = np.deg2rad(30.0), min_samples: int = 20):
     """Fourier coefficients of one rotation session's heading errors against the solar azimuth in the device frame.
 
@@ -51,9 +51,9 @@ def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2, s
         ``wrap(heading - yaw - c)``, radians.
     n_harmonics : int
         ``H``.
-    scale : float
-        The curve is ``scale`` times the series: 1 (plain form) or ``tan(h)`` of the session's sun
-        elevation ``h`` (tilt form; the coefficients are then radians of tilt).
+    scale : float or ndarray, shape ``(N,)``
+        The curve is ``scale`` times the series: 1 (plain form) or ``tan(h)`` of the sun's elevation
+        ``h`` (the session's, or each sample's; tilt form: the coefficients are then radians of tilt).
     max_error : float
         Samples with ``|error|`` above it (a wrong member of the eq. 4.6 pair, a glitch) are left out, radians.
     min_samples : int
@@ -69,7 +69,8 @@ def deviation_from_errors(sun_sensor_azimuth, errors, *, n_harmonics: int = 2, s
     ok = np.isfinite(phi) & np.isfinite(e) & (np.abs(e) <= max_error)
     if ok.sum() < max(int(min_samples), 2 * int(n_harmonics)):
         return None
-    coef, *_ = np.linalg.lstsq(float(scale) * fourier_basis(phi[ok], n_harmonics), e[ok], rcond=None)
+    s = np.broadcast_to(np.asarray(scale, float), phi.shape)[ok]
+    coef, *_ = np.linalg.lstsq(s[:, None] * fourier_basis(phi[ok], n_harmonics), e[ok], rcond=None)
     return coef
 
 
@@ -79,13 +80,13 @@ def pooled_deviation(per_session):
     return np.median(np.stack(got), axis=0) if got else None
 
 
-def corrected_heading(heading, sun_sensor_azimuth, coefficients, *, scale: float = 1.0):
+def corrected_heading(heading, sun_sensor_azimuth, coefficients, *, scale=1.0):
     """``wrap(heading - scale D(phi))`` (radians; NaN headings stay NaN; ``coefficients`` None: unchanged;
-    ``scale``: see :func:`deviation_from_errors`)."""
+    ``scale``: a float or one per sample, see :func:`deviation_from_errors`)."""
     heading = np.asarray(heading, float)
     if coefficients is None:
         return heading
     coefficients = np.asarray(coefficients, float)
     phi = np.nan_to_num(np.asarray(sun_sensor_azimuth, float))
-    d = float(scale) * (fourier_basis(phi, coefficients.size // 2) @ coefficients)
+    d = np.asarray(scale, float) * (fourier_basis(phi, coefficients.size // 2) @ coefficients)
     return np.where(np.isfinite(heading), wrap_angle(heading - d), np.nan)

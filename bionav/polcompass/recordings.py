@@ -6,9 +6,9 @@ full rotation of the robot): a JSON object with ``pol_op_0`` ..
 ``azimuths`` (the ``K`` unit azimuths, radians, clockwise from the robot's
 front) and ``yaw`` (``N`` IMU yaw angles, radians, counter-clockwise, up to a
 constant). A *session* is a folder of such files named ``<n>.json``, in a
-folder named ``<HH-MM>__<Day>_<dd-mm-yy>`` (local time); a top folder named
-``canopy_data`` marks sessions under tree canopy, ``tod_data`` time-of-day
-sessions.
+folder named ``<HH-MM>__<Day>_<dd-mm-yy>`` (local time); a folder named
+``canopy_data`` on its path marks sessions under tree canopy, ``tod_data``
+time-of-day sessions (:func:`path_condition`).
 
 Faults are data: :func:`sample_validity` marks, per sample and unit,
 saturated, overflowing or dark counts and photodiode pairs whose total light
@@ -33,6 +33,8 @@ from bionav.errors import UserError
 
 ROTATION_FILE = re.compile(r"^(\d+)\.json$")
 SESSION_DIR = re.compile(r"^(\d{1,2})-(\d{2})__\w*?_?(\d{2})-(\d{2})-(\d{2})$")
+#: a path part naming a condition (:func:`path_condition`): the word ``canopy`` or ``tod`` at its start
+CONDITION_WORD = re.compile(r"^(canopy|tod)(?![a-z])")
 
 
 class RecordingError(UserError):
@@ -69,7 +71,7 @@ class Session:
     name : str
         Folder path relative to the recordings root.
     condition : str
-        ``tod``, ``canopy`` or ``other``.
+        ``tod``, ``canopy`` or ``unknown`` (:func:`path_condition`).
     local_time : datetime or None
         Start time, naive local time from the folder name.
     rotations : list of Rotation
@@ -184,14 +186,24 @@ def parse_session_time(folder: str) -> _dt.datetime | None:
         return None
 
 
-def _condition(parts) -> str:
-    for part in parts:
-        low = part.lower()
-        if low.startswith("canopy"):
-            return "canopy"
-        if low.startswith("tod"):
-            return "tod"
-    return "other"
+def path_condition(folder) -> str:
+    """The condition a session folder's path names: ``canopy``, ``tod`` or ``unknown``.
+
+    The folder's own name and every folder above it count, the nearest first: a part that is or starts
+    with the word ``canopy`` (``canopy_data``, ``Canopy-2022``; not ``canopyx``) marks sessions under tree
+    canopy, one with the word ``tod`` (``tod_data``; not ``today``) time-of-day sessions under open sky,
+    whichever is nearer the session. So
+    ``recordings.path`` may point at the whole recordings, a condition's folder, a day's folder or one
+    session. A path naming neither is ``unknown``: such a session is scored and reported under that
+    name and never self-calibrates (docs/polcompass.md).
+    """
+    from bionav.files import user_path
+
+    for part in reversed(user_path(folder).resolve().parts):
+        marker = CONDITION_WORD.match(part.lower())
+        if marker:
+            return marker.group(1)
+    return "unknown"
 
 
 def find_sessions(root) -> list[tuple[Path, list[Path]]]:
@@ -240,7 +252,7 @@ def load_sessions(root, *, n_photodiodes: int = 4):
     sessions, errors = [], []
     for folder, files in find_sessions(root):
         rel = folder.relative_to(root) if folder != root and root.is_dir() else Path(folder.name)
-        session = Session(str(rel), _condition(rel.parts or (folder.name,)), parse_session_time(folder.name))
+        session = Session(str(rel), path_condition(folder), parse_session_time(folder.name))
         for f in files:
             try:
                 session.rotations.append(load_rotation(f, n_photodiodes=n_photodiodes))

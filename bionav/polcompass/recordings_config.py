@@ -39,19 +39,31 @@ class RecordingsConfig:
         leave one day out; ``calibration.json`` of all days in the run folder) or the path of such a file.
     calibration_parts : which parts to apply: ``gains`` (photodiode gains), ``angles`` (polarizer offsets), ``tilt``
         (the sensor's first-order mount tilt, learned from the daylight rotations with the chosen decoder).
-        Default ``[angles]``: on the recordings the estimated gains made every decoder worse (docs/polcompass.md).
+        Default ``[angles, tilt]``: on the recordings the estimated gains made every decoder worse (docs/polcompass.md).
     calibration_conditions : the session conditions (``tod_daylight``, ``tod_dusk``, ``canopy``) a calibration is
         applied to; the others are decoded uncalibrated (``sessions.csv`` column ``calibration`` says why).
         Default: all three (docs/polcompass.md "Self-calibration": what leaving canopy out does, and why that is
         not the default).
     calibration_solver : ``pol_op`` (the POL-OP chain, each pair at its mean calibrated orientation) or
         ``stokes`` (every photodiode at its own angle, linear least squares).
-    reference : the heading reference the errors are taken against (the same for every decoder), always one
-        offset per session unless said: ``stitched`` (default: the yaw's runs between odometry restarts,
-        :func:`bionav.polcompass.recordings.yaw_restarts`, turned into the first run's reference by the counts'
-        sky ring alone), ``session`` (the logged yaw as it is; the authors align it once per session),
-        ``yaw_run`` (one offset per run) or ``rotation`` (one per file; a lower bound). docs/polcompass.md,
-        "The reference: the logged yaw restarts".
+    calibration_transfer : ``evidence`` (default: each condition gets only the parts that lowered its error on
+        every one of the calibration's own training days, by nested leave-one-day-out; none without such
+        evidence: :mod:`bionav.polcompass.transfer`) or ``all`` (every part wherever ``calibration_conditions``
+        allows, the behaviour before issue 41; a file without a transfer rule is applied so too).
+    reference : the heading reference of the default-named errors (``heading_mae_deg``, ``sessions.csv``
+        ``mae_deg``; the same for every decoder), always one offset per session unless said: ``session``
+        (default: the logged yaw as it is, the published rule: the authors align it once per session),
+        ``stitched`` (the yaw's runs between odometry restarts, :func:`bionav.polcompass.recordings.yaw_restarts`,
+        turned into the first run's reference by the counts' sky ring alone), ``yaw_run`` (one offset per run) or
+        ``rotation`` (one per file; a lower bound). Whatever is chosen, every output also names the errors under
+        the logged yaw (``*_logged``) and under the stitched yaw (``*_stitched``); the self-calibration always
+        fits on the stitched yaw (:mod:`bionav.polcompass.references`; docs/polcompass.md, "The reference").
+    sun : ``sample`` (default: every sample decoded against the ephemeris at its own time,
+        :mod:`bionav.polcompass.timebase`) or ``session`` (one sun position per session, at the folder's time:
+        the published analysis' choice, and bionav's before issue 41).
+    rotation_period_s : seconds from one rotation file's start to the next (the files hold no time stamps);
+        72 is measured from the sky's brightening or darkening within and between sessions
+        (:mod:`bionav.polcompass.timebase`).
     """
 
     path: Optional[str] = None
@@ -72,8 +84,11 @@ class RecordingsConfig:
     calibration: str = "none"
     calibration_parts: list[str] = bounded(["angles", "tilt"], length=(1, 3), item=Range(choices=("gains", "angles", "tilt")))
     calibration_solver: str = bounded("pol_op", choices=("pol_op", "stokes"))
+    calibration_transfer: str = bounded("evidence", choices=("evidence", "all"))
     calibration_conditions: list[str] = bounded(list(CONDITIONS), length=(0, 3), item=Range(choices=CONDITIONS))
-    reference: str = bounded("stitched", choices=("stitched", "session", "yaw_run", "rotation"))
+    reference: str = bounded("session", choices=("session", "stitched", "yaw_run", "rotation"))
+    sun: str = bounded("sample", choices=("sample", "session"))
+    rotation_period_s: float = bounded(72.0, ge=0.0, le=86400.0)
 
     def validate(self) -> None:
         """``exclude_units`` is ``auto``, ``none`` or a list of unit numbers (called by ``typed_config``)."""

@@ -25,42 +25,6 @@ from bionav.geometry import wrap_angle
 log = logging.getLogger(__name__)
 
 
-def circular_offset(decoded, yaw) -> float:
-    """``c``: circular mean of ``decoded - yaw`` over finite samples (radians)."""
-    d = np.asarray(decoded, float) - np.asarray(yaw, float)
-    d = d[np.isfinite(d)]
-    return float(np.angle(np.mean(np.exp(1j * d)))) if d.size else 0.0
-
-
-def session_errors(decoded, yaw, *, runs=None, undecoded_error: float = np.pi / 2.0):
-    """Errors ``wrap(decoded - yaw - c)`` with one ``c`` per reference run; undecoded samples get ``undecoded_error``.
-
-    ``runs`` (int, shape ``(N,)``) numbers the runs over which the logged yaw
-    keeps one reference (:attr:`SessionData.reference_run`, ``recordings.reference``);
-    None: one ``c`` for the whole session. A sample a decoder cannot decode
-    (NaN) counts as a 90 degree error, the mean absolute error of a guess;
-    ``sessions.csv`` also gives the MAE over decoded samples only
-    (``mae_decoded_deg``) and the decoded fraction.
-
-    Returns
-    -------
-    errors : ndarray, radians in ``[-pi, pi)``
-    c : float
-        The offset of the first run (radians).
-    """
-    decoded = np.asarray(decoded, float)
-    yaw = np.asarray(yaw, float)
-    runs = np.zeros(decoded.shape, int) if runs is None else np.asarray(runs)
-    offsets = np.zeros(decoded.shape)
-    first = None
-    for r in np.unique(runs):
-        sel = runs == r
-        offsets[sel] = circular_offset(decoded[sel], yaw[sel])
-        first = offsets[sel][0] if first is None else first
-    err = wrap_angle(decoded - yaw - offsets)
-    return np.where(np.isfinite(err), err, undecoded_error), float(first or 0.0)
-
-
 def build_array(rc, file_azimuths):
     """The :class:`~bionav.polcompass.array.PolArray` of the recorded sensor."""
     from bionav.polcompass.array import PolArray
@@ -86,12 +50,19 @@ def excluded_units(rc, faults, k: int) -> list[int]:
 
 @dataclass
 class SessionData:
-    """Everything one session needs for decoding, computed once."""
+    """Everything one session needs for decoding and scoring, computed once.
+
+    ``yaw`` is the logged yaw as it is; ``yaw + yaw_shift`` the stitched yaw
+    (:func:`bionav.polcompass.references.stitch_shifts`). ``sun`` is the sun at the session's start (its
+    condition, ``sessions.csv``); ``sun_azimuth`` / ``sun_elevation`` the sun at every sample
+    (``recordings.sun``; :mod:`bionav.polcompass.timebase`), which decoding and the sky rings use.
+    ``reference`` names ``recordings.reference``, the rule of the default-named errors.
+    """
 
     session: Any
     array: Any
     counts: np.ndarray  # (N, K, P)
-    yaw: np.ndarray
+    yaw: np.ndarray  # (N,): the logged yaw, radians CCW
     rotation_index: np.ndarray
     valid: np.ndarray
     evectors: Any
@@ -100,8 +71,33 @@ class SessionData:
     sun: Any
     period: str
     pol_op_valid: np.ndarray | None = None  # (N, K, J): both photodiodes of the POL-OP usable, unit not dropped
-    reference_run: np.ndarray | None = None  # (N,): runs of one yaw reference (recordings.reference); None: the session
-    yaw_shift: np.ndarray | None = None  # (N,): radians added to the logged yaw (recordings.reference=stitched)
+    yaw_shift: np.ndarray | None = None  # (N,): radians added to the logged yaw to stitch its runs; None: zeros
+    times: np.ndarray | None = None  # (N,): seconds since the session's start
+    sun_azimuth: np.ndarray | None = None  # (N,): radians CCW from east, unwrapped; None: ``sun`` throughout
+    sun_elevation: np.ndarray | None = None  # (N,): radians
+    reference: str = "session"
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.yaw)
+        if self.yaw_shift is None:
+            self.yaw_shift = np.zeros(n)
+        if self.sun_azimuth is None:
+            self.sun_azimuth = np.full(n, float(self.sun.azimuth))
+        if self.sun_elevation is None:
+            self.sun_elevation = np.full(n, float(self.sun.elevation))
+
+    @property
+    def stitched_yaw(self) -> np.ndarray:
+        """The logged yaw with its runs turned into the first run's reference, radians, ``(N,)``."""
+        return self.yaw + self.yaw_shift
+
+    @property
+    def sky_yaw(self) -> np.ndarray:
+        """The stitched yaw against the sky of the first sample (:func:`~bionav.polcompass.references.sky_frame_yaw`):
+        the yaw the self-calibration bins its rings by."""
+        from bionav.polcompass.references import sky_frame_yaw
+
+        return sky_frame_yaw(self.stitched_yaw, self.sun_azimuth)
 
 
 def session_evectors(counts, array, pol_op_valid, excluded):
@@ -114,9 +110,11 @@ def session_evectors(counts, array, pol_op_valid, excluded):
 
 
 def prepare_session(session, rc) -> SessionData:
-    """Counts, validity, e-vectors and the sun position of one session."""
+    """Counts, validity, e-vectors, the sun at every sample and the stitched yaw of one session."""
     from bionav.light import sun_position
     from bionav.polcompass.recordings import detect_faults, pol_op_validity, sample_validity
+    from bionav.polcompass.references import stitch_shifts
+    from bionav.polcompass.timebase import sample_times, session_sun
 
     rots = session.rotations
     counts = np.concatenate([r.counts for r in rots])
@@ -141,64 +139,43 @@ def prepare_session(session, rc) -> SessionData:
             "(local time, e.g. 13-00__Thursday_12-05-22) so the sun position can be computed."
         )
     sun = sun_position(when, latitude_deg=rc.latitude_deg, longitude_deg=rc.longitude_deg)
-    if session.condition == "canopy":
-        period = "canopy"
-    else:
-        period = "tod_daylight" if np.degrees(sun.elevation) >= rc.dusk_elevation_deg else "tod_dusk"
-    data = SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun, period, pol_ok)
-    return with_reference(data, rc.reference)
-
-
-def yaw_runs(data: SessionData) -> np.ndarray:
-    """Per sample, the run of the logged yaw between its restarts (int, ``(N,)``, from 0;
-    :func:`bionav.polcompass.recordings.yaw_restarts`)."""
-    from bionav.polcompass.recordings import yaw_restarts
-
-    index = np.asarray(data.rotation_index, int)
-    logged = data.yaw if data.yaw_shift is None else data.yaw - data.yaw_shift
-    starts = [logged[index == r] for r in range(int(index.max()) + 1 if index.size else 0)]
-    return (np.cumsum(yaw_restarts(starts)) - 1)[index]
-
-
-def with_reference(data: SessionData, reference: str) -> SessionData:
-    """The session scored under ``recordings.reference``.
-
-    ``session``: as logged, one offset. ``yaw_run``: one offset per run between the yaw's restarts
-    (:attr:`SessionData.reference_run`). ``stitched``: each run turned by its shift against the first
-    run, found from the counts alone (:func:`bionav.polcompass.array_calibration.yaw_run_shifts`), then
-    one offset (:attr:`SessionData.yaw` is the stitched yaw, :attr:`SessionData.yaw_shift` what was
-    added). ``rotation``: one offset per rotation file.
-    """
-    if reference == "session":
-        return data
-    if reference == "rotation":
-        return replace(data, reference_run=np.asarray(data.rotation_index, int))
-    runs = yaw_runs(data)
-    if reference == "yaw_run":
-        return replace(data, reference_run=runs)
-    from bionav.polcompass.array_calibration import yaw_run_shifts
-
-    shifts = yaw_run_shifts(data.counts, data.yaw, data.valid, runs)
-    readable = np.array([data.valid[runs == r].any() for r in range(shifts.size)])
-    lost = np.flatnonzero(~np.isfinite(shifts) & readable)  # a run with nothing readable decodes nothing anyway
-    if lost.size:
+    times = sample_times(index, rc.rotation_period_s)
+    azimuth, elevation = session_sun(when, times, latitude_deg=rc.latitude_deg, longitude_deg=rc.longitude_deg,
+                                     per_sample=rc.sun == "sample")
+    shift, _runs, lost = stitch_shifts(counts, yaw, valid, index, azimuth)
+    if lost:
         log.warning("%s: yaw run(s) %s are not stitched (shift 0): no readable counts in common with the first run, or "
-                    "turned more than 20 degrees against it", data.session.name, lost.tolist())
-    shift = np.nan_to_num(shifts)[runs]
-    return replace(data, yaw=data.yaw + shift, yaw_shift=shift)
+                    "turned more than 20 degrees against it", session.name, lost)
+    return SessionData(session, array, counts, yaw, index, valid, ev, faults, excluded, sun,
+                       session_period(session.condition, sun.elevation, rc.dusk_elevation_deg), pol_ok, shift, times,
+                       azimuth, elevation, rc.reference)
+
+
+def session_period(condition: str, sun_elevation: float, dusk_elevation_deg: float) -> str:
+    """The group a session is reported in: ``canopy``, ``tod_daylight`` / ``tod_dusk`` (time-of-day sessions with
+    the sun at least / below ``dusk_elevation_deg`` at the start) or ``unknown`` (a session whose condition the
+    path does not tell, :func:`bionav.polcompass.recordings.path_condition`)."""
+    if condition in ("canopy", "unknown"):
+        return condition
+    return "tod_daylight" if np.degrees(sun_elevation) >= dusk_elevation_deg else "tod_dusk"
 
 
 def calibration_sessions(datas, rc) -> list:
     """Sessions the self-calibration learns from: time-of-day sessions with the sun at least ``dusk_elevation_deg`` high.
 
     Clear skies only: the gauge of the common polarizer offset is the sky's mirror symmetry about the
-    solar meridian, which canopy breaks.
+    solar meridian, which canopy breaks; a session whose condition the path does not tell (``unknown``)
+    never calibrates.
     """
-    return [d for d in datas if d.period == "tod_daylight"]
+    return [d for d in datas if d.period == "tod_daylight" and d.session.condition == "tod"]
 
 
 def self_calibrate(datas, rc, *, progress=None):
     """Per-session self-calibrations (:func:`bionav.polcompass.array_calibration.calibrate_session`).
+
+    Each session's counts are binned by the yaw it has repaired itself, whatever reference the run scores
+    against: the stitched yaw against the sky of its first sample (:attr:`SessionData.sky_yaw`), so neither
+    an odometry restart nor the sun's motion turns one part of the session's ring against another.
 
     Returns
     -------
@@ -211,7 +188,7 @@ def self_calibrate(datas, rc, *, progress=None):
     chosen = calibration_sessions(datas, rc)
     for d in (progress(chosen, desc="self-calibration", total=len(chosen)) if progress else chosen):
         try:
-            out[d.session.name] = (d.session.day, calibrate_session(d.counts, d.yaw, d.valid, d.array))
+            out[d.session.name] = (d.session.day, calibrate_session(d.counts, d.sky_yaw, d.valid, d.array))
         except UserError as exc:
             log.warning("self-calibration skips %s: %s", d.session.name, exc)
     return out
@@ -245,6 +222,9 @@ def calibrated(data: SessionData, calibration, parts, solver: str = "pol_op") ->
 def decode_session(decoder, data: SessionData, mount_tilt=None):
     """Decode every sample of a session; returns ``(heading, resolved, seconds)``.
 
+    The heading is the sun's azimuth at each sample's time minus the decoded solar azimuth in the sensor
+    frame (:func:`~bionav.polcompass.decoders.heading_from_sun`); a decoder that needs the sun's elevation
+    gets each rotation's own (its mean over the rotation: it changes by at most about 0.2 degrees in one).
     ``mount_tilt`` (radians, ``(2,)``, :attr:`~bionav.polcompass.array_calibration.ArrayCalibration.mount_tilt`):
     its heading deviation ``tan(h) (a cos phi + b sin phi)`` is removed (:mod:`bionav.polcompass.deviation`).
     """
@@ -252,32 +232,47 @@ def decode_session(decoder, data: SessionData, mount_tilt=None):
     from bionav.polcompass.deviation import corrected_heading
 
     t0 = time.perf_counter()
-    est = decoder.decode(data.evectors, data.valid, array=data.array, sun_elevation=float(data.sun.elevation))
-    heading = heading_from_sun(est.azimuth, data.sun.azimuth)
+    elevation = np.asarray(data.sun_elevation, float)
+    if getattr(decoder, "needs_sun_elevation", False) and elevation.size and np.ptp(elevation) > 0:
+        azimuth = np.full(elevation.shape, np.nan)
+        resolved = np.zeros(elevation.shape, bool)
+        for r in np.unique(data.rotation_index):
+            sel = np.flatnonzero(data.rotation_index == r)
+            est = decoder.decode(data.evectors.rows(sel), data.valid[sel], array=data.array,
+                                 sun_elevation=float(np.mean(elevation[sel])))
+            azimuth[sel], resolved[sel] = est.azimuth, est.resolved
+    else:
+        est = decoder.decode(data.evectors, data.valid, array=data.array,
+                             sun_elevation=float(np.mean(elevation)) if elevation.size else float(data.sun.elevation))
+        azimuth, resolved = est.azimuth, est.resolved
+    heading = heading_from_sun(azimuth, data.sun_azimuth)
     if mount_tilt is not None:
-        heading = corrected_heading(heading, est.azimuth, mount_tilt, scale=float(np.tan(data.sun.elevation)))
-    return heading, np.asarray(est.resolved, bool), time.perf_counter() - t0
+        heading = corrected_heading(heading, azimuth, mount_tilt, scale=np.tan(elevation))
+    return heading, np.asarray(resolved, bool), time.perf_counter() - t0
 
 
-def mount_tilt(datas, rc, calibration, decoder, *, leave_out_day=None):
+def mount_tilt(datas, rc, calibration, decoder, *, leave_out_day=None, days=None, parts=None):
     """The sensor's first-order mount tilt (radians, ``(2,)``, or None) from the daylight rotations of the other days.
 
-    Each session (:func:`calibration_sessions`, not of ``leave_out_day``) is decoded through ``calibration``
-    with ``decoder``; its errors against the logged yaw are fitted with ``tan(h) (a cos phi + b sin phi)``
-    (:func:`bionav.polcompass.deviation.deviation_from_errors`, tilt form), and the sessions are pooled by
-    the median. Only the logged yaw is used, no heading truth.
+    Each session (:func:`calibration_sessions`, not of ``leave_out_day``; only of ``days`` if given) is decoded
+    through ``calibration`` (its ``parts``, default ``recordings.calibration_parts``) with ``decoder``; its errors
+    against the stitched yaw (one offset per session: the yaw the calibration repaired itself, whatever
+    ``recordings.reference`` scores against) are fitted with
+    ``tan(h) (a cos phi + b sin phi)`` (:func:`bionav.polcompass.deviation.deviation_from_errors`, tilt form,
+    ``h`` each sample's sun elevation), and the sessions are pooled by the median. No heading truth is used.
     """
     from bionav.polcompass.deviation import deviation_from_errors, pooled_deviation
+    from bionav.polcompass.references import session_errors
 
     fits = []
     for d in calibration_sessions(datas, rc):
-        if d.session.day == leave_out_day:
+        if d.session.day == leave_out_day or (days is not None and d.session.day not in days):
             continue
-        dc = calibrated(d, calibration, rc.calibration_parts, rc.calibration_solver)
+        dc = calibrated(d, calibration, rc.calibration_parts if parts is None else parts, rc.calibration_solver)
         heading, _resolved, _seconds = decode_session(decoder, dc)
-        err, _c = session_errors(heading, dc.yaw, runs=dc.reference_run)
-        fits.append(deviation_from_errors(wrap_angle(dc.sun.azimuth - heading), err, n_harmonics=1,
-                                          scale=float(np.tan(dc.sun.elevation))))
+        err, _c = session_errors(heading, dc.stitched_yaw)
+        fits.append(deviation_from_errors(wrap_angle(dc.sun_azimuth - heading), err, n_harmonics=1,
+                                          scale=np.tan(dc.sun_elevation)))
     return pooled_deviation(fits)
 
 
@@ -321,22 +316,28 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     variance common to a unit's photodiodes) and
     polarizer angle offsets ``sim_angle_sigma_deg`` (the decoder assumes the
     nominal device), with proportional noise and the same saturation; canopy
-    sessions get a cloud field of ``sim_canopy_cover``.
+    sessions get a cloud field of ``sim_canopy_cover``. The robot turns as the stitched yaw says (no
+    restarts: the simulated session's logged and stitched yaw are one) under the sun of each rotation
+    (:attr:`SessionData.sun_azimuth`, ``sun_elevation``: it moves as the real one did).
     """
-    from bionav.light import SkyModel, random_cloud_map
+    from bionav.light import SkyModel, SunPosition, random_cloud_map
     from bionav.polcompass.array import counts_from_stokes, stokes_from_sky
     from bionav.polcompass.recordings import photodiode_validity, pol_op_validity
 
     clouds = random_cloud_map(rng, cover=exp.sim_canopy_cover) if data.period == "canopy" and exp.sim_canopy_cover > 0 else None
-    model = SkyModel(data.sun, max_degree=exp.sim_max_degree, clouds=clouds)
     mount = float(rng.uniform(-np.pi, np.pi))
     offsets = np.deg2rad(exp.sim_angle_sigma_deg) * rng.standard_normal(data.array.polarizer_angles.shape)
     k = data.array.unit_tilts.shape
     device = replace(data.array, polarizer_angles=data.array.polarizer_angles + offsets,
                      unit_tilts=data.array.unit_tilts + np.deg2rad(exp.sim_tilt_sigma_deg) * rng.standard_normal(k),
                      unit_azimuths=data.array.unit_azimuths + np.deg2rad(exp.sim_azimuth_sigma_deg) * rng.standard_normal(k))
-    intensity, q, u = stokes_from_sky(model, device, mount + data.yaw)
-    counts = counts_from_stokes(intensity, q, u, device)
+    heading = mount + data.stitched_yaw
+    stokes = np.zeros((3,) + data.valid.shape)
+    for r in np.unique(data.rotation_index):  # the sky of each rotation
+        sel = data.rotation_index == r
+        sun = SunPosition(float(np.mean(data.sun_azimuth[sel])), float(np.mean(data.sun_elevation[sel])))
+        stokes[:, sel] = stokes_from_sky(SkyModel(sun, max_degree=exp.sim_max_degree, clouds=clouds), device, heading[sel])
+    counts = counts_from_stokes(*stokes, device)
     lit = data.counts[data.counts > 0]
     scale = (np.median(lit) if lit.size else 1000.0) / max(float(np.median(counts)), 1e-12)
     k, n_pd = counts.shape[1:]
@@ -345,7 +346,7 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     gains = np.exp(exp.sim_gain_sigma * z)
     counts = counts * scale * gains
     if exp.sim_view_sigma > 0:  # each photodiode's own smooth departure from the shared sky ring (world frame)
-        counts = counts * np.exp(exp.sim_view_sigma * view_field(rng, mount + data.yaw, data.array.unit_azimuths,
+        counts = counts * np.exp(exp.sim_view_sigma * view_field(rng, heading, data.array.unit_azimuths,
                                                                    counts.shape[-1], shared=exp.sim_view_shared))
     counts = counts * (1.0 + exp.sim_noise * rng.standard_normal(counts.shape))
     counts = np.clip(np.round(counts), 0, None)
@@ -356,7 +357,8 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     pol_ok[:, data.excluded] = False
     ev = session_evectors(counts, data.array, pol_ok, data.excluded)
     valid &= np.isfinite(ev.angle)
-    return replace(data, counts=counts, valid=valid, evectors=ev, pol_op_valid=pol_ok)
+    return replace(data, counts=counts, valid=valid, evectors=ev, pol_op_valid=pol_ok, yaw=data.stitched_yaw,
+                   yaw_shift=np.zeros(data.yaw.shape))
 
 
 def prepared_sessions(rc, progress=None) -> tuple[list, list]:
@@ -387,18 +389,15 @@ __all__ = [
     "build_array",
     "calibrated",
     "calibration_sessions",
-    "circular_offset",
     "decode_session",
     "excluded_units",
     "leave_one_day_out",
     "mount_tilt",
     "prepare_session",
     "prepared_sessions",
+    "session_period",
     "self_calibrate",
-    "session_errors",
     "session_evectors",
     "simulate_session",
     "view_field",
-    "with_reference",
-    "yaw_runs",
 ]

@@ -123,6 +123,7 @@ def test_the_command_self_calibrates_leaving_one_day_out(tmp_path):
         out = tmp_path / how
         proc = run_bionav("experiment=pol_recordings", f"recordings.path={root}", f"recordings.calibration={how}",
                           "recordings.calibration_parts=[gains,angles]", "recordings.calibration_solver=stokes",
+                          "recordings.calibration_transfer=all",  # two days: no nested leave-one-day-out evidence
                           "experiment.compare=[sky_fit]", "experiment.simulate=false", f"hydra.run.dir={out}", cwd=tmp_path)
         assert proc.returncode == 0, proc.stderr
         runs[how] = json.loads((out / "metrics.json").read_text())
@@ -150,9 +151,9 @@ def test_the_command_self_calibrates_leaving_one_day_out(tmp_path):
 @pytest.mark.slow  # over 5 s on two cores
 @needs_data
 def test_a_real_daylight_session_self_calibrates():
+    from bionav.polcompass.recordings import load_sessions
     from bionav.polcompass.recordings_config import RecordingsConfig
     from bionav.polcompass.sessions import prepare_session
-    from bionav.polcompass.recordings import load_sessions
 
     sessions, _ = load_sessions(COMPASS / "tod_data" / "Thursday_12-05-22" / "17-01__Thursday_12-05-22")
     data = prepare_session(sessions[0], RecordingsConfig())

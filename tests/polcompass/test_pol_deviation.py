@@ -9,6 +9,7 @@ from helpers import external_data, run_bionav
 
 from bionav.geometry import wrap_angle
 from bionav.polcompass.deviation import corrected_heading, deviation_from_errors, fourier_basis, pooled_deviation
+from bionav.polcompass.references import session_errors
 
 COMPASS = external_data() / "celestial-compass"
 
@@ -54,10 +55,9 @@ def test_pooling_is_the_median_and_too_few_samples_give_none():
 @pytest.mark.slow
 @pytest.mark.skipif(not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)")
 def test_deviation_bench_learns_on_the_other_day(tmp_path):
+    from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
     from bionav.polcompass import recordings_config as pr
     from bionav.polcompass import sessions as ps
-    from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
-    from bionav.polcompass.decoders import heading_from_sun
 
     days = {"12-05-22": "17-01__Thursday_12-05-22", "14-05-22": "08-30__Saturday_14-05-22"}
     for day, folder in days.items():
@@ -69,21 +69,22 @@ def test_deviation_bench_learns_on_the_other_day(tmp_path):
     lines = [json.loads(line) for line in proc.stdout.splitlines()]
     daylight = lines[0]
     assert daylight["condition"] == "tod_daylight" and len(lines) == 2
-    # the same numbers in-process: each session corrected with the curve of the *other* day's session
+    # the same numbers in-process: each session corrected with the curve learned on the *other* day's session (its
+    # errors against the stitched yaw), scored against the logged yaw (the published rule)
     rc = pr.recordings_config({"path": str(tmp_path / "rec")})
     prepared, _ = ps.prepared_sessions(rc)
     dec = SkyFit(SkyFitConfig())
     out = []
     for d in prepared:
-        phi = dec.decode(d.evectors, d.valid, array=d.array, sun_elevation=float(d.sun.elevation)).azimuth
-        heading = heading_from_sun(phi, d.sun.azimuth)
-        out.append((heading, phi, ps.session_errors(heading, d.yaw)[0], d.yaw))
+        heading = ps.decode_session(dec, d)[0]
+        phi = wrap_angle(d.sun_azimuth - heading)
+        out.append((heading, phi, session_errors(heading, d.yaw)[0], d.yaw, session_errors(heading, d.stitched_yaw)[0]))
     before = np.concatenate([o[2] for o in out])
     after = []
-    for i, (heading, phi, _err, yaw) in enumerate(out):
+    for i, (heading, phi, _err, yaw, _stitched) in enumerate(out):
         other = out[1 - i]
-        curve = deviation_from_errors(other[1], other[2], n_harmonics=1)
-        after.append(ps.session_errors(corrected_heading(heading, phi, curve), yaw)[0])
+        curve = deviation_from_errors(other[1], other[4], n_harmonics=1)
+        after.append(session_errors(corrected_heading(heading, phi, curve), yaw)[0])
     assert daylight["n_samples"] == before.size
     assert daylight["mae_deg"] == pytest.approx(np.degrees(np.mean(np.abs(before))), abs=1e-3)
     assert daylight["mae_deviation_removed_deg"] == pytest.approx(np.degrees(np.mean(np.abs(np.concatenate(after)))),
@@ -99,7 +100,8 @@ def test_deviation_bench_learns_on_the_other_day(tmp_path):
     for parts, key in (("[angles]", "mae_deg"), ("[angles,tilt]", "mae_deviation_removed_deg")):
         out = tmp_path / f"run{len(parts)}"
         run = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path / 'rec'}", "recordings.calibration=auto",
-                         f"recordings.calibration_parts={parts}", "experiment.simulate=false",
+                         f"recordings.calibration_parts={parts}", "recordings.calibration_transfer=all",
+                         "experiment.simulate=false",
                          "experiment.compare=[sky_fit]", f"hydra.run.dir={out}", cwd=tmp_path)
         assert run.returncode == 0, run.stderr
         metrics = json.loads((out / "metrics.json").read_text())
@@ -115,30 +117,17 @@ def test_deviation_bench_refuses_a_bad_harmonics_count(tmp_path):
     assert proc.returncode == 2 and "--harmonics" in proc.stderr and "Traceback" not in proc.stderr
 
 
-def _rotation_files(root, day_folder, when, date, *, n=120, mount_deg=30.0):
-    """Two fan-8 rotations under the model sky at ``date`` ``when`` (CEST, Sardinia), unit 7 polarization-blind."""
-    from bionav.light import SkyModel, sun_position
-    from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
+def _rotation_files(root, day_folder, when, *, n=120, mount_deg=30.0):
+    """Two fan-8 rotations under the model sky at each sample's time (CEST, Sardinia), unit 7 polarization-blind."""
+    from bionav.testing.polcompass import write_model_session
 
-    arr = PolArray.fan8()
-    sun = sun_position(f"{date}T{when[:2]}:{when[3:5]}:00+02:00", latitude_deg=39.2, longitude_deg=9.1)
-    folder = root / "tod_data" / day_folder / when
-    folder.mkdir(parents=True)
-    for r in range(2):
-        yaw = np.linspace(-np.pi, np.pi, n, endpoint=False) + 0.01 * r
-        inten, q, u = stokes_from_sky(SkyModel(sun, max_degree=0.5), arr, np.deg2rad(mount_deg) + yaw)
-        counts = np.round(counts_from_stokes(3000.0 * inten, q, u, arr))
-        counts[:, 7, 1], counts[:, 7, 3] = counts[:, 7, 0], counts[:, 7, 2]
-        data = {f"pol_op_{k}": counts[:, k, :].tolist() for k in range(8)}
-        data["azimuths"] = np.deg2rad([0.0, 90.0, 180.0, 270.0, 45.0, 135.0, 225.0, 315.0]).tolist()
-        data["yaw"] = yaw.tolist()
-        (folder / f"{r + 1}.json").write_text(json.dumps(data))
+    write_model_session(root / "tod_data" / day_folder / when, samples=n, mount_deg=mount_deg)
 
 
 def test_pol_recordings_learns_a_mount_tilt_from_the_other_days_and_removes_it(tmp_path):
+    from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
     from bionav.polcompass import recordings_config as pr
     from bionav.polcompass import sessions as ps
-    from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
     from bionav.polcompass.decoders import SunEstimate
 
     class Tilted(SkyFit):  # the decoder of a sensor tilted by (a, b): azimuths off by tan(h) (a cos phi + b sin phi)
@@ -149,9 +138,9 @@ def test_pol_recordings_learns_a_mount_tilt_from_the_other_days_and_removes_it(t
             dev = np.tan(sun_elevation) * (fourier_basis(est.azimuth, 1) @ self.tilt)
             return SunEstimate(wrap_angle(est.azimuth - dev), est.alternative, est.resolved)
 
-    _rotation_files(tmp_path, "Thursday_12-05-22", "13-00__Thursday_12-05-22", "2022-05-12")
-    _rotation_files(tmp_path, "Thursday_12-05-22", "17-00__Thursday_12-05-22", "2022-05-12")
-    _rotation_files(tmp_path, "Saturday_14-05-22", "10-00__Saturday_14-05-22", "2022-05-14")
+    _rotation_files(tmp_path, "Thursday_12-05-22", "13-00__Thursday_12-05-22")
+    _rotation_files(tmp_path, "Thursday_12-05-22", "17-00__Thursday_12-05-22")
+    _rotation_files(tmp_path, "Saturday_14-05-22", "10-00__Saturday_14-05-22")
     rc = pr.recordings_config({"path": str(tmp_path), "calibration_parts": ["tilt"]})
     prepared, bad = ps.prepared_sessions(rc)
     assert not bad and len(prepared) == 3
@@ -160,8 +149,8 @@ def test_pol_recordings_learns_a_mount_tilt_from_the_other_days_and_removes_it(t
     tilt = ps.mount_tilt(prepared, rc, None, dec, leave_out_day="2022-05-14")
     np.testing.assert_allclose(np.degrees(tilt), [1.5, -2.0], atol=0.1)
     held_out = next(d for d in prepared if d.session.day == "2022-05-14")
-    before = ps.session_errors(ps.decode_session(dec, held_out)[0], held_out.yaw)[0]
-    after = ps.session_errors(ps.decode_session(dec, held_out, tilt)[0], held_out.yaw)[0]
+    before = session_errors(ps.decode_session(dec, held_out)[0], held_out.yaw)[0]
+    after = session_errors(ps.decode_session(dec, held_out, tilt)[0], held_out.yaw)[0]
     assert np.degrees(np.mean(np.abs(before))) > 1.0 > 10 * np.degrees(np.mean(np.abs(after)))
     assert ps.mount_tilt(prepared, rc, None, dec, leave_out_day="2022-05-12") is not None
 

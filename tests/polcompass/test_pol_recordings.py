@@ -8,39 +8,20 @@ import numpy as np
 import pytest
 from helpers import external_data, run_bionav
 
-from bionav.light import SkyModel, sun_position
-from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
 from bionav.polcompass.recordings import RecordingError, detect_faults, load_rotation, load_sessions
+from bionav.testing.polcompass import write_model_session
 
 COMPASS = external_data() / "celestial-compass"
 needs_data = pytest.mark.skipif(
     not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)"
 )
-FILE_AZIMUTHS = np.deg2rad([0.0, 90.0, 180.0, 270.0, 45.0, 135.0, 225.0, 315.0])
 
 
-def _write_rotation(path, counts, yaw, azimuths=FILE_AZIMUTHS):
-    data = {f"pol_op_{k}": counts[:, k, :].tolist() for k in range(counts.shape[1])}
-    data["azimuths"] = list(map(float, azimuths))
-    data["yaw"] = list(map(float, yaw))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(data))
-
-
-def _synthetic_session(root, *, when="13-00__Thursday_12-05-22", rotations=2, n=90, mount_deg=30.0, blind_unit=7):
-    """Rotation files of the fan-8 under the model sky at the folder's time and place (Sardinia, CEST)."""
-    arr = PolArray.fan8()
-    sun = sun_position("2022-05-12T" + when[:2] + ":" + when[3:5] + ":00+02:00", latitude_deg=39.2, longitude_deg=9.1)
-    sky = SkyModel(sun, max_degree=0.5)
-    folder = root / "tod_data" / "Thursday_12-05-22" / when
-    for r in range(rotations):
-        yaw = np.linspace(-np.pi, np.pi, n, endpoint=False) + 0.01 * r
-        inten, q, u = stokes_from_sky(sky, arr, np.deg2rad(mount_deg) + yaw)
-        counts = np.round(counts_from_stokes(3000.0 * inten, q, u, arr))
-        counts[:, blind_unit, 1] = counts[:, blind_unit, 0]  # a polarization-blind unit, as on the real sensor
-        counts[:, blind_unit, 3] = counts[:, blind_unit, 2]
-        _write_rotation(folder / f"{r + 1}.json", counts, yaw)
-    return folder
+def _synthetic_session(root, *, when="13-00__Thursday_12-05-22", rotations=2, n=90, mount_deg=30.0, blind_unit=7,
+                       **kw):
+    """Rotation files of the fan-8 under the model sky at each sample's time and place (Sardinia, CEST)."""
+    return write_model_session(root / "tod_data" / "Thursday_12-05-22" / when, rotations=rotations, samples=n,
+                               mount_deg=mount_deg, blind_unit=blind_unit, **kw)
 
 
 def test_loader_reads_a_rotation_and_rejects_bad_files_naming_file_and_field(tmp_path):
@@ -177,7 +158,7 @@ def test_experiment_on_one_real_session(tmp_path):
 
 @pytest.mark.slow
 def test_pol_compass_rotation_runs_on_recorded_counts_and_replays_exactly(tmp_path):
-    folder = _synthetic_session(tmp_path / "rec", rotations=1, n=60)
+    folder = _synthetic_session(tmp_path / "rec", rotations=1, n=60, rotation_period_s=0.0)  # one sky time
     sky = ["experiment.sky.time=2022-05-12T13:00:00+02:00", "experiment.sky.latitude_deg=39.2",
            "experiment.sky.longitude_deg=9.1"]
     rec = tmp_path / "a"

@@ -7,38 +7,28 @@ import numpy as np
 import pytest
 from helpers import run_bionav
 
-from bionav.light import SkyModel, sun_position
-from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
-
-AZIMUTHS = np.deg2rad([0.0, 90.0, 180.0, 270.0, 45.0, 135.0, 225.0, 315.0]).tolist()
+from bionav.testing.polcompass import write_model_session
 
 
-def _session(root, kind, day_folder, when, date, *, n=120, overflow=False):
+def _session(root, kind, day_folder, when, *, n=120, overflow=False):
     """Two fan-8 rotations under the model sky (CEST, Sardinia), unit 7 polarization-blind; ``overflow``: every
     unit but unit 0 has one photodiode pair overflowing (32768) at every sample."""
-    arr = PolArray.fan8()
-    sun = sun_position(f"{date}T{when[:2]}:{when[3:5]}:00+02:00", latitude_deg=39.2, longitude_deg=9.1)
-    folder = root / kind / day_folder / when
-    folder.mkdir(parents=True)
-    for r in range(2):
-        yaw = np.linspace(-np.pi, np.pi, n, endpoint=False) + 0.01 * r
-        inten, q, u = stokes_from_sky(SkyModel(sun, max_degree=0.5), arr, np.deg2rad(30.0) + yaw)
-        counts = np.round(counts_from_stokes(3000.0 * inten, q, u, arr))
-        counts[:, 7, 1], counts[:, 7, 3] = counts[:, 7, 0], counts[:, 7, 2]
-        if overflow:
-            counts[:, 1:4, 0:2] = 32768.0
-            counts[:, 4:7, 2:4] = 32768.0
-        data = {f"pol_op_{k}": counts[:, k, :].tolist() for k in range(8)}
-        data["azimuths"], data["yaw"] = AZIMUTHS, yaw.tolist()
-        (folder / f"{r + 1}.json").write_text(json.dumps(data))
+    folder = write_model_session(root / kind / day_folder / when, samples=n)
+    for f in folder.glob("*.json") if overflow else ():
+        data = json.loads(f.read_text())
+        counts = np.stack([np.asarray(data[f"pol_op_{k}"], float) for k in range(8)], axis=1)
+        counts[:, 1:4, 0:2] = 32768.0
+        counts[:, 4:7, 2:4] = 32768.0
+        data.update({f"pol_op_{k}": counts[:, k, :].tolist() for k in range(8)})
+        f.write_text(json.dumps(data))
 
 
 @pytest.mark.slow
 def test_calibration_applies_only_in_the_listed_conditions(tmp_path):
     rec = tmp_path / "rec"
-    _session(rec, "tod_data", "Thursday_12-05-22", "13-00__Thursday_12-05-22", "2022-05-12")
-    _session(rec, "tod_data", "Saturday_14-05-22", "10-00__Saturday_14-05-22", "2022-05-14")
-    _session(rec, "canopy_data", "Sunday_15-05-22", "17-05__Sunday_15-05-22", "2022-05-15")
+    _session(rec, "tod_data", "Thursday_12-05-22", "13-00__Thursday_12-05-22")
+    _session(rec, "tod_data", "Saturday_14-05-22", "10-00__Saturday_14-05-22")
+    _session(rec, "canopy_data", "Sunday_15-05-22", "17-05__Sunday_15-05-22")
     out = tmp_path / "run"
     proc = run_bionav("experiment=pol_recordings", f"recordings.path={rec}", "recordings.calibration=auto",
                       "recordings.calibration_conditions=[tod_daylight]", "experiment.simulate=false",
@@ -57,7 +47,7 @@ def test_calibration_applies_only_in_the_listed_conditions(tmp_path):
 def test_overflowing_pairs_are_decoded_from_the_other_pol_op(tmp_path):
     # only unit 0 reads both POL-OPs: per unit nothing is decodable, per POL-OP the model sky gives the heading
     rec = tmp_path / "rec"
-    _session(rec, "tod_data", "Thursday_12-05-22", "17-00__Thursday_12-05-22", "2022-05-12", overflow=True)
+    _session(rec, "tod_data", "Thursday_12-05-22", "17-00__Thursday_12-05-22", overflow=True)
     results = {}
     for fallback in ("true", "false"):
         out = tmp_path / fallback

@@ -5,11 +5,12 @@ Compass swinging on the real-sky recordings (:mod:`bionav.polcompass.deviation`)
 calibration, or ``--calibration auto``: each day through the self-calibration of the other days) and
 decoded with ``--decoder`` (default ``sky_fit``); for each day a Fourier deviation
 curve in the solar azimuth of the device frame (``--harmonics``; ``--form tilt``: times the tangent of
-the sun's elevation, a mount tilt to first order) is learned from the clear-sky
-daylight sessions of the *other* days (errors against the logged yaw, one constant per session,
-per-session fits pooled by the median) and removed from that day's headings. Printed: one JSON
-object per condition (``tod_daylight``, ``tod_dusk``, ``canopy``) with the pooled MAE in degrees
-before and after (undecoded samples count 90 degrees, as in ``experiment=pol_recordings``), then
+the sun's elevation at each sample, a mount tilt to first order) is learned from the clear-sky
+daylight sessions of the *other* days (errors against the stitched yaw, one constant per session, as
+the calibration's mount tilt; per-session fits pooled by the median) and removed from that day's headings.
+Printed: one JSON object per condition (``tod_daylight``, ``tod_dusk``, ``canopy``) with the pooled MAE in
+degrees before and after under the published rule (the logged yaw, one constant per session; undecoded
+samples count 90 degrees, as in ``experiment=pol_recordings``), then
 one with the curve learned from all days without array calibration (``D(phi)`` coefficients in degrees,
 ``[a1, b1, a2, ...]``).
 """
@@ -21,6 +22,7 @@ import json
 import numpy as np
 
 from bionav.polcompass.recordings_config import CONDITIONS as GROUPS
+from bionav.polcompass.references import session_errors
 
 
 def _prepared(path: str):
@@ -32,29 +34,31 @@ def _prepared(path: str):
 
 
 def _decoded(prepared, dec, calibration=None):
-    """``(session data, heading, sun azimuth in the device frame, errors)`` per session, through ``calibration``."""
+    """``(session data, heading, sun azimuth in the device frame, errors against the logged yaw, against the stitched
+    yaw)`` per session, through ``calibration`` (its angles)."""
+    from bionav.geometry import wrap_angle
     from bionav.polcompass import sessions as ps
-    from bionav.polcompass.decoders import heading_from_sun
 
     out = []
     for d in prepared:
         d = ps.calibrated(d, calibration, ["angles"])
-        est = dec.decode(d.evectors, d.valid, array=d.array, sun_elevation=float(d.sun.elevation))
-        heading = heading_from_sun(est.azimuth, d.sun.azimuth)
-        out.append((d, heading, est.azimuth, ps.session_errors(heading, d.yaw)[0]))
+        heading = ps.decode_session(dec, d)[0]
+        out.append((d, heading, wrap_angle(d.sun_azimuth - heading), session_errors(heading, d.yaw)[0],
+                    session_errors(heading, d.stitched_yaw)[0]))
     return out
 
 
-def _scale(d, form: str) -> float:
-    return float(np.tan(d.sun.elevation)) if form == "tilt" else 1.0
+def _scale(d, form: str):
+    return np.tan(d.sun_elevation) if form == "tilt" else 1.0
 
 
 def _learn(decoded, n_harmonics: int, form: str, *, leave_out_day=None):
     from bionav.polcompass.deviation import deviation_from_errors, pooled_deviation
 
     return pooled_deviation([deviation_from_errors(phi, err, n_harmonics=n_harmonics, scale=_scale(d, form))
-                             for d, _h, phi, err in decoded
-                             if d.period == "tod_daylight" and d.session.day != leave_out_day])
+                             for d, _h, phi, _logged, err in decoded
+                             if d.period == "tod_daylight" and d.session.condition == "tod"
+                             and d.session.day != leave_out_day])
 
 
 def main(argv=None) -> int:
@@ -85,11 +89,11 @@ def main(argv=None) -> int:
     for day in days:  # the day's array calibration (auto: of the other days) on every session, the curve of the others
         decoded = _decoded(prepared, dec, ps.leave_one_day_out(estimates, day)[0]) if estimates else uncalibrated
         curve = _learn(decoded, args.harmonics, args.form, leave_out_day=day)
-        for d, heading, phi, err in decoded:
+        for d, heading, phi, err, _stitched in decoded:
             if d.session.day == day:
                 before[d.period].append(err)
                 fixed = corrected_heading(heading, phi, curve, scale=_scale(d, args.form))
-                after[d.period].append(ps.session_errors(fixed, d.yaw)[0])
+                after[d.period].append(session_errors(fixed, d.yaw)[0])
     for g in GROUPS:
         if before[g]:
             print(json.dumps({"condition": g, "decoder": args.decoder, "harmonics": args.harmonics, "form": args.form,

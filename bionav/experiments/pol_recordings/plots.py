@@ -121,36 +121,41 @@ def sim_vs_real(path, real, sim, decoder) -> None:
     save_figure(fig, path, dpi=DPI)
 
 
-def yaw_reference(path, per_session, decoder, reference: str) -> None:
-    """Per-rotation circular mean of the scored heading error over decoded samples (chosen decoder), sessions in a row.
+def yaw_reference(path, per_session, decoder) -> None:
+    """Per-rotation circular mean of the heading error over decoded samples (chosen decoder), sessions in a row,
+    under the logged yaw (top, the published rule) and the stitched yaw (bottom).
 
-    Each run of the logged yaw is its own line; red dotted lines mark the rotations whose logged yaw restarts
-    (:func:`bionav.polcompass.recordings.yaw_restarts`): steps of the mean there are the
-    yaw reference moving, not the decoder (docs/polcompass.md, "The reference").
+    ``per_session``: ``(session, data, errors by rule, decoded)``. Each run of the logged yaw is its own line; red
+    dotted lines mark the rotations whose logged yaw restarts (:func:`bionav.polcompass.recordings.yaw_restarts`):
+    steps of the mean there are the yaw reference moving, not the decoder (docs/polcompass.md, "The reference").
     """
-    from bionav.polcompass.sessions import circular_offset, yaw_runs
+    from bionav.polcompass.references import circular_offset, yaw_runs
 
     plt = pyplot()
     n_rot = sum(int(d.rotation_index.max()) + 1 for _s, d, *_ in per_session)
-    fig, ax = plt.subplots(figsize=(max(6.0, 0.05 * n_rot + 2.0), 4.0))
-    x0 = 0
-    for i, (_s, d, err, decoded) in enumerate(per_session):
-        r = int(d.rotation_index.max()) + 1
-        runs = yaw_runs(d)
-        means = []
-        for j in range(r):
-            e = err[(d.rotation_index == j) & decoded]  # undecoded samples (scored 90 degrees) left out
-            means.append(np.degrees(circular_offset(e, 0.0)) if e.size else np.nan)
-        run_of = np.array([runs[d.rotation_index == j][0] for j in range(r)])
-        for run in np.unique(run_of):  # one line per run of the yaw: a step between lines is the reference moving
-            js = np.flatnonzero(run_of == run)
-            ax.plot(x0 + js, np.asarray(means)[js], ".-", color="C0" if i % 2 == 0 else "C1", lw=0.9, ms=3)
-        for j in np.flatnonzero(np.diff(run_of)) + 1:
-            ax.axvline(x0 + j - 0.5, color="C3", lw=0.6, ls=":")
-        x0 += r + 1
-    ax.axhline(0.0, color="0.6", lw=0.6)
-    ax.set_xlabel("rotation (sessions one after another, alternating colours)")
-    ax.set_ylabel("mean heading error of the rotation (deg)")
-    ax.set_title(f"per-rotation mean error, decoder={decoder}, recordings.reference={reference}\n"
-                 "one line per run of the logged yaw; red dotted: the yaw restarts (odometry restart)", fontsize=9)
+    fig, axes = plt.subplots(2, 1, figsize=(max(6.0, 0.05 * n_rot + 2.0), 6.5), sharex=True)
+    for ax, rule in zip(axes, ("logged", "stitched")):
+        x0 = 0
+        for i, (_s, d, errs, decoded) in enumerate(per_session):
+            r = int(d.rotation_index.max()) + 1
+            err = errs[rule]
+            means = []
+            for j in range(r):
+                e = err[(d.rotation_index == j) & decoded]  # undecoded samples (scored 90 degrees) left out
+                means.append(np.degrees(circular_offset(e, 0.0)) if e.size else np.nan)
+            runs = yaw_runs(d.yaw, d.rotation_index)
+            run_of = np.array([runs[d.rotation_index == j][0] for j in range(r)])
+            for run in np.unique(run_of):  # one line per run of the yaw: a step between lines is the reference moving
+                js = np.flatnonzero(run_of == run)
+                ax.plot(x0 + js, np.asarray(means)[js], ".-", color="C0" if i % 2 == 0 else "C1", lw=0.9, ms=3)
+            for j in np.flatnonzero(np.diff(run_of)) + 1:
+                ax.axvline(x0 + j - 0.5, color="C3", lw=0.6, ls=":")
+            x0 += r + 1
+        ax.axhline(0.0, color="0.6", lw=0.6)
+        ax.set_ylabel("rotation's mean error (deg)")
+        ax.set_title(f"{rule} yaw" + (" (the published rule)" if rule == "logged" else " (repaired from the counts)"),
+                     fontsize=9)
+    axes[-1].set_xlabel("rotation (sessions one after another, alternating colours)")
+    fig.suptitle(f"per-rotation mean error, decoder={decoder}; one line per run of the logged yaw, "
+                 "red dotted: the yaw restarts (odometry restart)", fontsize=9)
     save_figure(fig, path, dpi=DPI)
