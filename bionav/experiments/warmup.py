@@ -51,11 +51,23 @@ def _marker(method: str) -> Path | None:
     return Path(folder) / f"bionav-warmup-{method}-{digest}.done"
 
 
+def _ships_with_bionav(method: str) -> bool:
+    """Whether homing method ``method`` is one of bionav's own (its entry point declared by bionav).
+
+    A third-party plugin is never warmed up: its ``home_vector`` may have side effects (files,
+    devices, sleeps) that must not run a second time in another process unasked.
+    """
+    from bionav.registry import entry_points_of
+
+    entry = entry_points_of("homing").get(method)
+    return entry is not None and entry.distribution == "bionav" and entry.value.startswith("bionav.")
+
+
 def start_warmup(cfg: Any, *, used_groups: tuple[str, ...]) -> subprocess.Popen | None:
     """Start compiling ``cfg.homing``'s kernels in a second process, unless done before; the process or None.
 
-    Only for runs that home (``homing`` among ``used_groups``) with a method built from its config and
-    the images' geometry alone; any problem here just means no warm-up (the run compiles what it needs).
+    Only for runs that home (``homing`` among ``used_groups``) with one of bionav's own methods
+    (:func:`_ships_with_bionav`) built from its config and the images' geometry alone; any problem here just means no warm-up (the run compiles what it needs).
     """
     from omegaconf import OmegaConf
 
@@ -63,6 +75,8 @@ def start_warmup(cfg: Any, *, used_groups: tuple[str, ...]) -> subprocess.Popen 
     if not node or not node.get("name") or os.environ.get("BIONAV_NO_WARMUP"):
         return None
     try:
+        if not _ships_with_bionav(str(node.name)):
+            return None
         marker = _marker(str(node.name))
         if marker is None or marker.exists():
             return None
