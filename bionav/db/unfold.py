@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
+
+log = logging.getLogger(__name__)
 
 
 def _unfold_maps(center: tuple[float, float], inner_radius: float, outer_radius: float,
@@ -99,3 +103,40 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = Non
         map_y = float(center[1]) + radius * np.sin(phi)[None, :]
     src = np.asarray(raw, dtype=np.float64)
     return _bilinear(src, map_x, map_y).astype(np.float32)
+
+
+def unfold_frames(frames, unfold, *, first: str) -> list[np.ndarray]:
+    """Unfold raw mirror frames with the ``db.unfold`` settings (:func:`unfold_panorama`).
+
+    ``db.unfold.center`` defaults to the frame's centre, ``db.unfold.outer_radius`` (0) to half the
+    shorter side less one pixel. The one unfolding of real frames: folder databases and ROS bags.
+
+    Parameters
+    ----------
+    frames : sequence of ndarray, shape (h, w)
+        Raw frames of one size.
+    unfold : UnfoldConfig
+        ``center``, ``inner_radius``, ``outer_radius``, ``size``.
+    first : str
+        Where the first frame comes from (a file, a bag message), for the log.
+
+    Raises
+    ------
+    UserError
+        Inconsistent ``db.unfold`` values.
+    """
+    from bionav.errors import UserError
+
+    h, w = frames[0].shape
+    center = unfold.center if unfold.center is not None else [(w - 1) / 2.0, (h - 1) / 2.0]
+    outer = float(unfold.outer_radius) if unfold.outer_radius else min(w, h) / 2.0 - 1.0
+    inner = float(unfold.inner_radius)
+    if len(center) != 2 or not 0 <= inner < outer or len(unfold.size) != 2 or min(unfold.size) < 1:
+        raise UserError(
+            f"db.unfold is inconsistent (center={list(center)}, inner_radius={inner}, "
+            f"outer_radius={outer}, size={list(unfold.size)}): need center=[cx,cy], "
+            "0 <= inner_radius < outer_radius in pixels of the raw frame, and size=[W,H]."
+        )
+    log.debug("unfolding %d raw frames of %d x %d (first: %s)", len(frames), w, h, first)
+    return [unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size)
+            for f in frames]
