@@ -21,9 +21,12 @@ CONTAINERS = ("ros1", "sqlite3", "mcap")
 
 
 def _stores():
-    from rosbags.typesys import Stores, get_typestore
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-    return get_typestore(Stores.ROS1_NOETIC), get_typestore(Stores.ROS2_HUMBLE)
+    ros1 = get_typestore(Stores.ROS1_NOETIC)
+    if "tf2_msgs/msg/TFMessage" not in ros1.types:  # rosbags' Noetic store has no tf2_msgs: its .msg text
+        ros1.register(get_types_from_msg("geometry_msgs/TransformStamped[] transforms", "tf2_msgs/msg/TFMessage"))
+    return ros1, get_typestore(Stores.ROS2_HUMBLE)
 
 
 class BagWriter:
@@ -166,3 +169,50 @@ def write_drive(path: Path, container: str, *, images, poses, encoding: str = "m
     if extra is not None:
         extra(w)
     return w.close()
+
+
+#: the test drive's grid: cells of 0.3 m, cell (0, 0) at (-0.5, -0.4) in the pillar room
+CELL_M = 0.3
+ORIGIN = (-0.5, -0.4)
+T0_NS = 1_700_000_000 * 10**9
+
+
+def lawnmower(nx: int = 4, ny: int = 3) -> list[tuple[int, int]]:
+    """Cells of a boustrophedon drive: along x, up one row, back."""
+    return [(i, j) for j in range(ny) for i in (range(nx) if j % 2 == 0 else range(nx - 1, -1, -1))]
+
+
+def drive_poses(cells, *, rate_hz: float = 20.0, offset_ns: int = 7_000_000, yaw=None, seconds_per_cell: float = 1.0):
+    """Poses along the drive (straight segments between cell centres at constant speed), stamped
+    ``offset_ns`` after the images' seconds so no pose stamp coincides with an image stamp.
+
+    The position at time t is exactly linear within each segment, so interpolating between two poses of
+    one segment gives the true position; at a corner the interpolation cuts it (by less than one pose
+    step). Returns ``[(stamp_ns, x, y, yaw), ...]`` covering the first to the last image."""
+    per = int(seconds_per_cell * 1e9)
+    step = int(1e9 / rate_hz)
+    out = []
+    t = T0_NS - step + offset_ns
+    end = T0_NS + (len(cells) - 1) * per + step
+    while t <= end:
+        k = min(max((t - T0_NS) // per, 0), len(cells) - 2)
+        f = (t - T0_NS - k * per) / per
+        (i0, j0), (i1, j1) = cells[k], cells[k + 1]
+        x = ORIGIN[0] + CELL_M * (i0 + f * (i1 - i0))
+        y = ORIGIN[1] + CELL_M * (j0 + f * (j1 - j0))
+        out.append((t, x, y, 0.0 if yaw is None else yaw(t)))
+        t += step
+    return out
+
+
+def pillar_views(cells, *, width: int = 96, height: int = 16, headings=None):
+    """8-bit views rendered in the pillar room at the cell centres (column 0 along ``headings[k]``, CCW)."""
+    from bionav.testing import render_pillar_panorama
+
+    out = []
+    for k, (i, j) in enumerate(cells):
+        h = 0.0 if headings is None else float(headings[k])
+        img, _ = render_pillar_panorama((ORIGIN[0] + i * CELL_M, ORIGIN[1] + j * CELL_M), heading=h, width=width,
+                                        height=height, supersample=1)
+        out.append(np.uint8(np.rint(img * 255.0)))
+    return out
