@@ -86,9 +86,14 @@ def _repair_hint(path: Path, reason: str) -> str:
     if "encoding json" in low or "serialization format" in low:
         return ("it holds no ROS messages (a bionav run.mcap is JSON: replay it with sensor=replay "
                 "sensor.path=run.mcap, inspect it with python -m bionav.logs info)")
-    reindex = "`rosbag reindex " + path.name + "`" if ros1 else "`ros2 bag reindex`"
+    if ros1:
+        repair = f"rebuild its index with `rosbag reindex {path.name}`"
+    elif path.suffix == ".mcap" or (path.is_dir() and any(path.glob("*.mcap"))):
+        repair = "rewrite it with `mcap recover IN -o OUT` (the mcap command-line tool) or `ros2 bag reindex`"
+    else:
+        repair = "recover the database with `sqlite3 IN .recover | sqlite3 OUT`, then `ros2 bag reindex`"
     return (f"the file looks cut short or damaged (a recording that was killed, an interrupted copy): "
-            f"rebuild its index with {reindex} or copy it again")
+            f"{repair}, or copy it again")
 
 
 def _library_errors():
