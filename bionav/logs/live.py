@@ -16,6 +16,12 @@ channel written once (the views' poses), still shows it;
 A client that is slow or goes away never stops the run: the server drops what
 a client cannot take (``foxglove-sdk``'s per-client backlog), and a failing
 publish detaches the sink with one warning.
+
+Known limit of ``foxglove-sdk`` 0.30: a subscription that reaches the server
+within milliseconds of a channel's advertisement, while the run keeps the
+CPUs busy, can be refused with the status ``Unknown channel ID: N`` (the
+server advertises before it records the channel); a client subscribes again
+(the tests' client does, after 0.1 s).
 """
 
 from __future__ import annotations
@@ -30,6 +36,8 @@ log = logging.getLogger(__name__)
 
 #: what ``bionav.live_host`` defaults to: loopback only
 LOOPBACK = "127.0.0.1"
+#: seconds between a new subscription and the resend of the channel's latest message
+RESEND_DELAY_S = 0.2
 
 
 class LiveServer:
@@ -54,6 +62,7 @@ class LiveServer:
 
     def __init__(self, port: int, *, host: str = LOOPBACK, linger_s: float = 0.0, name: str = "bionav") -> None:
         fox = require_extra("foxglove", extra="live", what=f"bionav.live={port}")
+        fox.set_log_level(logging.WARNING)  # the SDK's own records: warnings and errors only
         self._fox = fox
         self._context = fox.Context()
         self._lock = threading.Lock()
@@ -87,6 +96,7 @@ class LiveServer:
         channel.log(data, log_time=int(log_time_ns))
 
     def _resend(self, channel_id: int) -> None:
+        time.sleep(RESEND_DELAY_S)  # foxglove-sdk calls the listener before the subscription delivers messages
         with self._lock:
             topic = self._by_id.get(channel_id)
             latest = self._latest.get(topic) if topic is not None else None
