@@ -154,6 +154,11 @@ def _make_renderer(setup: _RouteSetup, rng: np.random.Generator):
     from bionav.db.synthetic import quantise
     from bionav.world.mesh_render import render_mesh_panorama
 
+    if recorded_world(setup):  # db=bag: the drive's recorded views are the world
+        from bionav.experiments.route_homing_bag import recorded_renderer
+
+        return recorded_renderer(setup)
+
     def render(xy, heading):
         z = float(setup.world.terrain_height(np.array([xy]))[0])
         z = (setup.world.ground_z if not np.isfinite(z) else z) + setup.height
@@ -250,10 +255,33 @@ def _check_step_counts(name: str, dense_xy: np.ndarray, step_m: float) -> None:
         )
 
 
+def recorded_world(setup: _RouteSetup) -> bool:
+    """Whether the route's world is a recording (``db=bag``) rather than a mesh to render."""
+    from bionav.db.bag.route import RecordedViews
+
+    return isinstance(setup.world, RecordedViews)
+
+
+def route_names(cfg: DictConfig, exp: RouteHomingConfig, default: list[str]) -> list[str]:
+    """The routes to follow: ``experiment.routes``, else ``default``; with ``db=bag`` the bag's one drive."""
+    from bionav.experiments.route_homing_bag import check_routes, is_bag
+
+    if is_bag(cfg):
+        check_routes(exp)
+        return ["drive"]
+    return list(exp.routes or default)
+
+
 def _setup_route(cfg: DictConfig, name: str) -> _RouteSetup:
     from bionav.db.loading import as_database_config
     from bionav.db.mesh import MeshDatabaseSpec, load_route, route_database, world_from_spec
+    from bionav.experiments.route_homing_bag import bag_route_setup, is_bag
 
+    if is_bag(cfg):
+        setup = bag_route_setup(cfg, _RouteSetup)
+        check_route_length(setup.name, float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum()),
+                           route_homing_config(cfg))
+        return setup
     node = OmegaConf.to_container(cfg.db, resolve=True)
     if node.get("source") != "route":
         raise UserError(f"experiment=route_homing needs a route database (db=seville_route), not db={node.get('name')}.")
@@ -277,14 +305,19 @@ def check_step_budget(routes: list[str], exp: RouteHomingConfig, routes_path=Non
     from bionav.db.mesh import load_route
 
     for name in routes:
-        length = load_route(name, routes_path).length_m
-        steps = math.ceil(exp.max_steps_factor * length / exp.agent_step_m)
-        if steps > MAX_STEPS_PER_ROUTE:
-            smallest = exp.max_steps_factor * length / MAX_STEPS_PER_ROUTE
-            raise UserError(f"experiment.agent_step_m={exp.agent_step_m:g} allows {steps} steps on {name} "
-                            f"({length:.2f} m x max_steps_factor={exp.max_steps_factor:g}), more than the "
-                            f"{MAX_STEPS_PER_ROUTE} steps a route may take; use experiment.agent_step_m >= "
-                            f"{math.ceil(smallest * 1e4) / 1e4:g} (the ardin2016 protocol steps 0.1 m).")
+        if name != "drive":  # db=bag's drive is checked once it is read (check_route_length)
+            check_route_length(name, load_route(name, routes_path).length_m, exp)
+
+
+def check_route_length(name: str, length: float, exp: RouteHomingConfig) -> None:
+    """Refuse a route of ``length`` metres that would take more than :data:`MAX_STEPS_PER_ROUTE` agent steps."""
+    steps = math.ceil(exp.max_steps_factor * length / exp.agent_step_m)
+    if steps > MAX_STEPS_PER_ROUTE:
+        smallest = exp.max_steps_factor * length / MAX_STEPS_PER_ROUTE
+        raise UserError(f"experiment.agent_step_m={exp.agent_step_m:g} allows {steps} steps on {name} "
+                        f"({length:.2f} m x max_steps_factor={exp.max_steps_factor:g}), more than the "
+                        f"{MAX_STEPS_PER_ROUTE} steps a route may take; use experiment.agent_step_m >= "
+                        f"{math.ceil(smallest * 1e4) / 1e4:g} (the ardin2016 protocol steps 0.1 m).")
 
 
 def run(cfg: DictConfig, ctx) -> dict[str, Any]:
@@ -295,13 +328,14 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         from bionav.experiments.route_homing_ardin2016 import run_ardin2016
 
         return run_ardin2016(cfg, ctx, exp)
-    routes = exp.routes or [str(cfg.db.route)]
+    routes = route_names(cfg, exp, [str(OmegaConf.select(cfg, "db.route", default=None))])
     if exp.closed_loop:  # open-loop runs take no agent steps
         check_step_budget(routes, exp, _routes_path(cfg))
     rows = []
     per_route = {}
     for name in routes:
         setup = _setup_route(cfg, name)
+        name = setup.name
         homing = make_homing(cfg, ctx, setup.geometry) if "homing" in exp.methods else None
         per_route[name] = {"setup": setup, "results": {}}
         for method in exp.methods:
@@ -328,6 +362,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
                               schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
             per_route[name]["results"][method] = res
             rows.append(row)
+    routes = list(per_route)  # db=bag: the drive's own name
     _write_csv(ctx.dir / "route_homing.csv", rows)
     if exp.plots:
         from bionav.experiments.route_plots import plot_error_maps, plot_headings, plot_world_routes
@@ -365,5 +400,5 @@ def _write_csv(path, rows):
                             "catchment_width_m", "invalid", "completed", "route_distance_m", "steps"])
 
 
-__all__ = ["RouteHomingConfig", "check_step_budget", "closed_loop", "open_loop", "route_homing_config", "run",
-           "write_rows"]
+__all__ = ["RouteHomingConfig", "check_route_length", "check_step_budget", "closed_loop", "open_loop",
+           "recorded_world", "route_homing_config", "route_names", "run", "write_rows"]

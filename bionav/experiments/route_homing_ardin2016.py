@@ -39,6 +39,8 @@ from bionav.experiments.route_homing import (
     _RouteSetup,
     _setup_route,
     check_step_budget,
+    recorded_world,
+    route_names,
     write_rows,
 )
 
@@ -148,6 +150,10 @@ def _scan_renderer(setup: _RouteSetup, exp: RouteHomingConfig, rng: np.random.Ge
     from bionav.evaluation.route import scan_views
     from bionav.world.mesh_render import render_mesh_panorama
 
+    if recorded_world(setup):  # db=bag: scans cut from the drive's recorded views
+        from bionav.experiments.route_homing_bag import recorded_scan_renderer
+
+        return recorded_scan_renderer(setup, exp, half_deg=half_deg)
     geometry, col, shift = scan_geometry(exp)
     half = exp.scan_half_deg if half_deg is None else half_deg
 
@@ -199,7 +205,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
     """``experiment.protocol=ardin2016``: the published route-following test for every agent, route and seed."""
     from bionav.evaluation.route import follow_route
 
-    routes = exp.routes or list(ARDIN_ROUTES)
+    routes = route_names(cfg, exp, list(ARDIN_ROUTES))
     kinds = _agent_kinds(exp.agents)
     _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, _routes_path(cfg))
@@ -207,6 +213,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
     timing = {a: [0.0, 0.0] for a in exp.agents}
     for name in ctx.progress(routes, desc="ardin2016 routes"):
         setup = _setup_route(cfg, name)
+        name = setup.name
         setups.append(setup)
         length = float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum())
         max_steps = int(math.ceil(exp.max_steps_factor * length / exp.agent_step_m))
@@ -233,6 +240,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
                 ctx.log.write(PATH_TOPIC, {"route": name, "method": agent_name, "xy": res.path.tolist(),
                                            "completed": bool(res.reached_nest)},
                               schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
+    routes = [s.name for s in setups]  # db=bag: the drive's own name
     write_rows(ctx.dir / ARDIN_CSV, rows, ARDIN_KEYS)
     if exp.plots:
         from bionav.experiments.route_plots import plot_world_routes

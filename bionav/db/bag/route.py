@@ -24,6 +24,7 @@ radians CCW from world +x.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,7 +111,7 @@ class BagRoute:
     Attributes
     ----------
     name : str
-        ``<bag name>:<image topic>``.
+        The bag's name and the image topic, ``/`` as ``_`` (``drive_camera_image``; names plot files).
     db : ImageDatabase
         The route views (positions ``(k, 0)``, grid ``(K, 1)``, spacing ``db.route_step_m``,
         headings the robot's; ``meta["world_xy"]`` in metres).
@@ -177,7 +178,7 @@ def load_bag_route(cfg) -> BagRoute:
         raise UserError(f"the drive of {views.topic.name} is {float(np.ptp(views.xy, axis=0).max()):.3f} m long: "
                         f"fewer than 2 route views at db.route_step_m={cfg.route_step_m:g}; give a smaller step.")
     geometry = view_geometry(cfg, *native).resized(images.shape[-1], images.shape[-2])
-    name = f"{Path(str(cfg.path)).stem}:{views.topic.name}"
+    name = Path(str(cfg.path)).stem + re.sub(r"[^A-Za-z0-9_.-]+", "_", views.topic.name)  # a file-name part
     k = len(stations)
     meta = {"source": "bag", "kind": "route", "path": str(cfg.path), "image_topic": views.topic.name,
             "pose_topic": views.pose_topic, "world_frame": views.world_frame, "step_m": cfg.route_step_m,
