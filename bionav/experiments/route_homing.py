@@ -262,7 +262,7 @@ def recorded_world(setup: _RouteSetup) -> bool:
     return isinstance(setup.world, RecordedViews)
 
 
-def route_names(cfg: DictConfig, exp: RouteHomingConfig, default: list[str]) -> list[str]:
+def routes_to_follow(cfg: DictConfig, exp: RouteHomingConfig, default: list[str]) -> list[str]:
     """The routes to follow: ``experiment.routes``, else ``default``; with ``db=bag`` the bag's one drive."""
     from bionav.experiments.route_homing_bag import check_routes, is_bag
 
@@ -328,7 +328,7 @@ def run(cfg: DictConfig, ctx) -> dict[str, Any]:
         from bionav.experiments.route_homing_ardin2016 import run_ardin2016
 
         return run_ardin2016(cfg, ctx, exp)
-    routes = route_names(cfg, exp, [str(OmegaConf.select(cfg, "db.route", default=None))])
+    routes = routes_to_follow(cfg, exp, [str(OmegaConf.select(cfg, "db.route", default=None))])
     if exp.closed_loop:  # open-loop runs take no agent steps
         check_step_budget(routes, exp, _routes_path(cfg))
     rows = []
@@ -401,4 +401,4 @@ def _write_csv(path, rows):
 
 
 __all__ = ["RouteHomingConfig", "check_route_length", "check_step_budget", "closed_loop", "open_loop",
-           "recorded_world", "route_homing_config", "route_names", "run", "write_rows"]
+           "recorded_world", "route_homing_config", "routes_to_follow", "run", "write_rows"]

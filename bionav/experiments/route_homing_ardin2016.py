@@ -40,7 +40,7 @@ from bionav.experiments.route_homing import (
     _setup_route,
     check_step_budget,
     recorded_world,
-    route_names,
+    routes_to_follow,
     write_rows,
 )
 
@@ -205,7 +205,7 @@ def run_ardin2016(cfg: DictConfig, ctx, exp: RouteHomingConfig) -> dict[str, Any
     """``experiment.protocol=ardin2016``: the published route-following test for every agent, route and seed."""
     from bionav.evaluation.route import follow_route
 
-    routes = route_names(cfg, exp, list(ARDIN_ROUTES))
+    routes = routes_to_follow(cfg, exp, list(ARDIN_ROUTES))
     kinds = _agent_kinds(exp.agents)
     _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, _routes_path(cfg))
