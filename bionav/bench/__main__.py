@@ -86,9 +86,10 @@ def _parser():
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all",) + RUN_METHODS, default="minwarping",
+    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all",) + RUN_METHODS + ("bag",),
+                        default="minwarping",
                         help="method to time (default: minwarping; all = the pair methods, not sift); "
-                             "sweep and cleaning time whole runs")
+                             "sweep and cleaning time whole runs; bag: a ROS bag read into a grid database")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -140,6 +141,9 @@ def _parser():
     sift.add_argument("--images", type=int, default=None, metavar="N",
                       help="use the first N images of the grid (default: all)")
     add_arguments(parser)
+    from bionav.bench.bag import add_arguments as add_bag_arguments
+
+    add_bag_arguments(parser)
     return parser
 
 
@@ -182,6 +186,15 @@ def _check_args(parser, args) -> None:
         from bionav.bench.runs import check_arguments
 
         check_arguments(parser, args)
+    if args.method == "bag":
+        if not 0.001 <= args.bag_gb <= 64:
+            parser.error(f"--bag-gb {args.bag_gb} must lie in 0.001..64 (GB of bag written to a temporary folder); "
+                         "e.g. --bag-gb 0.5")
+        if not 0.01 <= args.bag_cell <= 100:
+            parser.error(f"--bag-cell {args.bag_cell} must lie in 0.01..100 metres; e.g. --bag-cell 0.5")
+        fw, fh = args.bag_frame
+        if not (16 <= fw <= 8192 and 16 <= fh <= 8192):
+            parser.error(f"--bag-frame {fw} {fh} must lie in 16..8192 pixels per side; e.g. --bag-frame 1280 960")
 
 
 def _run_for_cpu(parser, args, argv: list[str]) -> int:
@@ -213,9 +226,11 @@ def main(argv=None) -> int:
     _check_args(parser, args)
     if args.cpu_name is not None and os.environ.get(_CHILD) != args.cpu_name:
         return _run_for_cpu(parser, args, argv)
-    if args.method in ("sweep", "cleaning"):
+    if args.method in ("sweep", "cleaning", "bag"):
         from bionav.bench.runs import run_benchmark
 
+        if args.method == "bag":
+            from bionav.bench.bag import bag_rows as run_benchmark
         for row in run_benchmark(args):
             print(json.dumps(row) if args.json else "  ".join(f"{k}={v}" for k, v in row.items()))
         return 0

@@ -22,22 +22,33 @@ def _unfold_maps(center: tuple[float, float], inner_radius: float, outer_radius:
     return map_x, map_y
 
 
-def _bilinear(src: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
-    """Bilinear samples of ``src`` at ``(map_x, map_y)`` (column, row), pixels outside the frame 0.
+class _Bilinear:
+    """Bilinear sampling at fixed ``(map_x, map_y)`` (column, row) of frames of one shape, pixels outside 0.
 
-    Exact in float64 (``cv2.remap`` rounds coordinates to 1/32 pixel before OpenCV 5).
+    The indices, weights and the inside masks are computed once; each call gathers the four neighbours
+    of every sample. Exact in float64 (``cv2.remap`` rounds coordinates to 1/32 pixel before OpenCV 5).
     """
-    h, w = src.shape
-    x0, y0 = np.floor(map_x).astype(np.int64), np.floor(map_y).astype(np.int64)
-    fx, fy = map_x - x0, map_y - y0
 
-    def at(rows, cols):
-        inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
-        return np.where(inside, src[np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)], 0.0)
+    def __init__(self, shape, map_x: np.ndarray, map_y: np.ndarray) -> None:
+        h, w = shape
+        x0, y0 = np.floor(map_x).astype(np.int64), np.floor(map_y).astype(np.int64)
+        self.fx, self.fy = map_x - x0, map_y - y0
+        self.corners = []
+        for rows, cols in ((y0, x0), (y0, x0 + 1), (y0 + 1, x0), (y0 + 1, x0 + 1)):
+            inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+            self.corners.append((inside, np.clip(rows, 0, h - 1) * w + np.clip(cols, 0, w - 1)))
 
-    top = (1.0 - fx) * at(y0, x0) + fx * at(y0, x0 + 1)
-    bottom = (1.0 - fx) * at(y0 + 1, x0) + fx * at(y0 + 1, x0 + 1)
-    return (1.0 - fy) * top + fy * bottom
+    def __call__(self, src: np.ndarray) -> np.ndarray:
+        flat = src.reshape(-1)
+        a, b, c, d = (np.where(inside, flat[index], 0.0) for inside, index in self.corners)
+        top = (1.0 - self.fx) * a + self.fx * b
+        bottom = (1.0 - self.fx) * c + self.fx * d
+        return (1.0 - self.fy) * top + self.fy * bottom
+
+
+def _bilinear(src: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
+    """Bilinear samples of ``src`` at ``(map_x, map_y)`` (column, row), pixels outside the frame 0 (:class:`_Bilinear`)."""
+    return _Bilinear(src.shape, map_x, map_y)(src)
 
 
 def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = None,
@@ -138,5 +149,12 @@ def unfold_frames(frames, unfold, *, first: str) -> list[np.ndarray]:
             "0 <= inner_radius < outer_radius in pixels of the raw frame, and size=[W,H]."
         )
     log.debug("unfolding %d raw frames of %d x %d (first: %s)", len(frames), w, h, first)
-    return [unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size)
-            for f in frames]
+    width, height = int(unfold.size[0]), int(unfold.size[1])
+    sample = _Bilinear((h, w), *_unfold_maps((float(center[0]), float(center[1])), inner, outer, (width, height)))
+    out = []
+    for f in frames:  # unfold_panorama's arithmetic, the maps computed once
+        if f.shape != (h, w):
+            out.append(unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size))
+        else:
+            out.append(sample(np.asarray(f, dtype=np.float64)).astype(np.float32))
+    return out

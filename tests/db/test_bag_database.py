@@ -171,3 +171,21 @@ def test_binning_keeps_the_view_nearest_each_cell_centre():
     assert offsets == pytest.approx([0.0, 0.01, 0.05])
     chosen, cells, shape, *_rest, outside = bin_views(xy, stamps, cell_m=0.3, origin=[0.3, 0.0], grid_shape=[2, 1])
     assert cells.tolist() == [[0, 0]] and outside == 3  # two views left of the origin, one above the grid
+
+
+@pytest.mark.parametrize("container", ["ros1", "sqlite3", "mcap"])
+def test_few_views_read_through_the_time_index(tmp_path, views, container):
+    """Decoding 1 of 12 messages reads it through the bag's time index; all 12: one pass. Same pixels."""
+    from bionav.db.bag.reader import open_bag
+    from bionav.db.bag.views import WINDOW_SHARE, decode_views, index_views
+
+    bag = write_drive(tmp_path / "d", container, images=[(T0_NS + k * 10**9, v) for k, v in enumerate(views)],
+                      poses=drive_poses(CELLS), encoding="png")
+    with open_bag(bag) as b:
+        index = index_views(b, _bag_cfg(bag))
+        assert 1 * WINDOW_SHARE < len(index.index) <= 12 * WINDOW_SHARE
+        kept, few = decode_views(b, index, [7, 2], skip=False)
+        _all, every = decode_views(b, index, list(range(12)), skip=False)
+    assert kept == [7, 2]
+    assert np.array_equal(few[0], every[7]) and np.array_equal(few[1], every[2])
+    assert np.array_equal(every[7], views[7].astype(np.float32) / np.float32(255))

@@ -35,11 +35,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-async def collect(port: int, *, until=None, idle_s: float = 15.0, connect_s: float = 120.0):
+async def collect(port: int, *, until=None, idle_s: float = 15.0, connect_s: float = 120.0, messages=None):
     """Connect (retrying while the server starts), subscribe to every channel, collect until closed or idle.
 
     Returns ``(subprotocol, channels {topic: advertised channel}, messages {topic: [(log_time, payload bytes)]})``;
-    ``until(messages)`` may end the collection early. A subscription refused as ``Unknown channel ID`` is sent
+    ``until(messages)`` may end the collection early; ``messages`` may be a dict the caller watches. A subscription refused as ``Unknown channel ID`` is sent
     again (see :mod:`bionav.logs.live`).
     """
     t0 = time.monotonic()
@@ -51,7 +51,8 @@ async def collect(port: int, *, until=None, idle_s: float = 15.0, connect_s: flo
             if time.monotonic() - t0 > connect_s:
                 raise
             await asyncio.sleep(0.1)
-    channels, subs, messages, next_id, retries = {}, {}, {}, 1, []
+    channels, subs, next_id, retries = {}, {}, 1, []
+    messages = {} if messages is None else messages
     try:
         while until is None or not until(messages):
             frame = await asyncio.wait_for(ws.recv(), idle_s)
@@ -105,12 +106,14 @@ def test_server_publishes_what_the_log_writes(tmp_path):
     got = {}
 
     async def client():
-        task = asyncio.ensure_future(collect(server.port, until=lambda m: len(m.get("/late", [])) >= 3, idle_s=5))
-        await asyncio.sleep(0.5)  # connected and subscribed to /early by now
-        for k in range(3):
-            log.write("/late", {"k": k, "x": [0.5, None]}, schema_name="bionav.Late",
-                      log_time_ns=100 + k)
-            await asyncio.sleep(0.2)
+        seen: dict = {}
+        task = asyncio.ensure_future(collect(server.port, until=lambda m: len(m.get("/late", [])) >= 3, idle_s=30,
+                                             messages=seen))
+        log.write("/late", {"k": 0, "x": [0.5, None]}, schema_name="bionav.Late", log_time_ns=100)
+        while not seen.get("/late") and not task.done():  # the client subscribes and gets k=0 (latched) ...
+            await asyncio.sleep(0.05)
+        for k in (1, 2):  # ... then every message as it is written
+            log.write("/late", {"k": k, "x": [0.5, None]}, schema_name="bionav.Late", log_time_ns=100 + k)
         got["result"] = await task
 
     asyncio.run(client())

@@ -118,16 +118,52 @@ def view_geometry(cfg, width: int, height: int) -> PanoramaGeometry:
                             float(cfg.rad_per_row) if cfg.rad_per_row is not None else TWO_PI / width)
 
 
-def decoded_frames(bag, views, which, cfg):
-    """Decode and (``db.unfold``) unfold the views ``which``: ``(kept positions, frames)``."""
-    from bionav.db.unfold import unfold_frames
+#: views decoded at once: the raw frames in memory at a time
+DECODE_BATCH = 32
 
-    kept, frames = decode_views(bag, views, which, skip=cfg.on_bad_image == "skip")
-    if not frames:
+
+def decode_all(bag, views, which, cfg, *, align: bool, size=None):
+    """Decode the views ``which`` in batches into one array of canonical panoramas.
+
+    Each batch of :data:`DECODE_BATCH` messages is decoded, unfolded (``db.unfold``), made canonical
+    (:func:`canonical_views`, ``align``) and resized to ``size = [W, H]`` if given before the next is
+    read, so memory holds the result and one batch of raw frames.
+
+    Returns
+    -------
+    kept : list of int
+        The positions in ``views`` that were used, in the order of ``which``.
+    images : ndarray, shape (len(kept), H, W), float32
+    native : (int, int)
+        ``(W, H)`` of the panoramas before the resize.
+    """
+    from bionav.db.unfold import unfold_frames
+    from bionav.homing.imageops import resize_images
+    from bionav.validation import check_allocation
+
+    which = np.asarray(which, np.int64)
+    skip = cfg.on_bad_image == "skip"
+    kept_all, out, shape, native = [], None, None, None
+    for start in range(0, len(which), DECODE_BATCH):
+        kept, frames = decode_views(bag, views, which[start:start + DECODE_BATCH], skip=skip, shape=shape)
+        if not frames:
+            continue
+        shape = frames[0].shape
+        if cfg.unfold is not None and cfg.unfold.enabled:
+            frames = unfold_frames(frames, cfg.unfold, first=f"{cfg.path} {views.topic.name}")
+        batch = canonical_views(frames, views.yaw[kept], cfg, align=align)
+        native = (batch.shape[-1], batch.shape[-2])
+        if size is not None:
+            batch = resize_images(batch, size)
+        if out is None:
+            check_allocation(4.0 * len(which) * batch[0].size, what=f"the {len(which)} views of {views.topic.name}",
+                             fix="give a larger db.grid_cell_m or a smaller db.unfold.size / db.image_size")
+            out = np.empty((len(which), *batch.shape[1:]), np.float32)
+        out[len(kept_all):len(kept_all) + len(kept)] = batch
+        kept_all += list(kept)
+    if out is None:
         raise UserError(f"no image of {views.topic.name} in {cfg.path} could be used; see the warnings above.")
-    if cfg.unfold is not None and cfg.unfold.enabled:
-        frames = unfold_frames(frames, cfg.unfold, first=f"{cfg.path} {views.topic.name}")
-    return kept, frames
+    return kept_all, out[:len(kept_all)], native
 
 
 def load_bag_database(cfg) -> ImageDatabase:
@@ -164,9 +200,8 @@ def load_bag_database(cfg) -> ImageDatabase:
             raise UserError(f"the views of {views.topic.name} fill {len(chosen)} cell(s) of db.grid_cell_m="
                             f"{cfg.grid_cell_m:g} m; homing needs at least 2: use a smaller db.grid_cell_m or a longer "
                             "drive.")
-        kept, frames = decoded_frames(bag, views, chosen, cfg)
+        kept, images, _native = decode_all(bag, views, chosen, cfg, align=cfg.align)
     pick = [int(np.flatnonzero(chosen == w)[0]) for w in kept]
-    images = canonical_views(frames, views.yaw[kept], cfg, align=cfg.align)
     geometry = view_geometry(cfg, images.shape[-1], images.shape[-2])
     headings = np.zeros(len(kept)) if cfg.align else np.mod(views.yaw[kept], TWO_PI)
     n_cells = nx * ny

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bionav.db.bag.grid import canonical_views, decoded_frames, view_geometry
+from bionav.db.bag.grid import decode_all, view_geometry
 from bionav.db.bag.reader import open_bag
 from bionav.db.bag.views import index_views
 from bionav.db.conventions import to_canonical
@@ -37,8 +37,6 @@ from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
 from bionav.geometry import TWO_PI
 
-#: views decoded at once (memory: this many raw frames)
-DECODE_BATCH = 64
 #: most recorded views a route world holds
 MAX_ROUTE_VIEWS = 50_000
 
@@ -131,35 +129,6 @@ class BagRoute:
         return float(np.linalg.norm(np.diff(self.dense_xy, axis=0), axis=1).sum())
 
 
-def _recorded_images(bag, views, cfg) -> tuple[np.ndarray, tuple[int, int]]:
-    """Every covered view, decoded in batches, canonical in the robot frame, resized to ``db.image_size``;
-    and the native ``(W, H)`` (after unfolding, before the resize)."""
-    from bionav.homing.imageops import resize_images
-    from bionav.validation import check_allocation
-
-    n = len(views.index)
-    if n > MAX_ROUTE_VIEWS:
-        raise UserError(f"{views.topic.name} has {n} views with poses, more than the {MAX_ROUTE_VIEWS} a route world "
-                        f"holds; cut the bag to the drive you want to follow (rosbags-convert with a time range).")
-    out = None
-    for start in range(0, n, DECODE_BATCH):
-        which = np.arange(start, min(n, start + DECODE_BATCH))
-        kept, frames = decoded_frames(bag, views, which, cfg)
-        if len(kept) != len(which):
-            raise UserError(f"{views.topic.name}: a route needs every view of the drive; {len(which) - len(kept)} "
-                            "could not be used (see the warnings above).")
-        batch = canonical_views(frames, views.yaw[which], cfg, align=False)
-        native = (batch.shape[-1], batch.shape[-2])
-        if cfg.image_size is not None:
-            batch = resize_images(batch, cfg.image_size)
-        if out is None:
-            check_allocation(4.0 * n * batch[0].size, what=f"the {n} recorded views of {views.topic.name}",
-                             fix="give a smaller db.image_size=[W,H]")
-            out = np.empty((n, *batch.shape[1:]), np.float32)
-        out[which] = batch
-    return out, native
-
-
 def load_bag_route(cfg) -> BagRoute:
     """The drive of ``db=bag`` as a route (see the module docstring).
 
@@ -172,7 +141,15 @@ def load_bag_route(cfg) -> BagRoute:
 
     with open_bag(cfg.path, key="db.path") as bag:
         views = index_views(bag, cfg)
-        images, native = _recorded_images(bag, views, cfg)
+        n = len(views.index)
+        if n > MAX_ROUTE_VIEWS:
+            raise UserError(f"{views.topic.name} has {n} views with poses, more than the {MAX_ROUTE_VIEWS} a route "
+                            "world holds; cut the bag to the drive you want to follow (rosbags-convert with a time "
+                            "range).")
+        kept, images, native = decode_all(bag, views, np.arange(n), cfg, align=False, size=cfg.image_size)
+        if len(kept) != n:
+            raise UserError(f"{views.topic.name}: a route needs every view of the drive; {n - len(kept)} could not "
+                            "be used (see the warnings above).")
     stations = route_stations(views.xy, cfg.route_step_m)
     if len(stations) < 2:
         raise UserError(f"the drive of {views.topic.name} is {float(np.ptp(views.xy, axis=0).max()):.3f} m long: "

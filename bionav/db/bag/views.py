@@ -27,6 +27,9 @@ from bionav.errors import UserError
 
 log = logging.getLogger(__name__)
 
+#: decode by the time index when fewer than one message in this many is wanted, else in one pass
+WINDOW_SHARE = 8
+
 
 @dataclass
 class ViewIndex:
@@ -148,11 +151,11 @@ def _log_coverage(image_topic: str, pose_topic: str, stamps, covered, tolerance_
         log.info("%s: all %d images have a pose of %s", image_topic, len(stamps), pose_topic)
 
 
-def decode_views(bag, views: ViewIndex, which, *, skip: bool):
+def decode_views(bag, views: ViewIndex, which, *, skip: bool, shape=None):
     """Decode the images ``which`` (positions in ``views``): ``(kept positions, frames)`` in the order given.
 
-    Only those messages are read, by their record times in the bag's index. Compressed images whose
-    decoded size differs from the first are an error (``skip``: left out, logged).
+    Only those messages are read, by their record times in the bag's index. Images whose decoded size
+    differs from ``shape`` (default: the first's) are an error (``skip``: left out, logged).
     """
     which = [int(w) for w in which]
     wanted = {}
@@ -160,19 +163,20 @@ def decode_views(bag, views: ViewIndex, which, *, skip: bool):
         wanted.setdefault(int(views.bag_ns[w]), {})[int(views.index[w])] = w
     frames: dict[int, np.ndarray] = {}
     topic = views.topic.name
-    for t in sorted(wanted):
-        for_time = wanted[t]
-        seen = 0
-        for _name, msgtype, bag_ns, msg in bag.messages([topic], start=t, stop=t + 1):
-            # messages recorded at one time are told apart by their order on the topic
-            position = int(np.searchsorted(views.message_bag_ns, t)) + seen
-            seen += 1
-            w = for_time.get(position)
+    times = sorted(wanted)
+    # a few images: each read through the bag's time index; many: one pass over the topic from the first to the last
+    windows = [(t, t + 1) for t in times] if len(times) * WINDOW_SHARE < len(views.message_bag_ns) else \
+        [(times[0], times[-1] + 1)]
+    for start, stop in windows:
+        position = int(np.searchsorted(views.message_bag_ns, start))  # the topic's first message recorded at start
+        for _name, msgtype, bag_ns, msg in bag.messages([topic], start=start, stop=stop):
+            w = wanted.get(bag_ns, {}).get(position)
+            position += 1
             if w is None:
                 continue
-            m = image_message(msg, msgtype, stamp_ns=int(views.stamp_ns[w]), index=position)
+            m = image_message(msg, msgtype, stamp_ns=int(views.stamp_ns[w]), index=position - 1)
             frames[w] = decode(m, topic)
-    kept, out, shape = [], [], None
+    kept, out = [], []
     for w in which:
         f = frames.get(w)
         if f is None:
