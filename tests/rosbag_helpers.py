@@ -13,6 +13,7 @@ OpenCV); poses as ``nav_msgs/Odometry``, ``geometry_msgs/PoseStamped`` or
 from __future__ import annotations
 
 import math
+
 from pathlib import Path
 
 import numpy as np
@@ -216,3 +217,44 @@ def pillar_views(cells, *, width: int = 96, height: int = 16, headings=None):
                                         height=height, supersample=1)
         out.append(np.uint8(np.rint(img * 255.0)))
     return out
+
+
+def robot_bag(path: Path, *, container: str = "ros1", width: int = 288, height: int = 50) -> Path:
+    """The bag docs/ros.md works on: a robot's boustrophedon over 5 x 4 cells of 0.3 m in the pillar room.
+
+    A view every 0.1 m of the drive (``/camera/image``, mono8 panoramas, column 0 along the heading,
+    azimuth counter-clockwise), odometry at 20 Hz (``/odom``) and the same poses on ``/tf``
+    (odom -> base_link, with base_link -> camera on ``/tf_static``), an IMU (``/imu/data``) and a
+    magnetometer (``/imu/mag``) at 10 Hz; the robot faces along each lane (yaw 0 or pi).
+    """
+    from bionav.testing import render_pillar_panorama
+
+    cells = lawnmower(5, 4)
+    knots = np.array([(ORIGIN[0] + i * CELL_M, ORIGIN[1] + j * CELL_M) for i, j in cells])
+    seg = np.linalg.norm(np.diff(knots, axis=0), axis=1)
+    s_knot = np.concatenate([[0.0], np.cumsum(seg)])
+    speed = 0.1  # m/s
+
+    def pose(t_ns):
+        s = min(max((t_ns - T0_NS) / 1e9 * speed, 0.0), s_knot[-1])
+        k = int(min(np.searchsorted(s_knot, s, side="right") - 1, len(seg) - 1))
+        f = (s - s_knot[k]) / seg[k]
+        x, y = knots[k] + f * (knots[k + 1] - knots[k])
+        d = knots[k + 1] - knots[k]
+        return float(x), float(y), math.atan2(d[1], d[0])
+
+    w = BagWriter(path, container)
+    w.put("/tf_static", T0_NS - 10**9, w.tf(T0_NS - 10**9, [("base_link", "camera", 0.0, 0.0, 0.0)]))
+    end = T0_NS + int(s_knot[-1] / speed * 1e9)
+    for k, t in enumerate(range(T0_NS - 10**8 + 3 * 10**6, end + 10**8, 5 * 10**7)):
+        x, y, yaw = pose(t)
+        w.put("/odom", t, w.odometry(t, x, y, yaw))
+        w.put("/tf", t, w.tf(t, [("odom", "base_link", x, y, yaw)]))
+        if k % 2 == 0:
+            w.put("/imu/data", t, w.imu(t, yaw + 0.2))
+            w.put("/imu/mag", t, w.magnetic_field(t, (2e-5 * math.sin(yaw), 2e-5 * math.cos(yaw), -4e-5)))
+    for t in range(T0_NS, end + 1, 10**9):  # one view per second: every 0.1 m
+        x, y, yaw = pose(t)
+        img, _ = render_pillar_panorama((x, y), heading=yaw, width=width, height=height, supersample=1)
+        w.put("/camera/image", t + 2 * 10**7, w.image(t, np.uint8(np.rint(img * 255)), "mono8"))
+    return w.close()

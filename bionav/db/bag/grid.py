@@ -28,7 +28,7 @@ import logging
 import numpy as np
 
 from bionav.db.bag.reader import open_bag
-from bionav.db.bag.views import decode_views, index_views
+from bionav.db.bag.views import check_topics, decode_views, index_views
 from bionav.db.conventions import azimuth_sign, to_canonical
 from bionav.db.database import ImageDatabase
 from bionav.errors import UserError
@@ -188,10 +188,11 @@ def load_bag_database(cfg) -> ImageDatabase:
         Everything :func:`~bionav.db.bag.views.index_views` refuses, ``db.grid_cell_m`` unset,
         a grid too large, fewer than 2 views.
     """
-    if cfg.grid_cell_m is None:
-        raise UserError("db=bag as a grid database needs its cell size: set db.grid_cell_m=METRES (e.g. 0.3, the "
-                        "Bielefeld grids' spacing); each cell keeps the view nearest to its centre.")
     with open_bag(cfg.path, key="db.path") as bag:
+        check_topics(bag, cfg)
+        if cfg.grid_cell_m is None:
+            raise UserError("db=bag as a grid database needs its cell size: set db.grid_cell_m=METRES (e.g. 0.3, the "
+                            "Bielefeld grids' spacing); each cell keeps the view nearest to its centre.")
         views = index_views(bag, cfg)
         chosen, cells, (nx, ny), origin, offsets, outside = bin_views(
             views.xy, views.stamp_ns, cell_m=cfg.grid_cell_m, origin=cfg.origin_m, grid_shape=cfg.grid_shape)

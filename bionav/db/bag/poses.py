@@ -237,7 +237,8 @@ def _frames_menu(parent: dict[str, str]) -> str:
 def read_tf_track(bag, topic, *, stamps: str, tolerance_ns: int, world_frame: str | None,
                   pose_frame: str | None) -> TfTrack:
     """The tf tree of ``topic`` (and ``/tf_static``) as a :class:`TfTrack` from ``world_frame`` to ``pose_frame``."""
-    statics = [t for t in bag.of_types(TF_TYPES) if t.name.rstrip("/").endswith("tf_static") and t.name != topic.name]
+    statics = [t for t in bag.topics.values()
+               if t.msgtype in TF_TYPES and t.name.rstrip("/").endswith("tf_static") and t.name != topic.name]
     dynamic, static = _collect_tf(bag, [topic, *statics], stamps)
     parent = _parents(list(dynamic) + list(static))
     body = (pose_frame or "base_link").lstrip("/")

@@ -43,7 +43,7 @@ class Topic:
     count: int
 
     def describe(self) -> str:
-        return f"{self.name} ({self.msgtype}, {self.count} messages)"
+        return f"{self.name} ({self.msgtype}, {self.count} message{'' if self.count == 1 else 's'})"
 
 
 def _kind(path: Path) -> str:
@@ -167,8 +167,10 @@ class Bag:
 
     # -- topics -----------------------------------------------------------------------------------
     def of_types(self, types) -> list[Topic]:
-        """The topics whose message type is one of ``types``, by name."""
-        return [t for _, t in sorted(self.topics.items()) if t.msgtype in types]
+        """The topics whose message type is one of ``types``, by name (without ``/tf_static``: it is read with
+        ``/tf``, never a pose topic of its own)."""
+        return [t for _, t in sorted(self.topics.items())
+                if t.msgtype in types and not t.name.rstrip("/").endswith("tf_static")]
 
     def topic(self, value: str | None, *, key: str, types, what: str, also=()) -> Topic:
         """The topic ``key=value`` names, checked: present, of one of ``types``, holding messages.

@@ -67,7 +67,7 @@ class ViewIndex:
     message_bag_ns: np.ndarray  # the bag's record time of every message on the topic, in topic order
 
 
-def _topics(bag, cfg):
+def check_topics(bag, cfg):
     """The checked image and pose topics (one message lists both kinds when a key is missing)."""
     missing = [k for k, v in (("db.image_topic", cfg.image_topic), ("db.pose_topic", cfg.pose_topic)) if not v]
     if missing:
@@ -90,7 +90,7 @@ def index_views(bag, cfg) -> ViewIndex:
         A missing, misspelt or wrongly typed topic; images of changing encoding or size
         (unless ``db.on_bad_image=skip``); stamps that jump back; no image covered by the poses.
     """
-    image_topic, pose_topic = _topics(bag, cfg)
+    image_topic, pose_topic = check_topics(bag, cfg)
     tol = int(round(cfg.pose_tolerance_s * NS))
     track = read_poses(bag, pose_topic, stamps=cfg.stamps, tolerance_ns=tol, world_frame=cfg.world_frame,
                        pose_frame=cfg.pose_frame)
