@@ -119,7 +119,7 @@ def view_geometry(cfg, width: int, height: int) -> PanoramaGeometry:
 
 
 #: views decoded at once: the raw frames in memory at a time
-DECODE_BATCH = 32
+DECODE_BATCH = 8
 
 
 def decode_all(bag, views, which, cfg, *, align: bool, size=None):
