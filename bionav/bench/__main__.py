@@ -141,7 +141,7 @@ def _parser():
     sift.add_argument("--images", type=int, default=None, metavar="N",
                       help="use the first N images of the grid (default: all)")
     add_arguments(parser)
-    from bionav.bench.bag import add_arguments as add_bag_arguments
+    from bionav.bench.bag import add_bag_arguments
 
     add_bag_arguments(parser)
     return parser

@@ -52,7 +52,7 @@ SPEED = 1.0
 CELL_M = 0.5
 
 
-def add_arguments(parser) -> None:
+def add_bag_arguments(parser) -> None:
     group = parser.add_argument_group("--method bag (ROS bag to grid database)")
     group.add_argument("--bag", default=None, metavar="PATH",
                        help="bag: time this bag (with --bag-topics) instead of writing one")

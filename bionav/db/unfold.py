@@ -116,7 +116,7 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = Non
     return _bilinear(src, map_x, map_y).astype(np.float32)
 
 
-def unfold_frames(frames, unfold, *, first: str) -> list[np.ndarray]:
+def unfold_frames(frames, unfold, *, first: str, threads: int = 1) -> list[np.ndarray]:
     """Unfold raw mirror frames with the ``db.unfold`` settings (:func:`unfold_panorama`).
 
     ``db.unfold.center`` defaults to the frame's centre, ``db.unfold.outer_radius`` (0) to half the
@@ -130,6 +130,8 @@ def unfold_frames(frames, unfold, *, first: str) -> list[np.ndarray]:
         ``center``, ``inner_radius``, ``outer_radius``, ``size``.
     first : str
         Where the first frame comes from (a file, a bag message), for the log.
+    threads : int
+        Frames unfolded at once on this many threads (NumPy releases the GIL); the results do not depend on it.
 
     Raises
     ------
@@ -151,10 +153,15 @@ def unfold_frames(frames, unfold, *, first: str) -> list[np.ndarray]:
     log.debug("unfolding %d raw frames of %d x %d (first: %s)", len(frames), w, h, first)
     width, height = int(unfold.size[0]), int(unfold.size[1])
     sample = _Bilinear((h, w), *_unfold_maps((float(center[0]), float(center[1])), inner, outer, (width, height)))
-    out = []
-    for f in frames:  # unfold_panorama's arithmetic, the maps computed once
+
+    def one(f):  # unfold_panorama's arithmetic, the maps computed once
         if f.shape != (h, w):
-            out.append(unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size))
-        else:
-            out.append(sample(np.asarray(f, dtype=np.float64)).astype(np.float32))
-    return out
+            return unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size)
+        return sample(np.asarray(f, dtype=np.float64)).astype(np.float32)
+
+    if threads > 1 and len(frames) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(min(threads, len(frames))) as pool:
+            return list(pool.map(one, frames))
+    return [one(f) for f in frames]

@@ -139,6 +139,7 @@ def decode_all(bag, views, which, cfg, *, align: bool, size=None):
     """
     from bionav.db.unfold import unfold_frames
     from bionav.homing.imageops import resize_images
+    from bionav.machine import usable_cpus
     from bionav.validation import check_allocation
 
     which = np.asarray(which, np.int64)
@@ -150,7 +151,8 @@ def decode_all(bag, views, which, cfg, *, align: bool, size=None):
             continue
         shape = frames[0].shape
         if cfg.unfold is not None and cfg.unfold.enabled:
-            frames = unfold_frames(frames, cfg.unfold, first=f"{cfg.path} {views.topic.name}")
+            frames = unfold_frames(frames, cfg.unfold, first=f"{cfg.path} {views.topic.name}",
+                                   threads=min(2, usable_cpus()))
         batch = canonical_views(frames, views.yaw[kept], cfg, align=align)
         native = (batch.shape[-1], batch.shape[-2])
         if size is not None:

@@ -151,6 +151,19 @@ def _log_coverage(image_topic: str, pose_topic: str, stamps, covered, tolerance_
         log.info("%s: all %d images have a pose of %s", image_topic, len(stamps), pose_topic)
 
 
+def _map(fn, items: list) -> list:
+    """``[fn(x) for x in items]`` on up to 2 threads of this process's CPUs (decoding releases the GIL)."""
+    from bionav.machine import usable_cpus
+
+    threads = min(2, usable_cpus(), len(items))
+    if threads < 2:
+        return [fn(x) for x in items]
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(threads) as pool:
+        return list(pool.map(fn, items))
+
+
 def decode_views(bag, views: ViewIndex, which, *, skip: bool, shape=None):
     """Decode the images ``which`` (positions in ``views``): ``(kept positions, frames)`` in the order given.
 
@@ -161,7 +174,7 @@ def decode_views(bag, views: ViewIndex, which, *, skip: bool, shape=None):
     wanted = {}
     for w in which:
         wanted.setdefault(int(views.bag_ns[w]), {})[int(views.index[w])] = w
-    frames: dict[int, np.ndarray] = {}
+    found: dict[int, object] = {}
     topic = views.topic.name
     times = sorted(wanted)
     # a few images: each read through the bag's time index; many: one pass over the topic from the first to the last
@@ -174,8 +187,8 @@ def decode_views(bag, views: ViewIndex, which, *, skip: bool, shape=None):
             position += 1
             if w is None:
                 continue
-            m = image_message(msg, msgtype, stamp_ns=int(views.stamp_ns[w]), index=position - 1)
-            frames[w] = decode(m, topic)
+            found[w] = image_message(msg, msgtype, stamp_ns=int(views.stamp_ns[w]), index=position - 1)
+    frames = dict(zip(found, _map(lambda m: decode(m, topic), list(found.values()))))
     kept, out = [], []
     for w in which:
         f = frames.get(w)
