@@ -52,5 +52,5 @@ def require_extra(module: str, *, extra: str, what: str):
     except ImportError as exc:
         raise UserError(
             f"{what} needs the Python package {module.split('.')[0]!r}, which is not installed here ({exc}); "
-            f"install it with: pip install \"bionav[{extra}]\"."
+            f"install it with: pip install \"bionav[{extra}]\" (in a clone of bionav: pip install \".[{extra}]\")."
         ) from None
