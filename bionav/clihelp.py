@@ -96,7 +96,7 @@ def composition_message(exc: BaseException, overrides: list[str]) -> str:
             node, bad = full_key.rsplit(".", 1)
         else:
             node, bad = "", full_key
-        from bionav.experiments.configs import LEGACY_KEYS
+        from bionav.experiments.settings import LEGACY_KEYS
 
         if full_key in LEGACY_KEYS:  # a setting that moved (one setting per quantity): say where to
             return (f"{full_key} is no longer a setting: it is {LEGACY_KEYS[full_key]} now (one setting per "

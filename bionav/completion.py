@@ -59,7 +59,7 @@ def rewrite_query_line(environ: dict | None = None) -> None:
 
 
 #: config groups that exist for bionav's own wiring (typed schemas), never typed by users
-INTERNAL_GROUPS = ("experiment_schema", "db_schema", "recordings_schema")
+INTERNAL_GROUPS = ("experiment_schema", "experiment_nodes", "db_schema")
 _GROUP_WORD = re.compile(r"([+~]?)([A-Za-z_]\w*)=([^=,]*)")
 
 

@@ -28,7 +28,12 @@ from bionav.registry import config_dirs  # noqa: F401  (its home is the registry
 from bionav.validation import unknown_key_message  # noqa: F401  (its home is validation; re-exported for cli.py)
 
 #: config groups users select plugins in
-PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder")
+PLUGIN_GROUPS = ("homing", "signature", "sensor", "pantilt", "controller", "decoder", "experiment")
+#: internal config groups of the experiment plugins' schemas: ``experiment_schema/<name>`` (the ``experiment``
+#: node: the plugin's ``Config``) and ``experiment_nodes/<name>/<node>`` (another node it reads, e.g.
+#: ``recordings``: its ``group_configs``), both served from the plugin when a preset composes them
+EXPERIMENT_SCHEMA_GROUP = "experiment_schema"
+EXPERIMENT_NODES_GROUP = "experiment_nodes"
 
 
 class BionavSearchPathPlugin(SearchPathPlugin):
@@ -82,10 +87,12 @@ class PluginConfigSource(ConfigSource):
     distributions claim, gives :class:`BrokenPluginNode`, so that selecting it raises its
     message from :func:`plugin_config`, and listing is never broken by it.
 
-    It also serves the typed schemas of ``bionav.schemas`` (``db_schema``,
-    ``experiment_schema/<name>``, ...; :func:`register_configs`): each dataclass becomes a
-    structured config only when Hydra loads it, so a command pays for the one experiment
-    schema it composes, not for all of them.
+    It also serves the typed schemas of ``bionav.schemas`` (``db_schema``, the SLURM launcher;
+    :func:`register_configs`) and those of the experiment plugins (``experiment_schema/<name>``,
+    ``experiment_nodes/<name>/<node>``: the ``Config`` of ``bionav.experiments`` entry point
+    ``<name>`` and its ``group_configs``): each dataclass becomes a structured config only when
+    Hydra loads it, so a command pays for the one experiment it composes, not for all of them,
+    also in a launcher's worker process (entry points are read on first use).
     """
 
     def __init__(self, provider: str, path: str) -> None:
@@ -108,12 +115,15 @@ class PluginConfigSource(ConfigSource):
 
     def is_group(self, config_path: str) -> bool:
         path = config_path.strip("/")
-        return path == "" or registry.kind_of_group(path) is not None or path in _schema_groups()
+        return (path == "" or registry.kind_of_group(path) is not None or path in _schema_groups()
+                or _experiment_group(path))
 
     def is_config(self, config_path: str) -> bool:
         group, name = self._split(config_path)
         if f"{group}/{name}".strip("/") in _schemas():
             return True
+        if _experiment_group(group):
+            return _experiment_schema(group, name) is not None
         kind = registry.kind_of_group(group)
         # a name no entry point declares is answered without importing any plugin (Hydra asks for `sensor/None`)
         return kind is not None and name in registry.entry_points_of(kind) and name in registry.names_in_group(group)
@@ -126,6 +136,8 @@ class PluginConfigSource(ConfigSource):
         schemas = [key[len(prefix):] for key in _schemas() if key.startswith(prefix) and "/" not in key[len(prefix):]]
         groups = [g for g in _schema_groups() if g.startswith(prefix) and "/" not in g[len(prefix):]]
         groups = [g[len(prefix):] for g in groups] + (list(PLUGIN_GROUPS) if path == "" else [])
+        if path == EXPERIMENT_SCHEMA_GROUP:
+            schemas = sorted(registry.entry_points_of("experiment"))
         configs = schemas + (sorted(registry.names_in_group(path)) if registry.kind_of_group(path) else [])
         return sorted(set((groups if results_filter in (None, ObjectType.GROUP) else [])
                           + (configs if results_filter in (None, ObjectType.CONFIG) else [])))
@@ -133,7 +145,9 @@ class PluginConfigSource(ConfigSource):
     def load_config(self, config_path: str) -> ConfigResult:
         group, name = self._split(config_path)
         schema = _schemas().get(f"{group}/{name}".strip("/"))
-        if schema is not None:  # a typed schema of bionav.schemas, converted now
+        if schema is None and _experiment_group(group):
+            schema = _experiment_schema(group, name)
+        if schema is not None:  # a typed schema of bionav.schemas or of an experiment, converted now
             return ConfigResult(config=OmegaConf.structured(schema[0]), path=f"{self.scheme()}://{self.path}",
                                 provider=schema[1], header={"package": None})
         kind = registry.kind_of_group(group)
@@ -148,6 +162,32 @@ class PluginConfigSource(ConfigSource):
             node = OmegaConf.structured(plugin_node_class(name, cls.Config))
         return ConfigResult(config=node, path=f"{self.scheme()}://{self.path}", provider=provider,
                             header={"package": None})
+
+
+def _experiment_group(path: str) -> bool:
+    """``experiment_schema``, ``experiment_nodes`` or ``experiment_nodes/<an installed experiment>``."""
+    if path in (EXPERIMENT_SCHEMA_GROUP, EXPERIMENT_NODES_GROUP):
+        return True
+    parent, _, name = path.partition("/")
+    return parent == EXPERIMENT_NODES_GROUP and "/" not in name and name in registry.entry_points_of("experiment")
+
+
+def _experiment_schema(group: str, name: str) -> tuple[Any, str] | None:
+    """``(dataclass, provider)`` of ``experiment_schema/<name>`` or ``experiment_nodes/<experiment>/<name>``.
+
+    The experiment's plugin is imported here, and only here (a name no entry point declares is
+    answered from the entry points); a plugin that fails to load raises its
+    :class:`~bionav.errors.PluginError` (a preset that names it cannot compose without it).
+    """
+    experiment = name if group == EXPERIMENT_SCHEMA_GROUP else group.partition("/")[2]
+    entry = registry.entry_points_of("experiment").get(experiment)
+    if entry is None or group == EXPERIMENT_NODES_GROUP:
+        return None
+    cls = registry.load_plugin("experiment", experiment)
+    if group == EXPERIMENT_SCHEMA_GROUP:  # with its registry name, as a preset sets experiment.name
+        return plugin_node_class(name, cls.Config), entry.distribution
+    schema = dict(cls.group_configs).get(name)
+    return None if schema is None else (schema, entry.distribution)
 
 
 @functools.cache
@@ -166,7 +206,7 @@ def register_configs() -> None:
 def _schemas() -> dict[str, tuple[Any, str]]:
     """The typed schemas of ``bionav.schemas``: config path -> (dataclass or instance, provider).
 
-    Keys are ``db_schema``, ``experiment_schema/grid_homing``, ...; :class:`PluginConfigSource`
+    Keys are ``db_schema`` and what registration functions store without a package; :class:`PluginConfigSource`
     serves them. Read once per process, also in a launcher's worker process (joblib, submitit,
     SLURM), where Hydra restores its plugins but no bionav code has run yet.
     """
@@ -182,14 +222,14 @@ def _schemas() -> dict[str, tuple[Any, str]]:
     for name, schema in schemas.items():
         if isinstance(schema, type):
             store.store(name=name, node=schema, provider="bionav")
-        else:  # a registration function: experiment_schema/<name>, hydra/launcher=submitit_slurm, ...
+        else:  # a registration function: hydra/launcher=submitit_slurm, ...
             schema(store)
     return store.nodes
 
 
 @functools.cache
 def _schema_groups() -> frozenset[str]:
-    """Config groups holding schemas (``experiment_schema``), parents included (once per process, as :func:`_schemas`)."""
+    """Config groups holding schemas of ``bionav.schemas``, parents included (once per process, as :func:`_schemas`)."""
     out: set[str] = set()
     for key in _schemas():
         parts = key.split("/")[:-1]

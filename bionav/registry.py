@@ -3,7 +3,7 @@
 Modelled on xarray's backend registry. Each *kind* of plugin has an
 entry-point group (``bionav.homing``, ``bionav.signatures``,
 ``bionav.sensors``, ``bionav.controllers``, ``bionav.decoders``,
-``bionav.route_agents``); bionav's own built-ins are
+``bionav.route_agents``, ``bionav.experiments``); bionav's own built-ins are
 registered through the same entry points as third-party plugins.
 
 * Entry points are read once per process and cached (:func:`entry_points_of`).
@@ -35,6 +35,7 @@ GROUPS: dict[str, str] = {
     "controller": "bionav.controllers",
     "decoder": "bionav.decoders",
     "route_agent": "bionav.route_agents",
+    "experiment": "bionav.experiments",
 }
 #: entry-point group of config packages (folders of YAML files)
 CONFIG_GROUP = "bionav.configs"
@@ -53,7 +54,7 @@ class PluginEntry:
     Attributes
     ----------
     kind : str
-        Plugin kind (``homing``, ``signature``, ``sensor``, ``controller``).
+        Plugin kind (``homing``, ``signature``, ``sensor``, ``controller``, ``experiment``, ...).
     name : str
         Registry name (what the user types, e.g. ``homing=sift``).
     value : str
@@ -187,6 +188,8 @@ def _check_plugin_class(kind: str, cls: Any) -> str | None:
     config = getattr(cls, "Config", None)
     if config is None or not dataclasses.is_dataclass(config):
         return "plugin class has no `Config` dataclass (its typed parameters)"
+    if kind == "experiment" and not callable(getattr(cls, "run", None)):
+        return "experiment class has no `run(self, ctx)` method"
     return None
 
 
@@ -347,9 +350,9 @@ def config_schemas() -> dict[str, Any]:
     """Structured config schemas declared in ``bionav.schemas``: name -> dataclass or registration function.
 
     A room that owns a config node registers its schema here (bionav's
-    ``db_schema`` is :class:`bionav.db.config.DatabaseConfig`; the experiment
-    schemas come from :func:`bionav.experiments.configs.register`), so the
-    Hydra wiring stores them without importing that room. An entry whose
+    ``db_schema`` is :class:`bionav.db.config.DatabaseConfig`), so the Hydra wiring stores them
+    without importing that room (the experiments' schemas come from their plugins,
+    ``bionav.experiments``). An entry whose
     optional dependency is not installed (e.g. the SLURM launcher without the
     ``slurm`` extra) is skipped.
     """

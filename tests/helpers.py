@@ -124,6 +124,29 @@ def source_copy(src: Path, dst: Path) -> Path:
     return Path(dst)
 
 
+#: a fenced block holding a file of a package shown in the docs: ```python file=<package folder>/<path>
+DOCS_FILE_BLOCK = re.compile(r"^```\w+ file=(\S+)\n(.*?)^```", re.M | re.S)
+
+
+def docs_packages() -> dict[str, dict[str, str]]:
+    """Packages written out in README.md and docs/*.md as ``file=`` blocks: folder -> {path in it: text}."""
+    out: dict[str, dict[str, str]] = {}
+    for doc in [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]:
+        for path, text in DOCS_FILE_BLOCK.findall(doc.read_text()):
+            folder, _, rel = path.partition("/")
+            out.setdefault(folder, {})[rel] = text
+    return out
+
+
+def write_docs_package(folder: str, dst: Path) -> Path:
+    """The docs' package ``folder`` (:func:`docs_packages`) written under ``dst / folder``."""
+    root = Path(dst) / folder
+    for rel, text in docs_packages()[folder].items():
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_text(text)
+    return root
+
+
 def external_data() -> Path:
     """Real data written by others: ``$BIONAV_EXTERNAL_DATA``, else ``../shared/data`` beside the checkout."""
     env = os.environ.get("BIONAV_EXTERNAL_DATA")

@@ -13,8 +13,21 @@ class FakeLog:
         self.messages.append((topic, message, schema_name))
 
 
+def run_with(cfg, ctx):
+    """Run ``cfg.experiment`` in ``ctx`` as the runner hands it over (the plugin from the registry, its checked
+    config and group nodes), without the runner's files."""
+    from bionav.experiments.settings import check_group_nodes, experiment_class, experiment_config
+
+    cls = experiment_class(str(cfg.experiment.name))
+    ctx.cfg = cfg
+    ctx.nodes = check_group_nodes(cfg, cls)
+    return cls(experiment_config(cfg)).run(ctx)
+
+
 class FakeContext:
     def __init__(self, tmp_path, seed=0):
+        self.cfg = None
+        self.nodes = {}
         self.dir = Path(tmp_path)
         self.plots = self.dir / "plots"
         self.plots.mkdir(exist_ok=True)

@@ -44,6 +44,7 @@ from bionav.db.config import CameraConfig, PoseErrorConfig
 from bionav.db.unfold import unfold_panorama
 from bionav.geometry import PanoramaGeometry
 from bionav.world.catadioptric import MirrorProjection, RawFrameLayout, raw_frame_layout, render_raw_frame
+from bionav.world.scene import Scene
 
 #: Bump whenever a change to the camera pipeline changes pixels (part of the cache key).
 CAMERA_VERSION = 2
@@ -357,80 +358,11 @@ def session_seed(seed: int, db_seed: int = 0) -> int:
     database was taken: the pose errors, the clouds
     (:class:`bionav.light.capture.CaptureLight`) and where the supervisor
     stood (:class:`bionav.world.worlds.common.Supervisor`) share
-    ``db.pose_error.seed`` (and ``db.seed``).
+    ``db.pose_error.seed`` (and ``db.seed``); the world as it was at each capture is
+    :meth:`bionav.world.worlds.common.World.capture_scenes` with this seed.
     """
     return int(np.random.SeedSequence([int(db_seed) & 0xFFFFFFFF, int(seed) & 0xFFFFFFFF, 0x44415921])
                .generate_state(1)[0])
-
-
-def capture_scenes(world, positions: np.ndarray, *, seed: int, db_seed: int = 0):
-    """``scene_at(k)``: the compiled scene at capture ``k`` of a recording session, or None if the world is static.
-
-    Adds what changes while a database is recorded (``world.daylight``: the
-    sun and the clouds, entering through ``world.windows``; ``world.supervisor``: the person following the robot)
-    to a copy of the world's scene, compiled once; each capture then only
-    moves lights and the person in the compiled arrays.
-
-    Parameters
-    ----------
-    world : bionav.world.worlds.common.World
-    positions : ndarray, shape (N, 2), int
-        Grid cells ``(i, j)`` in capture order of the database (not the time order).
-    seed, db_seed : int
-        ``db.pose_error.seed`` and ``db.seed`` (:func:`session_seed`).
-
-    Returns
-    -------
-    callable or None
-        ``scene_at(k) -> CompiledScene`` (radiance without the scene's exposure).
-    """
-    import copy
-
-    daylight = getattr(world, "daylight", None)
-    supervisor = getattr(world, "supervisor", None)
-    if daylight is None and supervisor is None:
-        return None
-    if getattr(world, "capture_scene", None) is not None:
-        raise ValueError("a world has either World.capture_scene or a recording session (daylight, supervisor)")
-    if getattr(world.scene, "sky", None) is not None:
-        raise ValueError("recording-session changes (daylight, supervisor) are modelled for indoor worlds only "
-                         "(a compiled scene renders without the world's sky)")
-    from bionav.world.render import _compiled
-    from bionav.world.worlds.common import Supervisor, stream
-
-    sseed = session_seed(seed, db_seed)
-    windows = world.windows
-    scene = (windows.session_scene(world.scene, sun_irradiance=daylight.sun_irradiance) if daylight is not None
-             else copy.deepcopy(world.scene))
-    scene.info.pop("_compiled", None)
-    parts = supervisor.add_to(scene, seed=sseed) if supervisor is not None else None
-    session = _compiled(scene)
-    if daylight is not None:
-        kinds = session.light_params[:, 0]
-        sun = int(np.flatnonzero(kinds == 1)[-1])
-        sky = []
-        for idx in windows.sky_lights:
-            pos = np.asarray(world.scene.lights[idx].position, float)
-            hit = np.flatnonzero((kinds == 0) & np.all(np.isclose(session.light_params[:, 1:4], pos), axis=1))
-            sky.append(int(hit[0]))
-        sky = np.asarray(sky, np.int64)
-        cond = daylight.session_conditions(positions, rng=stream(sseed, "daylight/clouds"))
-    if supervisor is not None:
-        xy = np.array([world.cell_position(i, j)[:2] for i, j in positions], float).reshape(-1, 2)
-        feet, yaw = supervisor.stances(positions, xy, seed=sseed)
-
-    def scene_at(k: int):
-        kw = {}
-        if daylight is not None:
-            kw.update(windows.capture_lighting(session, sun_index=sun, sky_index=sky, sun_dir=cond["sun_dir"][k],
-                                               transmission=float(cond["transmission"][k]),
-                                               sky=float(cond["sky"][k])))
-        if supervisor is not None:
-            boxes, ell = Supervisor.place(session.boxes, session.ellipsoids, parts, feet[k], float(yaw[k]))
-            kw.update(boxes=boxes, ellipsoids=ell, prim_kind=None, prim_idx=None, spheres=None, casters=None)
-        return dataclasses.replace(session, **kw, shadow_grids=None, shadow_starts=None, shadow_items=None)
-
-    return scene_at
 
 
 def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, camera: CameraConfig,
@@ -486,20 +418,16 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     it = range(n)
     if progress is not None:
         it = progress(it)
-    scene_at = capture_scenes(world, positions, seed=int(pose_error.seed), db_seed=int(seed))
+    # the world as it was at each capture (the capture light, outdoors or through windows; the supervisor)
+    scene_at = world.capture_scenes(positions, seed=session_seed(int(pose_error.seed), int(seed)))
     light_level = float(getattr(world, "light_level", 1.0))
     for k in it:
         i, j = positions[k]
         x, y, z = world.cell_position(i, j)
-        if scene_at is not None:  # the recording session of a living room (daylight, supervisor)
-            scene = scene_at(k)
-        elif getattr(world, "capture_scene", None) is not None:  # the light of the capture (sim_uni)
-            scene = world.capture_scene(int(i), int(j))
-        else:
-            scene = world.scene
+        scene = world.scene if scene_at is None else scene_at(k)
         radiance = render_raw_frame(scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
                                     heading=float(dheads[k]), layout=setup.layout, threads=threads)
-        if scene_at is not None:  # a CompiledScene renders without the scene's exposure
+        if not isinstance(scene, Scene):  # a compiled session scene renders without the scene's exposure
             radiance *= float(world.scene.exposure)
         if light_level != 1.0:  # a dim scene (the night hall): the automatic exposure has to make up for it
             radiance *= light_level

@@ -184,7 +184,7 @@ class DatabaseConfig:
     def own_values(self) -> dict[str, Any]:
         """Values this database has whatever the config says (keys outside :data:`USED_KEYS`)."""
         if self.source == "synthetic":
-            from bionav.db.synthetic import get_spec
+            from bionav.db.standins import get_spec
 
             spec = get_spec(self.name)
             geometry = spec.geometry(*spec.native_size)

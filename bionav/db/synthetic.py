@@ -6,7 +6,7 @@ the grid shape, spacing and mirror field of view of the real database, adds
 camera noise and 8-bit quantisation, and optionally rotates every image by a
 random whole number of columns (Vardy's protocol for current views).
 
-The stand-ins (:data:`SYNTHETIC_DATABASES`):
+The stand-ins (:data:`bionav.db.standins.SYNTHETIC_DATABASES`):
 
 =============== ======= ======= ======== ======= ==========================================
 name            grid    spacing #images  mirror  world
@@ -31,149 +31,27 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable
 
 import numpy as np
 
 from bionav.db.database import ImageDatabase
+from bionav.db.standins import (  # noqa: F401  (the stand-ins' table: its home is db/standins.py)
+    NATIVE_SIZE,
+    SYNTHETIC_DATABASES,
+    SyntheticSpec,
+    get_spec,
+    normal_view_geometry,
+    synthetic_database_names,
+    ultra_wide_geometry,
+)
 from bionav.errors import UserError
 from bionav.files import cache_key, default_cache_dir, write_atomic
 from bionav.geometry import PanoramaGeometry
 
-#: Native size ``(W, H)`` of the stand-ins (the user may ask for any other size).
-NATIVE_SIZE = (561, 81)
-
 #: Bump when the database pipeline (noise, quantisation, layout) changes.
 DATABASE_VERSION = 1
-
-
-def ultra_wide_geometry(width: int = NATIVE_SIZE[0], height: int = NATIVE_SIZE[1]) -> PanoramaGeometry:
-    """Ultra-wide-view mirror: square pixels, horizon on the middle row (about +-26 deg at 561 x 81)."""
-    return PanoramaGeometry.square_pixels(*NATIVE_SIZE).resized(width, height)
-
-
-def normal_view_geometry(width: int = NATIVE_SIZE[0], height: int = NATIVE_SIZE[1]) -> PanoramaGeometry:
-    """Normal-view mirror: narrower view upwards (about +17 deg) and more of the ground (about -34 deg)."""
-    native = PanoramaGeometry.square_pixels(*NATIVE_SIZE, horizon_row=27.0)
-    return native.resized(width, height)
-
-
-def _lab(variant: str):
-    def build(seed: int):
-        from bionav.world.worlds.lab import build_lab_variant
-
-        return build_lab_variant(variant, seed)
-
-    return build
-
-
-def _lazy(module: str, func: str, **kwargs):
-    def build(seed: int):
-        import importlib
-
-        return getattr(importlib.import_module(module), func)(seed, **kwargs)
-
-    return build
-
-
-@dataclass(frozen=True)
-class SyntheticSpec:
-    """One synthetic stand-in of thesis table 3.1.
-
-    Attributes
-    ----------
-    name : str
-        ``sim_<thesis name>``.
-    grid_shape : (int, int)
-        ``(nx, ny)`` of the declared grid.
-    spacing_m : float
-        Grid spacing in metres.
-    n_images : int
-        Number of existing cells (table 3.1).
-    mirror : str
-        ``ultra-wide`` or ``normal-view``.
-    description : str
-        What the world shows.
-    builder : callable
-        ``builder(seed) -> World``.
-    geometry : callable
-        ``geometry(W, H) -> PanoramaGeometry``.
-    native_size : (int, int)
-        Native ``(W, H)``.
-    positions_from : str
-        How the real database's positions were recorded (thesis 3.1): ``odometry``,
-        ``semi-automatic`` or ``outdoor-odometry``; selects the pose errors of
-        ``realism="camera"`` (:data:`bionav.db.camera.POSE_ERRORS`).
-    """
-
-    name: str
-    grid_shape: tuple[int, int]
-    spacing_m: float
-    n_images: int
-    mirror: str
-    description: str
-    builder: Callable
-    geometry: Callable[[int, int], PanoramaGeometry] = ultra_wide_geometry
-    native_size: tuple[int, int] = NATIVE_SIZE
-    positions_from: str = "odometry"
-
-
-def _spec(name, grid, spacing, n, mirror, description, builder, positions_from="odometry") -> SyntheticSpec:
-    geom = normal_view_geometry if mirror == "normal-view" else ultra_wide_geometry
-    return SyntheticSpec(name, grid, spacing, n, mirror, description, builder, geom, NATIVE_SIZE, positions_from)
-
-
-#: The 13 synthetic stand-ins, by name.
-SYNTHETIC_DATABASES: dict[str, SyntheticSpec] = {
-    s.name: s
-    for s in [
-        _spec("sim_original", (10, 17), 0.3, 170, "ultra-wide",
-              "laboratory, curtains and door closed, both ceiling light bands on", _lab("original")),
-        _spec("sim_arboreal", (10, 17), 0.3, 170, "ultra-wide",
-              "the laboratory with an arboreal plant in the middle", _lab("arboreal")),
-        _spec("sim_chairs", (10, 17), 0.3, 170, "ultra-wide", "the laboratory with chairs added", _lab("chairs")),
-        _spec("sim_day", (10, 17), 0.3, 170, "ultra-wide",
-              "the laboratory with open curtains and daylight", _lab("day")),
-        _spec("sim_doorlit", (10, 17), 0.3, 170, "ultra-wide",
-              "the laboratory with only the door-side light band on", _lab("doorlit")),
-        _spec("sim_screen", (10, 17), 0.3, 170, "ultra-wide",
-              "the laboratory with a white projection screen", _lab("screen")),
-        _spec("sim_twilight", (10, 17), 0.3, 170, "ultra-wide",
-              "the laboratory with open curtains at twilight", _lab("twilight")),
-        _spec("sim_winlit", (10, 17), 0.3, 170, "ultra-wide",
-              "the laboratory with only the window-side light band on", _lab("winlit")),
-        _spec("sim_hall1", (10, 20), 0.5, 170, "ultra-wide",
-              "a large, dim, achromatic hall at night (cells missing under a kiosk)",
-              _lazy("bionav.world.worlds.hall", "build_hall", part=1)),
-        _spec("sim_hall2", (10, 20), 0.5, 170, "ultra-wide", "another part of the hall",
-              _lazy("bionav.world.worlds.hall", "build_hall", part=2)),
-        _spec("sim_moeller1", (11, 22), 0.1, 242, "ultra-wide", "a living room",
-              _lazy("bionav.world.worlds.living", "build_living_room"), "semi-automatic"),
-        _spec("sim_roeben1", (11, 36), 0.1, 396, "ultra-wide",
-              "a living room with kitchen, furniture close to the grid",
-              _lazy("bionav.world.worlds.living", "build_living_kitchen"), "semi-automatic"),
-        _spec("sim_uni", (10, 17), 1.0, 170, "normal-view",
-              "outdoors at a university entrance: buildings, trees, sky and sun",
-              _lazy("bionav.world.worlds.outdoor", "build_uni"), "outdoor-odometry"),
-    ]
-}
-
-
-def synthetic_database_names() -> list[str]:
-    """Names of the synthetic stand-ins."""
-    return sorted(SYNTHETIC_DATABASES)
-
-
-def get_spec(name: str) -> SyntheticSpec:
-    """The :class:`SyntheticSpec` of a stand-in; raises :class:`UserError` for unknown names."""
-    if name not in SYNTHETIC_DATABASES:
-        raise UserError(
-            f"Unknown synthetic database {name!r}. Available synthetic databases: "
-            f"{', '.join(synthetic_database_names())}. Choose one of them with db=<name>."
-        )
-    return SYNTHETIC_DATABASES[name]
 
 
 def read_cached_images(path: Path, key: str) -> np.ndarray | None:
@@ -348,6 +226,7 @@ def _cache_params(name: str, seed: int, noise: float, geometry, world, positions
 def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
     """The camera and pose errors of ``realism="camera"`` (resolved), their keys added to ``params``."""
     from bionav.db.camera import resolve_pose_error
+    from bionav.world.worlds.common import OpenSky, Windows
 
     camera, pose_error = _camera_configs(spec, camera, pose_error, geometry)
     pose_error = resolve_pose_error(pose_error, world)  # tilt_sigma_deg=None: the world's floor
@@ -357,15 +236,16 @@ def _add_camera_params(params: dict, spec, world, camera, pose_error, geometry):
         del pose_key["heading_drift_deg"]
     params.update(realism="camera", camera_version=_camera_version(), camera=dataclasses.asdict(camera),
                   pose_error=pose_key, native_size=list(spec.native_size))
-    if getattr(world, "daylight", None) is not None:  # the recording session (bionav.db.camera.capture_scenes)
-        params["daylight"] = world.daylight.describe()
-        params["windows"] = dataclasses.asdict(world.windows)
+    light, aperture = getattr(world, "capture_light", None), getattr(world, "aperture", None)
+    if light is not None and isinstance(aperture, Windows):  # the light of a recording session through windows
+        params["daylight"] = light.describe()
+        params["windows"] = dataclasses.asdict(aperture)
     if getattr(world, "supervisor", None) is not None:
         params["supervisor"] = dataclasses.asdict(world.supervisor)
     if getattr(world, "light_level", 1.0) != 1.0:  # a dim scene; 1 keeps the key of the other worlds
         params["light_level"] = float(world.light_level)
-    if "capture_light" in world.info:  # light changing during the capture (sim_uni)
-        params["capture_light"] = world.info["capture_light"]
+    if light is not None and isinstance(aperture, OpenSky):  # light changing during the capture outdoors (sim_uni)
+        params["capture_light"] = light.describe()
         params.pop("sky", None)  # each capture's sky is the capture light's, not the scene's
     return camera, pose_error
 

@@ -1,4 +1,4 @@
-"""Pieces several experiments share: config values, the configured database, homing method and sample set."""
+"""Pieces several experiments share: the configured database, homing method, worker pool and sample set."""
 
 from __future__ import annotations
 
@@ -127,23 +127,15 @@ def prepared_cache(cfg: DictConfig):
     return PreparedCache(user_path(str(cfg.cache_dir)), name)
 
 
-def _get(node, key, default=None):
-    try:
-        value = node.get(key, default) if hasattr(node, "get") else getattr(node, key, default)
-    except Exception:  # omegaconf missing value
-        return default
-    return default if value is None else value
-
-
 def load_samples(data):
-    """The sample set a ``data`` config node names.
+    """The sample set a checked ``data`` config names.
 
     Parameters
     ----------
-    data : mapping
-        ``name`` (``sim_natural``, ``sim_artificial`` or ``csv``) and its
-        options: ``seed``, ``n_objects``, ``n_sky``, ``n_average``,
-        ``noise_counts`` for the simulated sets; ``path`` for ``csv``.
+    data : DataConfig or LearnSamplesConfig
+        (:mod:`bionav.spectral.sample_config`) ``name`` (``sim_natural``, ``sim_artificial`` or ``csv``)
+        and its options: ``seed``, ``n_objects``, ``n_sky``, ``n_average``, ``noise_counts`` for the
+        simulated sets (defaults where the config has no such field, or ``None``); ``path`` for ``csv``.
 
     Returns
     -------
@@ -151,9 +143,13 @@ def load_samples(data):
     """
     from bionav.spectral.sensor_model import LogSensorModel
 
-    name = str(_get(data, "name", ""))
+    def _get(key, default=None):
+        value = getattr(data, key, None)
+        return default if value is None else value
+
+    name = str(_get("name", ""))
     if name == "csv":
-        path = _get(data, "path")
+        path = _get("path")
         if not path or str(path) == "???":
             raise UserError("data=csv needs the file: add data.path=/path/to/samples.csv (columns class,UV,B,G,R,IR, "
                             "optional kind,time).")
@@ -169,10 +165,10 @@ def load_samples(data):
     if name in ("sim_natural", "sim_artificial"):
         from bionav.spectral import samples as sim
 
-        sensor = LogSensorModel(noise_counts=float(_get(data, "noise_counts", 4.0)))
+        sensor = LogSensorModel(noise_counts=float(_get("noise_counts", 4.0)))
         default_objects = 239 if name == "sim_natural" else 124
         fn = sim.sim_natural if name == "sim_natural" else sim.sim_artificial
-        return fn(seed=int(_get(data, "seed", 0)), n_objects=int(_get(data, "n_objects", default_objects)),
-                  n_sky=int(_get(data, "n_sky", 233)), sensor=sensor, n_average=int(_get(data, "n_average", 10)))
+        return fn(seed=int(_get("seed", 0)), n_objects=int(_get("n_objects", default_objects)),
+                  n_sky=int(_get("n_sky", 233)), sensor=sensor, n_average=int(_get("n_average", 10)))
     raise UserError(f"Unknown data set {name!r} for experiment=contrast_lda. Choose data=sim_natural, "
                     f"data=sim_artificial, or data=csv data.path=FILE.")

@@ -29,6 +29,9 @@ class RunContext:
         The resolved run configuration.
     show_progress : bool
         Whether progress bars are drawn (on stderr).
+    nodes : dict
+        The other config nodes the experiment reads (its ``group_configs``: ``layout``, ``data``,
+        ``recordings``), checked instances of their dataclasses, by key.
     """
 
     dir: Path
@@ -37,6 +40,7 @@ class RunContext:
     cfg: DictConfig
     show_progress: bool = True
     artifacts: dict[str, Path] = field(default_factory=dict)
+    nodes: dict[str, Any] = field(default_factory=dict)
 
     @property
     def plots(self) -> Path:

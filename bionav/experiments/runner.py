@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import errno
-import importlib
 import json
 import logging
 import os
@@ -48,33 +47,24 @@ def is_completed(run_dir: Path) -> bool:
     return bool(metrics) and metrics.get("status") == "completed"
 
 
-#: the plugin groups each experiment reads (run.mcap's "plugins" metadata records only these)
-EXPERIMENT_PLUGIN_GROUPS: dict[str, tuple[str, ...]] = {
-    "grid_homing": ("homing", "signature"),
-    "cross_db": ("homing", "signature"),
-    "param_sweep": ("homing", "signature"),
-    "skyline_homing": ("homing",),
-    "route_homing": ("homing",),  # only with "homing" in experiment.methods
-    "cleaning": ("controller", "homing"),
-    "pol_compass": ("sensor", "pantilt", "decoder"),
-    "pol_recordings": ("decoder",),
-    "contrast_scan": ("sensor", "pantilt"),
-    "contrast_lda": (),
-}
-
-
 def used_plugin_groups(cfg: DictConfig) -> tuple[str, ...]:
-    """The config groups whose plugins ``cfg.experiment`` uses (every group for an unknown experiment).
+    """The config groups whose plugins ``cfg.experiment`` uses (every group for an unknown or broken experiment).
 
     The defaults select ``homing=sift`` for every run; an experiment that
     homes on nothing (the compass, the spectral contrasts) does not use it,
-    so its run.mcap must not name it.
+    so its run.mcap must not name it. Each experiment plugin says which it reads
+    (:meth:`Experiment.used_plugin_groups <bionav.experiments.base.Experiment.used_plugin_groups>`).
     """
-    name = str(OmegaConf.select(cfg, "experiment.name", default="") or "")
-    groups = EXPERIMENT_PLUGIN_GROUPS.get(name, tuple(PLUGIN_NODES) + ("decoder",))
-    if name == "route_homing" and "homing" not in list(OmegaConf.select(cfg, "experiment.methods", default=[]) or []):
-        groups = ()
-    return groups
+    from bionav.errors import PluginError
+    from bionav.experiments.base import DEFAULT_PLUGIN_GROUPS
+    from bionav.experiments.settings import experiment_class
+
+    node = cfg.get("experiment")
+    try:
+        cls = experiment_class(str(OmegaConf.select(cfg, "experiment.name", default="") or ""))
+    except PluginError:
+        return DEFAULT_PLUGIN_GROUPS
+    return tuple(cls.used_plugin_groups(node))
 
 
 def plugin_versions(cfg: DictConfig) -> dict[str, str]:
@@ -123,13 +113,17 @@ PLUGIN_NODES = {"homing": "homing", "signature": "signature", "sensor": "sensor"
                 "controller": "controller"}
 
 
-def validate_run_config(cfg: DictConfig) -> None:
-    """Check every value of a run's config against its declared type and range.
+def validate_run_config(cfg: DictConfig) -> Any:
+    """Check every value of a run's config against its declared type and range; the typed experiment node.
 
     The selected plugins' nodes (``homing``, ``signature``, ``sensor``,
-    ``pantilt``, ``controller``), the ``db`` node and the experiment node are
-    each checked against their ``Config`` dataclass
-    (:func:`bionav.validation.check_config`).
+    ``pantilt``, ``controller``), the ``db`` node, the experiment node and the
+    other nodes the experiment reads (``layout``, ``data``, ``recordings``) are
+    each checked against their dataclass (:func:`bionav.validation.typed_config`).
+
+    Returns
+    -------
+    The experiment's checked ``Config`` instance (None without an ``experiment`` node).
 
     Raises
     ------
@@ -138,10 +132,12 @@ def validate_run_config(cfg: DictConfig) -> None:
     """
     from bionav.config import plugin_config
     from bionav.db.loading import as_database_config
-    from bionav.experiments.configs import check_group_nodes, check_run_settings, experiment_config
+    from bionav.experiments.settings import check_group_nodes, check_run_settings, experiment_class, experiment_config
 
     check_run_settings(cfg)
-    check_group_nodes(cfg)
+    name = OmegaConf.select(cfg, "experiment.name", default=None) if cfg.get("experiment") is not None else None
+    if name is not None:
+        check_group_nodes(cfg, experiment_class(str(name)))  # a PluginError names the installed experiments
     if cfg.get("cache_dir") is not None:  # before any rendering: a cache that cannot be written wastes it all
         from bionav.files import check_cache_dir
 
@@ -152,8 +148,7 @@ def validate_run_config(cfg: DictConfig) -> None:
             plugin_config(kind, node, key=group)  # a broken or conflicting plugin raises its message
     if cfg.get("db") is not None:
         as_database_config(cfg.db)
-    if cfg.get("experiment") is not None:
-        experiment_config(cfg)
+    return experiment_config(cfg)
 
 
 def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True) -> dict[str, Any]:
@@ -194,22 +189,21 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
         mcap = McapLog(run_dir / LOG_FILE)
         mcap.attach("config.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode(), media_type="application/yaml")
         mcap.metadata("plugins", plugin_versions(cfg))
-        validate_run_config(cfg)
+        config = validate_run_config(cfg)
         attach_live_view(mcap, cfg)
-        try:
-            module = importlib.import_module(f"bionav.experiments.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"bionav.experiments.{name}":
-                raise
-            raise UserError(f"there is no experiment named {name!r}; choose one with experiment=<name>.") from None
+        from bionav.experiments.settings import check_group_nodes, experiment_class
+
+        cls = experiment_class(name)  # from the registry (bionav.experiments)
         ctx = RunContext(
             dir=run_dir,
             log=mcap,
             rng=np.random.default_rng(int(cfg.get("seed", 0))),
             cfg=cfg,
             show_progress=show_progress,
+            nodes=check_group_nodes(cfg, cls),
         )
-        result = module.run(cfg, ctx)
+        experiment = cls(config)
+        result = experiment.run(ctx)
         metrics.update(result or {})
         metrics["status"] = "completed"
     except BaseException as exc:

@@ -12,10 +12,10 @@ windows brightens and darkens with them.
 :class:`CaptureLight` is that light, one class for both: per capture, where
 the sun stands, how much of its direct light the clouds let through and how
 bright the sky is. Where the light enters (the whole sky outdoors, a room's
-windows indoors) is geometry and belongs to the renderer:
-:func:`bionav.world.worlds.outdoor.relit_at` relights an outdoor scene,
-:class:`bionav.world.worlds.common.Windows` lets the light into a room
-(:func:`bionav.db.camera.capture_scenes`).
+windows indoors) is geometry and belongs to the renderer: a world's aperture,
+:class:`bionav.world.worlds.common.OpenSky` (relights an outdoor scene) or
+:class:`bionav.world.worlds.common.Windows` (lets the light into a room), both
+behind the one capture interface :meth:`bionav.world.worlds.common.World.capture_scenes`.
 
 Frame: east-north-up (x east, y north, z up; azimuths counter-clockwise from
 ``+x``); times in seconds after the first capture (UTC).

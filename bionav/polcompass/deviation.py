@@ -20,7 +20,7 @@ with another sky does not move it). Measured on the recordings (leave one day ou
 learned on clear-sky days, the plain curve lowers the held-out daylight MAE a little and raises canopy
 and dusk; the tilt form lowers daylight by half a degree without array calibration and by 0.1 on top of
 the polarizer offsets, without changing canopy or dusk there: it is the ``tilt`` part of
-``experiment=pol_recordings``'s calibration (:func:`bionav.experiments.pol_recordings_session.mount_tilt`), the plain
+``experiment=pol_recordings``'s calibration (:func:`bionav.polcompass.sessions.mount_tilt`), the plain
 form is not used. ``python -m bionav.bench.decoders.deviation`` repeats the study.
 """
 

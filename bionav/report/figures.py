@@ -54,3 +54,25 @@ def grid_cell_axes(ax, *, fontsize: float | None = None) -> None:
     ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("x (grid cells)", fontsize=fontsize)
     ax.set_ylabel("y (grid cells)", fontsize=fontsize)
+
+
+def draw_border_line(ax, point, tangent, style: str, label: str, *, color: str = "tab:blue", lw: float = 1.3) -> None:
+    """A straight class border through ``point`` along ``tangent`` (data units), drawn across the axes' view.
+
+    The line is moved along itself next to the view's centre and the axes' limits are kept, so
+    a border whose reference point lies far outside the data still shows where the data are.
+    """
+    import numpy as np
+
+    point, tangent = np.asarray(point, float), np.asarray(tangent, float)
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    span = 4 * max(x1 - x0, y1 - y0)
+    p = point + np.outer(np.linspace(-span, span, 3), tangent)
+    # move the border's reference point next to the data
+    centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
+    shift = ((centre - point) @ tangent) * tangent
+    p = p + shift
+    ax.plot(p[:, 0], p[:, 1], style, color=color, lw=lw, label=label)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)

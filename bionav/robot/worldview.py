@@ -1,4 +1,5 @@
-"""The simulated robot in a rendered world: loading the world, placing the lanes, the camera."""
+"""Where a cleaning robot runs: the world it sees (rendered, or an empty room for oracle runs), its lanes placed
+in it, its camera (:class:`CleaningWorld`)."""
 
 from __future__ import annotations
 
@@ -212,3 +213,77 @@ def place_plan(world, floor: FloorPlan, plan: LanePlan, *, layout: Any = None,
     raise UserError(f"the {plan.n_lanes} x {plan.lane_length} m layout does not fit along any wall of the world "
                     f"(best clearance {best_clear:.2f} m < robot radius {robot_radius} m); choose a smaller "
                     f"layout or give layout.start and layout.start_heading_deg.")
+
+
+@dataclass
+class CleaningWorld:
+    """Where the runs happen.
+
+    Attributes
+    ----------
+    floor : FloorPlan
+        Obstacles (collisions, wall sensor).
+    start : Pose
+        World pose of the plan frame's origin (nominal start of the first lane).
+    camera_factory : callable
+        ``camera_factory(seed) -> camera(true_pose, capture_index) -> image``.
+    geometry : PanoramaGeometry or None
+        Geometry of the rendered images (None in oracle mode).
+    scene : object
+        The rendered scene (None in oracle mode).
+    guide_wall : bool
+        A straight guide wall was added for the first lane's wall following
+        (the world has no wall where the layout fits).
+    """
+
+    floor: Any
+    start: Pose
+    camera_factory: Callable[[int], Callable]
+    geometry: Any = None
+    scene: Any = None
+    guide_wall: bool = False
+
+
+def oracle_world(plan: LanePlan, *, margin: float = 1.0) -> CleaningWorld:
+    """An empty room for oracle runs: the plan frame is the world frame, the wall along the first lane.
+
+    The first lane's wall lies ``plan.wall_offset`` to the right of the first
+    lane; the other walls ``margin`` metres beyond the target area.
+    """
+    from bionav.robot.floorplan import FloorPlan
+    from bionav.robot.oracle import oracle_camera
+
+    (x0, y0), (x1, y1) = plan.target_rectangle()
+    if plan.side > 0:
+        lo, hi = (x0 - margin, -plan.wall_offset), (x1 + margin, y1 + margin)
+    else:
+        lo, hi = (x0 - margin, y0 - margin), (x1 + margin, plan.wall_offset)
+    floor = FloorPlan.from_shapes(rooms=[(lo, hi)])
+    return CleaningWorld(floor=floor, start=Pose(0.0, 0.0, 0.0), camera_factory=lambda seed: oracle_camera)
+
+
+def rendered_world(plan: LanePlan, *, world: str, world_seed: int, camera, robot_height: float, robot_radius: float,
+                   layout: Any = None) -> CleaningWorld:
+    """The synthetic world ``world`` with the layout placed in it (:func:`place_plan`), and a rendering camera.
+
+    ``camera`` has ``width``, ``height`` (pixels), ``horizon_row`` (None: the middle row),
+    ``height_m`` (above the floor) and ``noise`` (``experiment.camera``); ``robot_height`` and
+    ``robot_radius`` in metres; ``layout`` the ``layout`` node (its ``start`` and ``start_heading_deg``).
+    """
+    from bionav.geometry import PanoramaGeometry
+    from bionav.robot.floorplan import floorplan_from_scene
+
+    scene_world = load_world(world, seed=world_seed)
+    cam = camera
+    geometry = PanoramaGeometry.square_pixels(
+        int(cam.width), int(cam.height), horizon_row=None if cam.horizon_row is None else float(cam.horizon_row))
+    floor = floorplan_from_scene(scene_world.scene, max_height=robot_height)
+    placement = place_plan(scene_world, floor, plan, layout=layout, robot_radius=robot_radius)
+    height = float(cam.height_m)
+    noise = float(cam.noise)
+
+    def factory(seed: int):
+        return render_camera(scene_world.scene, geometry, height=height, noise=noise, seed=seed)
+
+    return CleaningWorld(floor=placement.floor, start=placement.start, camera_factory=factory, geometry=geometry,
+                         scene=scene_world.scene, guide_wall=placement.guide_wall)

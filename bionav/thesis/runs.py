@@ -347,6 +347,10 @@ class Runner:
         database wait until its first run has rendered it (the render cache), and each run
         gets ``workers = max(1, cores // jobs)``, so the cores are shared, not oversubscribed.
         With a launcher: multiruns in flight at once (each one a job array on SLURM).
+    cost : callable, optional
+        ``cost(spec) -> float``: the CPU seconds a spec is expected to need (the plan's estimate,
+        ``lambda s: bionav.thesis.plan.task_cpu_s(s).cpu_s``); the longest expected task goes first.
+        None: the specs in the order given.
     """
 
     out: Path
@@ -355,6 +359,10 @@ class Runner:
     echo: Callable[[str], None] = print
     env: dict | None = None
     jobs: int = 1
+    cost: Callable[[RunSpec], float] | None = None
+
+    def _expected_cpu_s(self, spec: RunSpec) -> float:
+        return 0.0 if self.cost is None else float(self.cost(spec))
 
     def run_all(self, specs: Sequence[RunSpec]) -> dict[str, RunResult]:
         """Execute every spec not yet completed under :attr:`out`; split runs go as their tasks."""
@@ -440,16 +448,14 @@ class Runner:
     def _run_pool(self, todo: Sequence[RunSpec]) -> dict[str, RunResult]:
         """Run ``todo`` on :attr:`jobs` slots; a database's first run goes before its other runs.
 
-        Longest expected task first (the plan's CPU estimate, :func:`bionav.thesis.plan.task_cpu_s`):
-        the largest tasks then overlap the many small ones instead of running alone at the end.
+        Longest expected task first (:attr:`cost`, the plan's CPU estimate): the largest tasks then
+        overlap the many small ones instead of running alone at the end.
         """
         from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
-        from bionav.thesis.plan import task_cpu_s
-
         cores = usable_cpus()
         extra = [f"workers={max(1, cores // self.jobs)}"]
-        waiting = sorted(todo, key=lambda sp: -task_cpu_s(sp).cpu_s)  # stable: equal estimates keep their order
+        waiting = sorted(todo, key=lambda sp: -self._expected_cpu_s(sp))  # stable: equal estimates keep their order
         rendering: set[tuple[str, ...]] = set()  # databases whose first run is running
         rendered: set[tuple[str, ...]] = set()  # databases with a finished run (cached renders)
         results: dict[str, RunResult] = {}
@@ -496,9 +502,7 @@ class Runner:
                 run_dir = self.out / "runs" / spec.group / spec.slug
                 commands.append((spec.command(run_dir, launcher=self.launcher), [spec], run_dir))
         # the multirun holding the longest expected task first (queued first on SLURM), as the pool does
-        from bionav.thesis.plan import task_cpu_s
-
-        commands.sort(key=lambda c: -max(task_cpu_s(s).cpu_s for s in c[1]))
+        commands.sort(key=lambda c: -max(self._expected_cpu_s(s) for s in c[1]))
 
         def launch(i: int, cmd: list[str], covered: list[RunSpec], sweep_dir: Path) -> None:
             self.echo(f"[{i}/{len(commands)}] python " + " ".join(_quote(c) for c in cmd[1:]))

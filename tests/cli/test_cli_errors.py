@@ -56,8 +56,17 @@ def test_unwritable_output_dir(tmp_path):
 
 def test_failed_run_writes_failed_metrics(tmp_path):
     run_dir = tmp_path / "run"
-    proc = run_bionav("experiment.name=no_such_experiment", f"hydra.run.dir={run_dir}", cwd=tmp_path)
-    assert_fails_cleanly(proc, "no experiment named 'no_such_experiment'")
+    proc = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path / 'nowhere'}", f"hydra.run.dir={run_dir}",
+                      cwd=tmp_path)
+    assert_fails_cleanly(proc, "nowhere does not exist")
     metrics = json.loads((run_dir / "metrics.json").read_text())
-    assert metrics["status"] == "failed" and "no_such_experiment" in metrics["error"]
+    assert metrics["status"] == "failed" and "nowhere does not exist" in metrics["error"]
     assert (run_dir / "run.mcap").stat().st_size > 0
+
+
+def test_an_unknown_experiment_is_refused_before_the_run(tmp_path):
+    """``experiment.name`` names no installed experiment plugin: the installed ones listed, no run started."""
+    run_dir = tmp_path / "run"
+    proc = run_bionav("experiment.name=no_such_experiment", f"hydra.run.dir={run_dir}", cwd=tmp_path)
+    assert_fails_cleanly(proc, "no experiment plugin named 'no_such_experiment'", "grid_homing, param_sweep")
+    assert not (run_dir / "metrics.json").exists()

@@ -378,24 +378,24 @@ def test_interrupt_or_terminate_a_run_keeps_its_results(tmp_path, render_cache, 
 def test_ctrl_c_inside_compiled_code_counts_as_an_interrupt(tmp_path, monkeypatch):
     """numba turns a KeyboardInterrupt inside a jitted function into SystemError (caused by the interrupt);
     the runner records it as an interrupt and re-raises KeyboardInterrupt (so a sweep stops, not goes on)."""
-    import types
-
     from omegaconf import OmegaConf
 
+    from bionav.experiments.base import Experiment
     from bionav.experiments.runner import run_experiment
 
-    def run(cfg, ctx):
-        ctx.log.write("/t", {"before": 1}, schema_name="bionav.Test")
-        try:
-            raise KeyboardInterrupt
-        except KeyboardInterrupt as exc:
-            raise SystemError("CPUDispatcher(<function f>) returned a result with an exception set") from exc
+    class Interrupted(Experiment):
+        Config = dict  # not checked: validate_run_config is replaced below
 
-    module = types.ModuleType("bionav.experiments.interrupted_inside_numba")
-    module.run = run
-    monkeypatch.setitem(sys.modules, module.__name__, module)
+        def run(self, ctx):
+            ctx.log.write("/t", {"before": 1}, schema_name="bionav.Test")
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt as exc:
+                raise SystemError("CPUDispatcher(<function f>) returned a result with an exception set") from exc
+
     cfg = OmegaConf.create({"experiment": {"name": "interrupted_inside_numba"}, "seed": 0})
     monkeypatch.setattr("bionav.experiments.runner.validate_run_config", lambda cfg: None)
+    monkeypatch.setattr("bionav.experiments.settings.experiment_class", lambda name: Interrupted)
     with pytest.raises(KeyboardInterrupt):
         run_experiment(cfg, tmp_path / "run")
     metrics = json.loads((tmp_path / "run" / "metrics.json").read_text())

@@ -103,13 +103,16 @@ def test_data_node_is_typed():
     from omegaconf import OmegaConf
 
     from bionav.errors import UserError
-    from bionav.experiments.configs import check_group_nodes
+    from bionav.experiments.settings import check_group_nodes, experiment_class
 
-    check_group_nodes(OmegaConf.create({"seed": 4, "data": {"name": "sim_natural", "seed": "${seed}", "n_sky": 50}}))
+    lda = experiment_class("contrast_lda")  # its group_configs type the data= node
+    checked = check_group_nodes(OmegaConf.create({"seed": 4, "data": {"name": "sim_natural", "seed": "${seed}",
+                                                                       "n_sky": 50}}), lda)
+    assert checked["data"].seed == 4 and checked["data"].n_sky == 50
     with pytest.raises(UserError, match=r"data.n_sky=1: .*>= 2"):
-        check_group_nodes(OmegaConf.create({"data": {"name": "sim_natural", "n_sky": 1}}))
+        check_group_nodes(OmegaConf.create({"data": {"name": "sim_natural", "n_sky": 1}}), lda)
     with pytest.raises(UserError, match=r"unknown key data.n_skyy.*Did you mean data.n_sky\?"):
-        check_group_nodes(OmegaConf.create({"data": {"name": "sim_natural", "n_skyy": 1}}))
+        check_group_nodes(OmegaConf.create({"data": {"name": "sim_natural", "n_skyy": 1}}), lda)
 
 
 # --------------------------------------------------------------------------- the mechanism itself
@@ -139,22 +142,22 @@ def test_check_config_names_key_value_and_range(field, value, needle):
 
 #: string options that are free text (paths, ports, names resolved elsewhere, times)
 #: keys whose values are free text or paths (``calibration``: none | auto | a calibration.json path, checked where
-#: the file is read)
+#: the file is read; ``db=bag``'s topic and frame names: checked against the bag where it is read, db/bag/)
 FREE_TEXT = {"port", "path", "topic", "signature", "time", "name", "calibration_path", "world", "grid", "route",
-             "routes_path", "calibration"}
+             "routes_path", "calibration", "image_topic", "pose_topic", "pose_frame", "world_frame"}
 
 
 def _all_config_classes():
     from bionav import registry
     from bionav.db.config import DatabaseConfig
-    from bionav.experiments.configs import EXPERIMENT_CONFIGS
 
     out = [("db", DatabaseConfig)]
-    for kind in registry.GROUPS:
+    for kind in registry.GROUPS:  # the experiments' Config too (kind experiment) and their group configs
         for name, plugin in registry.plugins_of(kind, warn=False).items():
             if plugin.cls is not None and plugin.entry.distribution == "bionav":
                 out.append((f"{kind}={name}", plugin.cls.Config))
-    out += [(f"experiment={name}", cls) for name, cls in EXPERIMENT_CONFIGS.items()]
+                out += [(f"{kind}={name} {node}", schema) for node, schema in
+                        dict(getattr(plugin.cls, "group_configs", {})).items()]
     return out
 
 

@@ -114,7 +114,7 @@ def test_a_key_completion_composes_without_other_plugins_or_numpy_free_rooms(tmp
     assert printed[0].split() == ["homing.search_radius="]
     plugins = {m for m in modules if m.startswith("bionav.plugins.") and m.count(".") >= 3}
     assert plugins == {"bionav.plugins.homing.sift"}, plugins
-    assert "bionav.db.database" not in modules and "bionav.experiments.grid_homing" not in modules
+    assert "bionav.db.database" not in modules and "bionav.experiments.grid_homing.run" not in modules
 
 
 @pytest.mark.slow

@@ -89,3 +89,57 @@ def test_entry_points_are_read_once(fake_distributions, monkeypatch):
     registry.entry_points_of("homing")
     registry.load_plugin("homing", "sift")
     assert calls == []
+
+
+EXPERIMENT = """
+from dataclasses import dataclass
+from bionav.experiments import Experiment
+from bionav.validation import bounded
+
+@dataclass
+class SpinConfig:
+    turns: int = bounded(2, ge=1, le=10)
+
+class Spin(Experiment):
+    Config = SpinConfig
+    plugin_groups = ()
+
+    def run(self, ctx):
+        return {"turns": self.config.turns}
+
+class NoRun:
+    Config = SpinConfig
+"""
+
+
+def test_experiments_are_plugins_like_the_others(fake_distributions):
+    """Issue 39: bionav's experiments come from entry points; a third-party one is listed, loaded and composed
+    with no YAML (its keys from its Config); a broken one is a warning until selected; a duplicate blocks its name."""
+    import warnings
+
+    from bionav.config import compose
+    from bionav.experiments.settings import experiment_config
+
+    builtin = registry.entry_points_of("experiment")
+    assert {"grid_homing", "cleaning", "pol_recordings"} <= set(builtin)
+    assert builtin["grid_homing"].distribution == "bionav"
+    fake_distributions("fake-spin", {"bionav.experiments": {"spin": "fakeexp_spin:Spin", "norun": "fakeexp_spin:NoRun",
+                                                             "broken": "fakeexp_missing:Spin"}},
+                       {"fakeexp_spin": EXPERIMENT})
+    fake_distributions("fake-twin", {"bionav.experiments": {"grid_homing": "fakeexp_spin:Spin"}})
+    assert "spin" in registry.names_by_group()["experiment"]  # listed from the entry points alone
+    cfg = compose(["experiment=spin", "experiment.turns=3"])
+    assert dict(cfg.experiment) == {"turns": 3, "name": "spin"}
+    assert experiment_config(cfg).turns == 3
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        loaded = registry.plugins_of("experiment")
+    messages = " ".join(str(w.message) for w in caught)
+    assert "fake-spin" in messages and "broken" in messages and "norun" in messages
+    assert "no `run(self, ctx)` method" in loaded["norun"].error
+    assert loaded["spin"].cls.__name__ == "Spin" and loaded["cleaning"].cls is not None
+    with pytest.raises(PluginError, match="fake-twin"):  # two distributions claim grid_homing
+        registry.load_plugin("experiment", "grid_homing")
+    assert registry.load_plugin("experiment", "cleaning").__name__ == "Cleaning"  # the others stay usable
+    with pytest.raises(PluginError, match="experiment plugin 'broken'.*fake-spin.*fakeexp_missing"):
+        registry.load_plugin("experiment", "broken")

@@ -73,7 +73,7 @@ def test_merge_refuses_an_incomplete_split(folder_db, tmp_path):
 def test_cross_db_units_cover_every_pair_and_snapshot_once():
     """Known answer: up to as many tasks as snapshots, task i holds every n-th snapshot for all pairs
     (the old split); beyond, every n-th (snapshot, pair) unit, balanced, each exactly once."""
-    from bionav.experiments.cross_db import task_units
+    from bionav.experiments.cross_db.run import task_units
 
     snaps = [3, 7, 11]
     whole = task_units(None, snaps, 2)

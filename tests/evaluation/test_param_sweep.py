@@ -13,7 +13,7 @@ from parameter_scene import render, ring_of_landmarks
 
 from bionav.db.database import ImageDatabase
 from bionav.evaluation.pairs import home_vector_matrix, neighbour_table
-from bionav.experiments import param_sweep
+from bionav.experiments.param_sweep import levels as param_sweep
 from bionav.geometry import PanoramaGeometry
 from bionav.plugins.homing.parameter import Config, ParameterHoming
 from bionav.plugins.signatures import SIGNATURE_NAMES, builtin_signature_class
@@ -128,6 +128,8 @@ def test_ranking_table_best_configuration_per_signature():
 def test_run_writes_rows_and_report_builds_ranking(small_db, tmp_path, monkeypatch):
     import bionav.experiments.common as common
     from bionav.experiments.context import RunContext
+    from bionav.experiments.param_sweep.run import run as sweep_job
+    from bionav.experiments.settings import experiment_config
     from bionav.logs.writer import McapLog
 
     monkeypatch.setattr(common, "load_configured_database", lambda cfg, node=None: small_db)
@@ -145,7 +147,7 @@ def test_run_writes_rows_and_report_builds_ranking(small_db, tmp_path, monkeypat
         run_dir.mkdir(parents=True)
         log = McapLog(run_dir / "run.mcap")
         ctx = RunContext(dir=run_dir, log=log, rng=np.random.default_rng(0), cfg=cfg, show_progress=False)
-        metrics = param_sweep.run(cfg, ctx)
+        metrics = sweep_job(experiment_config(cfg), ctx)
         log.close()
         (run_dir / "metrics.json").write_text(json.dumps({"experiment": "param_sweep", "status": "completed", **metrics}))
         lines = (run_dir / "param_sweep.jsonl").read_text().splitlines()

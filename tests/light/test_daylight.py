@@ -11,13 +11,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from bionav.db.camera import capture_scenes, session_seed
+from bionav.db.camera import session_seed
 from bionav.db.synthetic import get_spec, synthetic_database
 from bionav.light.capture import CaptureLight
 from bionav.world.lights import Ambient
 from bionav.world.render import render_ray_grid
 from bionav.world.scene import Scene
-from bionav.world.worlds.common import Supervisor, Windows, World, lane_order, stream
+from bionav.world.worlds.common import OpenSky, Supervisor, Windows, World, lane_order, stream
 
 ROOM = (4.0, 4.0, 2.5)
 WINDOW = ("y0", 1.5, 2.5, 1.0, 2.0)  # on the wall y = 0, x 1.5 .. 2.5, z 1.0 .. 2.0
@@ -33,7 +33,7 @@ def _empty_room() -> World:
     daylight = CaptureLight(order=lane_order((1, 1)), seconds_per_capture=40.0, sun_azimuth_deg=(-90.0, -90.0),
                             sun_elevation_deg=(45.0, 45.0), sun_irradiance=2.0, cloud_sigma=0.0)
     return World(scene=scene, grid_origin=(2.0, 2.0), spacing=0.1, grid_shape=(1, 1), camera_height=0.6,
-                 daylight=daylight, windows=Windows(room=ROOM, windows=(WINDOW,)))
+                 capture_light=daylight, aperture=Windows(room=ROOM, windows=(WINDOW,)))
 
 
 def _radiance_towards(scene, eye, target) -> float:
@@ -46,7 +46,7 @@ def _radiance_towards(scene, eye, target) -> float:
 
 def test_the_sun_lights_the_floor_only_where_it_enters_through_the_window():
     world = _empty_room()
-    scene_at = capture_scenes(world, np.array([[0, 0]]), seed=0, db_seed=0)
+    scene_at = world.capture_scenes(np.array([[0, 0]]), seed=session_seed(0, 0))
     sunny = scene_at(0)
     eye = world.cell_position(0, 0)
     # sun from -y at 45 deg: a floor point at y = 1.5 sees the wall y = 0 at height 1.5, inside the window
@@ -91,7 +91,7 @@ def test_a_capture_light_needs_exactly_one_sun_path_and_comes_with_windows():
         light.conditions(0, 0)
     with pytest.raises(ValueError, match="come together"):
         World(scene=Scene(name="x"), grid_origin=(0.0, 0.0), spacing=0.1, grid_shape=(2, 3), camera_height=0.6,
-              daylight=light)
+              capture_light=light)
 
 
 def test_clouds_are_seeded_by_the_recording_session():
@@ -114,17 +114,18 @@ def test_clouds_are_seeded_by_the_recording_session():
 @pytest.mark.parametrize("name", ["sim_moeller1", "sim_roeben1"])
 def test_living_rooms_are_recorded_in_daylight_and_ideal_ignores_it(name, tmp_path):
     world = get_spec(name).builder(0)
-    assert world.daylight is not None and world.daylight.sun_irradiance > 0 and world.windows is not None
+    assert world.capture_light is not None and world.capture_light.sun_irradiance > 0
+    assert isinstance(world.aperture, Windows)
     kw = dict(image_size=(48, 8), cache_dir=tmp_path)
     cam = synthetic_database(name, realism="camera", **kw)
     assert cam.images.shape[0] == int(np.prod(world.grid_shape))
     # without the sun the camera images change (the cache key knows the daylight too)
-    dark = replace(world.daylight, sun_irradiance=0.0)
+    dark = replace(world.capture_light, sun_irradiance=0.0)
     orig = get_spec(name).builder
 
     def build_dark(seed):
         w = orig(seed)
-        w.daylight = dark
+        w.capture_light = dark
         return w
 
     import bionav.db.synthetic as syn
@@ -157,17 +158,17 @@ def test_the_supervisor_stands_behind_the_robot_facing_it():
 
 def test_the_supervisor_is_seen_where_he_stands_and_nowhere_else():
     world = _empty_room()
-    world.daylight, world.windows = None, None
+    world.capture_light, world.aperture = None, None
     world.supervisor = Supervisor(room=ROOM[:2], distance_m=1.2, jitter_m=0.0)
-    scene_at = capture_scenes(world, np.array([[0, 0]]), seed=0, db_seed=0)
+    scene_at = world.capture_scenes(np.array([[0, 0]]), seed=session_seed(0, 0))
     eye = world.cell_position(0, 0)  # (2.0, 2.0, 0.6): lane 0, the person stands at (2.0, 0.8)
     seen = scene_at(0)
     torso, beside = (2.0, 0.8, 1.2), (3.0, 0.8, 1.2)
     wall = _radiance_towards(world.scene, eye, torso)
     assert _radiance_towards(seen, eye, torso) != pytest.approx(wall, rel=1e-3)  # the shirt, not the wall
     assert _radiance_towards(seen, eye, beside) == pytest.approx(_radiance_towards(world.scene, eye, beside))
-    assert capture_scenes(World(scene=world.scene, grid_origin=(2.0, 2.0), spacing=0.1, grid_shape=(1, 1),
-                                camera_height=0.6), np.array([[0, 0]]), seed=0) is None
+    assert World(scene=world.scene, grid_origin=(2.0, 2.0), spacing=0.1, grid_shape=(1, 1),
+                 camera_height=0.6).capture_scenes(np.array([[0, 0]]), seed=0) is None
 
 
 def test_one_capture_light_outdoors_and_through_windows_agree():

@@ -150,8 +150,8 @@ def test_the_command_self_calibrates_leaving_one_day_out(tmp_path):
 @pytest.mark.slow  # over 5 s on two cores
 @needs_data
 def test_a_real_daylight_session_self_calibrates():
-    from bionav.experiments.configs import RecordingsConfig
-    from bionav.experiments.pol_recordings_session import prepare_session
+    from bionav.polcompass.recordings_config import RecordingsConfig
+    from bionav.polcompass.sessions import prepare_session
     from bionav.polcompass.recordings import load_sessions
 
     sessions, _ = load_sessions(COMPASS / "tod_data" / "Thursday_12-05-22" / "17-01__Thursday_12-05-22")
@@ -247,7 +247,7 @@ def test_the_simulated_view_field_gives_the_ring_residual_it_was_fitted_with():
     """``sim_view_sigma`` of experiment=pol_recordings is fitted on the real counts' departure from one shared sky ring
     (median ``residual_rms`` 0.087 over the daylight sessions, docs/polcompass.md): the self-calibration's residual
     grows with it, about 0.9 sigma, and a field of unit variance is what the docstring says."""
-    from bionav.experiments.pol_recordings_session import view_field
+    from bionav.polcompass.sessions import view_field
 
     rng = np.random.default_rng(3)
     g = view_field(rng, np.linspace(0, 2 * np.pi, 2000, endpoint=False), FILE_AZIMUTHS, 4)
@@ -269,7 +269,7 @@ def test_the_simulated_view_field_gives_the_ring_residual_it_was_fitted_with():
 
 def test_a_shared_view_field_is_the_same_for_a_units_photodiodes_and_keeps_unit_variance():
     """``view_field(shared=s)``: ``sqrt(s) u_k + sqrt(1 - s) g_kp``; all shared cancels in every POL-OP's log ratio."""
-    from bionav.experiments.pol_recordings_session import view_field
+    from bionav.polcompass.sessions import view_field
 
     heading = np.linspace(0, 2 * np.pi, 3000, endpoint=False)
     whole = view_field(np.random.default_rng(1), heading, FILE_AZIMUTHS, 4, shared=1.0)

@@ -158,7 +158,7 @@ def test_missing_port_fails_cleanly(tmp_path):
 
 
 def test_unplug_mid_scan_keeps_readings_in_the_log(tmp_path):
-    from bionav.experiments.pol_compass import run_session
+    from bionav.experiments.pol_compass.run import run_session
     from bionav.light import SkyModel, SunPosition
     from bionav.logs.writer import McapLog
     from bionav.plugins.sensors.fakes.dlpio8 import CompassCounts, FakeDLPIO8

@@ -54,10 +54,8 @@ def test_pooling_is_the_median_and_too_few_samples_give_none():
 @pytest.mark.slow
 @pytest.mark.skipif(not COMPASS.is_dir(), reason=f"real compass recordings not found at {COMPASS} (set BIONAV_EXTERNAL_DATA)")
 def test_deviation_bench_learns_on_the_other_day(tmp_path):
-    from omegaconf import OmegaConf
-
-    from bionav.experiments import pol_recordings as pr
-    from bionav.experiments import pol_recordings_session as ps
+    from bionav.polcompass import recordings_config as pr
+    from bionav.polcompass import sessions as ps
     from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
     from bionav.polcompass.decoders import heading_from_sun
 
@@ -72,7 +70,7 @@ def test_deviation_bench_learns_on_the_other_day(tmp_path):
     daylight = lines[0]
     assert daylight["condition"] == "tod_daylight" and len(lines) == 2
     # the same numbers in-process: each session corrected with the curve of the *other* day's session
-    rc = pr.recordings_config(OmegaConf.create({"recordings": {"path": str(tmp_path / "rec")}}))
+    rc = pr.recordings_config({"path": str(tmp_path / "rec")})
     prepared, _ = ps.prepared_sessions(rc)
     dec = SkyFit(SkyFitConfig())
     out = []
@@ -138,10 +136,8 @@ def _rotation_files(root, day_folder, when, date, *, n=120, mount_deg=30.0):
 
 
 def test_pol_recordings_learns_a_mount_tilt_from_the_other_days_and_removes_it(tmp_path):
-    from omegaconf import OmegaConf
-
-    from bionav.experiments import pol_recordings as pr
-    from bionav.experiments import pol_recordings_session as ps
+    from bionav.polcompass import recordings_config as pr
+    from bionav.polcompass import sessions as ps
     from bionav.plugins.decoders.sky_fit import SkyFit, SkyFitConfig
     from bionav.polcompass.decoders import SunEstimate
 
@@ -156,7 +152,7 @@ def test_pol_recordings_learns_a_mount_tilt_from_the_other_days_and_removes_it(t
     _rotation_files(tmp_path, "Thursday_12-05-22", "13-00__Thursday_12-05-22", "2022-05-12")
     _rotation_files(tmp_path, "Thursday_12-05-22", "17-00__Thursday_12-05-22", "2022-05-12")
     _rotation_files(tmp_path, "Saturday_14-05-22", "10-00__Saturday_14-05-22", "2022-05-14")
-    rc = pr.recordings_config(OmegaConf.create({"recordings": {"path": str(tmp_path), "calibration_parts": ["tilt"]}}))
+    rc = pr.recordings_config({"path": str(tmp_path), "calibration_parts": ["tilt"]})
     prepared, bad = ps.prepared_sessions(rc)
     assert not bad and len(prepared) == 3
     dec = Tilted(SkyFitConfig())

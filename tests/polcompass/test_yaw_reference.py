@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from helpers import external_data, run_bionav
 
-from bionav.experiments.pol_recordings_session import session_errors
+from bionav.polcompass.sessions import session_errors
 from bionav.light import SkyModel, sun_position
 from bionav.polcompass.array import PolArray, counts_from_stokes, stokes_from_sky
 from bionav.polcompass.array_calibration import yaw_run_shifts

@@ -68,7 +68,12 @@ def imported_modules(path: Path, module: str) -> list[tuple[int, str]]:
 
 
 def violations(package_root: Path, table: dict[str, set[str]], experiments: set[str]) -> list[str]:
-    """Imports that run against the table, modules outside it, and experiments importing experiments."""
+    """Imports that run against the table, modules outside it, and experiments importing experiments.
+
+    An experiment is a folder ``bionav/experiments/<name>/`` (``experiments``: the names): its modules
+    import no other experiment's folder, and the shared modules of ``experiments/`` (runner,
+    settings, merge, ...) import none at all (they find experiments through the registry).
+    """
     found = []
     for path in sorted(package_root.rglob("*.py")):
         module = module_name(path, package_root)
@@ -85,24 +90,34 @@ def violations(package_root: Path, table: dict[str, set[str]], experiments: set[
             if dst not in table[src]:
                 found.append(f"{path}:{line}: {src} imports {dst} ({name}), not allowed by docs/architecture.md")
         if src == "experiments":
-            own = module.split(".")[2] if len(module.split(".")) > 2 else ""
-            for line, name in imported_modules(path, module):
-                parts = name.split(".")
-                if len(parts) > 2 and parts[1] == "experiments" and parts[2] in experiments:
-                    target = parts[2]
-                    if target != own and not own.startswith(f"{target}_"):
-                        found.append(f"{path}:{line}: experiment module {own} imports the experiment {target}")
+            found += _experiment_imports(path, module, experiments)
     return found
 
 
-def experiment_names(conf: Path) -> set[str]:
-    return {p.stem for p in (conf / "experiment").glob("*.yaml")}
+def _experiment_imports(path: Path, module: str, experiments: set[str]) -> list[str]:
+    """An experiment's module importing another experiment, or a shared module importing any experiment."""
+    parts = module.split(".")
+    own = parts[2] if len(parts) > 2 and parts[2] in experiments else None
+    found = []
+    for line, name in imported_modules(path, module):
+        target = name.split(".")
+        if len(target) > 2 and target[1] == "experiments" and target[2] in experiments and target[2] != own:
+            who = f"experiment module {module}" if own else f"shared module {module}"
+            found.append(f"{path}:{line}: {who} imports the experiment {target[2]}")
+    return found
+
+
+def experiment_names(pyproject: Path) -> set[str]:
+    """The experiments bionav registers (its ``bionav.experiments`` entry points)."""
+    import tomllib
+
+    return set(tomllib.loads(pyproject.read_text())["project"]["entry-points"]["bionav.experiments"])
 
 
 def test_no_import_runs_against_the_table():
     table = allowed_imports(DOC.read_text(encoding="utf-8"))
     assert {"errors", "geometry", "light", "homing", "db", "experiments", "cli"} <= set(table)
-    found = violations(ROOT / "bionav", table, experiment_names(ROOT / "bionav" / "conf"))
+    found = violations(ROOT / "bionav", table, experiment_names(ROOT / "pyproject.toml"))
     assert found == [], "\n".join(found)
 
 
@@ -112,13 +127,15 @@ def test_the_check_catches_an_arrow_back_up(tmp_path):
         "__init__.py": "",
         "geometry.py": "import numpy\n",
         "light/__init__.py": "from bionav.geometry import x\n",
-        "light/sun.py": "from bionav.experiments import cleaning\nfrom . import clouds\n",
+        "light/sun.py": "from bionav.experiments.cleaning import run\nfrom . import clouds\n",
         "light/clouds.py": "",
         "experiments/__init__.py": "",
-        "experiments/cleaning.py": "from bionav.light import sun\n",
-        "experiments/cleaning_replay.py": "from bionav.experiments.cleaning import run\n",
-        "experiments/param_sweep.py": "from bionav.experiments.grid_homing import evaluate_agents\n",
-        "experiments/grid_homing.py": "from bionav.experiments.common import x\n",
+        "experiments/cleaning/__init__.py": "",
+        "experiments/cleaning/run.py": "from bionav.light import sun\nfrom bionav.experiments.cleaning import plots\n",
+        "experiments/cleaning/plots.py": "",
+        "experiments/cleaning_replay/__main__.py": "from bionav.experiments.cleaning.run import run\n",
+        "experiments/param_sweep/run.py": "def f():\n    from bionav.experiments.grid_homing.run import x\n",
+        "experiments/grid_homing/run.py": "from bionav.experiments.common import x\n",
         "experiments/common.py": "",
         "newroom/__init__.py": "",
     }.items():
@@ -126,11 +143,128 @@ def test_the_check_catches_an_arrow_back_up(tmp_path):
         (pkg / rel).write_text(text)
     table = {"geometry": {"geometry"}, "light": {"geometry", "light"}, "experiments": {"light", "geometry", "experiments"}}
     found = violations(pkg, table, {"cleaning", "param_sweep", "grid_homing"})
-    assert len(found) == 3, found
+    assert len(found) == 4, found
     text = "\n".join(found)
     assert "sun.py:1: light imports experiments" in text
-    assert "param_sweep.py:1: experiment module param_sweep imports the experiment grid_homing" in text
+    assert "run.py:2: experiment module bionav.experiments.param_sweep.run imports the experiment grid_homing" in text
+    assert "__main__.py:1: shared module bionav.experiments.cleaning_replay.__main__ imports the experiment cleaning" in text
     assert "room 'newroom' is not in" in text
+
+
+def test_one_folder_per_experiment():
+    """Every ``bionav.experiments`` entry point is the class of its own folder, with its config, run and plots."""
+    import tomllib
+
+    entries = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"]["bionav.experiments"]
+    assert {"grid_homing", "cross_db", "param_sweep", "pol_compass", "contrast_lda", "contrast_scan", "skyline_homing",
+            "cleaning", "pol_recordings", "route_homing"} <= set(entries)
+    for name, target in entries.items():
+        assert target.startswith(f"bionav.experiments.{name}:"), target
+        folder = ROOT / "bionav" / "experiments" / name
+        assert {"__init__.py", "config.py", "run.py", "plots.py"} <= {p.name for p in folder.glob("*.py")}, name
+    loose = [p.name for p in (ROOT / "bionav" / "experiments").glob("*.py")
+             if p.stem in entries or p.stem.startswith(tuple(f"{n}_" for n in entries))]
+    assert loose == [], f"experiment modules outside their folder: {loose}"
+
+
+def import_graph(package_root: Path) -> dict[str, set[str]]:
+    """bionav module -> the bionav modules it imports, at any depth (imports inside functions included).
+
+    ``from bionav.a import b`` names the module ``bionav.a.b`` when there is one, else ``bionav.a``
+    (the package, whose ``__init__`` runs); an import of a name that is no module of the package is
+    dropped.
+    """
+    modules = {module_name(p, package_root): p for p in package_root.rglob("*.py")}
+    root = package_root.name
+
+    def resolve(name: str) -> str | None:
+        while name and name not in modules:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    graph: dict[str, set[str]] = {}
+    for module, path in modules.items():
+        out = set()
+        is_package = path.name == "__init__.py"
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                out |= {resolve(a.name) for a in node.names if a.name.split(".")[0] == root}
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    pkg = module.split(".") if is_package else module.split(".")[:-1]
+                    pkg = pkg[: len(pkg) - (node.level - 1)]
+                    base = ".".join(pkg + ([base] if base else []))
+                if base.split(".")[0] != root:
+                    continue
+                out |= {resolve(f"{base}.{a.name}") if f"{base}.{a.name}" in modules else resolve(base)
+                        for a in node.names}
+        graph[module] = out - {None, module}
+    return graph
+
+
+def import_circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected groups of two or more modules: each is an import circle (Tarjan's algorithm)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    circles: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        work = [(v, iter(sorted(graph.get(v, ()))))]
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in index:
+                    index[child] = low[child] = len(index)
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(graph.get(child, ())))))
+                elif child in on_stack:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                group = []
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    group.append(w)
+                    if w == node:
+                        break
+                if len(group) > 1:
+                    circles.append(sorted(group))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(circles)
+
+
+def test_no_import_circle():
+    """No two bionav modules import each other, directly or round a circle, imports inside functions included."""
+    circles = import_circles(import_graph(ROOT / "bionav"))
+    assert circles == [], "import circles: " + "; ".join(" <-> ".join(c) for c in circles)
+
+
+def test_the_circle_check_finds_a_circle_through_a_function(tmp_path):
+    pkg = _package(tmp_path, {
+        "__init__.py": "",
+        "a.py": "from bionav.b import f\n",
+        "b.py": "def f():\n    from bionav import c\n    return c\n",
+        "c.py": "import bionav.a\n",
+        "d/__init__.py": "from .e import g\n",
+        "d/e.py": "def g():\n    from bionav.d import h\n",
+        "x.py": "from bionav.a import f\n",  # into the circle, not part of it
+    })
+    assert import_circles(import_graph(pkg)) == [["bionav.a", "bionav.b", "bionav.c"], ["bionav.d", "bionav.d.e"]]
 
 
 def test_one_definition_per_concept():

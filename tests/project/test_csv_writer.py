@@ -55,7 +55,7 @@ def test_an_empty_table_is_its_header(tmp_path):
 
 
 def test_per_snapshot_csv_is_unchanged(tmp_path):
-    from bionav.experiments.grid_homing import write_per_snapshot_csv
+    from bionav.experiments.grid_homing.run import write_per_snapshot_csv
 
     positions = np.array([[0, 0], [3, 1], [9, 16]])
     q = SimpleNamespace(aae_s=np.array([0.1, 1 / 3, np.pi]), mae_s=np.array([0.05, 0.2, 2.0]),

@@ -10,6 +10,20 @@ def _snippets() -> list[str]:
     return re.findall(r"```python\n(.*?)```", DOC.read_text(), flags=re.DOTALL)
 
 
+def _package_classes() -> dict[str, set[str]]:
+    """Module -> the classes it defines, of the packages this page writes out as ``file=`` blocks."""
+    import ast
+
+    from helpers import DOCS_FILE_BLOCK
+
+    out: dict[str, set[str]] = {}
+    for path, text in DOCS_FILE_BLOCK.findall(DOC.read_text()):
+        if path.endswith(".py"):
+            module = ".".join(path.split("/")[1:]).removesuffix(".py").removesuffix(".__init__")
+            out[module] = {n.name for n in ast.parse(text).body if isinstance(n, ast.ClassDef)}
+    return out
+
+
 def test_plugin_docs_snippets_run():
     snippets = _snippets()
     assert len(snippets) == 12  # a plugin and its test, per kind
@@ -75,9 +89,13 @@ def test_plugin_docs_complete_pyproject_names_the_documented_plugins():
     namespace: dict = {"__name__": "docs_plugins"}
     for snippet in _snippets():
         exec(compile(snippet, str(DOC), "exec"), namespace)
+    packages = _package_classes()  # the experiment's package, written out file by file
     for group, entries in eps.items():
         for name, target in entries.items():
             module, _, attr = target.partition(":")
+            if module in packages:
+                assert attr in packages[module], f"{group} {name} = {target}: no such class in {module}"
+                continue
             assert module.startswith("my_package"), target
             if group != CONFIG_GROUP:
                 assert attr in namespace, f"{group} {name} = {target}: no such class in the snippets"

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from helpers import source_copy
+from helpers import docs_packages, source_copy, write_docs_package
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -111,7 +111,8 @@ def documented_commands() -> list[Command]:
             for cmd in _split_shell(pending + line):
                 words = cmd.split()
                 if words[:2] == ["pip", "install"] or words[:4] == ["python", "-m", "pip", "install"]:
-                    local = [w for w in words if (ROOT / w).is_dir() and w not in (".", "-e")]
+                    local = [w for w in words if w not in (".", "-e") and ((ROOT / w).is_dir()
+                                                                         or w.rstrip("/") in docs_packages())]
                     requires = local[-1].rstrip("/") if local else requires
                 if cmd.startswith("python -m bionav"):
                     found.append(Command(rel, start, " ".join(words), requires))
@@ -285,7 +286,10 @@ def plugin_site(tmp_path_factory):
     """Local packages the docs install before using them (``pip install -e examples/...``)."""
     target = tmp_path_factory.mktemp("site")
     for req in sorted({c.requires for c in documented_commands() if c.requires}):
-        src = source_copy(ROOT / req, tmp_path_factory.mktemp("src") / Path(req).name)  # never build in the checkout
+        if req in docs_packages():  # a package the docs write out file by file (docs/plugins.md, Experiments)
+            src = write_docs_package(req, tmp_path_factory.mktemp("src"))
+        else:
+            src = source_copy(ROOT / req, tmp_path_factory.mktemp("src") / Path(req).name)  # never build in the checkout
         proc = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--no-build-isolation", "-q",
                                "--target", str(target), str(src)], capture_output=True, text=True)
         assert proc.returncode == 0, f"pip install {req} (documented before a command) failed:\n{proc.stderr}"
@@ -303,6 +307,7 @@ def test_commands_are_found():
     assert any(c.file == "README.md" and c.text == "python -m bionav" for c in cmds)  # after `pip install . &&`
     assert any(c.file.startswith("docs/") and c.text.startswith("python -m bionav.") for c in cmds)
     assert any(c.requires == "examples/bionav-plugin-example" for c in cmds)
+    assert any(c.requires == "bionav-catchment" and "experiment=catchment" in c.text for c in cmds)  # docs package
 
 
 def test_split_shell():

@@ -39,7 +39,7 @@ def _whole_cell_ticks(ax) -> None:
 
 
 def test_per_snapshot_maps_have_whole_cell_ticks_and_named_axes(tmp_path, figures):
-    from bionav.experiments.homing_plots import plot_home_vector_field, plot_per_snapshot_maps
+    from bionav.experiments.grid_homing.plots import plot_home_vector_field, plot_per_snapshot_maps
 
     pos = np.array([[0, 0], [3, 1], [2, 2]])  # a 4 x 3 grid: matplotlib alone would tick every half cell
     plot_per_snapshot_maps(tmp_path / "p.png", positions=pos, grid_shape=(4, 3), aae_s=np.array([0.1, 0.2, 0.3]),
@@ -54,7 +54,7 @@ def test_per_snapshot_maps_have_whole_cell_ticks_and_named_axes(tmp_path, figure
 
 
 def test_world_routes_legend_names_every_line_and_the_title_matches(tmp_path, figures):
-    from bionav.experiments.route_plots import ROUTE_COLOR, plot_world_routes
+    from bionav.experiments.route_homing.plots import ROUTE_COLOR, plot_world_routes
 
     tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
     world = SimpleNamespace(mesh=SimpleNamespace(triangles=tri), extent=lambda: ((0.0, 0.0), (4.0, 4.0)))
@@ -74,7 +74,7 @@ def test_world_routes_legend_names_every_line_and_the_title_matches(tmp_path, fi
 
 
 def test_session_errors_floor_whiskers_and_caption(tmp_path, figures):
-    from bionav.experiments.pol_recordings_plots import ERROR_FLOOR_DEG, session_distributions
+    from bionav.experiments.pol_recordings.plots import ERROR_FLOOR_DEG, session_distributions
 
     err = np.radians(np.r_[1e-4, np.linspace(0.5, 20.0, 99)])  # one error of 1e-4 deg, as the issue saw
     s = SimpleNamespace(day="2025-06-01", time_of_day="noon")
@@ -91,7 +91,7 @@ def test_session_errors_floor_whiskers_and_caption(tmp_path, figures):
 
 
 def test_compass_plots_axes_and_legends(tmp_path, figures):
-    from bionav.experiments.pol_compass_plots import plot_rotation, plot_unit_voltages
+    from bionav.experiments.pol_compass.plots import plot_rotation, plot_unit_voltages
 
     pans = np.radians(np.linspace(-160, 160, 33))
     plot_rotation(tmp_path / "r.png", pans, pans + 0.01, np.full(33, 0.01), axial=True)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from bionav.experiments.cleaning import oracle_world
+from bionav.robot.worldview import oracle_world
 from bionav.plugins.controllers.odometry import OdometryConfig, OdometryController
 from bionav.plugins.controllers.random_bounce import RandomConfig, RandomController
 from bionav.plugins.controllers.triangulation import TriangulationConfig, TriangulationController

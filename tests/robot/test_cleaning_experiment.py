@@ -35,7 +35,7 @@ def test_cleaning_run_writes_everything(tmp_path, controllers, controller):
     topics = {t for t, _, _ in read_messages(tmp_path / "run.mcap")}
     assert {"/cleaning/run", "/cleaning/step", "/cleaning/true_pose", "/cleaning/result"} <= topics
     # the logged runs replay exactly through freshly built controllers
-    from bionav.experiments.cleaning import replay_log
+    from bionav.experiments.cleaning.replay import replay_log
 
     replayed = replay_log(tmp_path / "run.mcap")
     assert sorted(replayed) == [0, 1]

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from omegaconf import OmegaConf
 
-from bionav.experiments.cleaning import oracle_world, simulate
+from bionav.experiments.cleaning.config import CleaningConfig
+from bionav.experiments.cleaning.run import simulate
 from bionav.experiments.context import RunContext
 from bionav.logs.reader import read_messages
 from bionav.logs.writer import McapLog
@@ -15,6 +16,8 @@ from bionav.plugins.controllers.triangulation import TriangulationConfig, Triang
 from bionav.robot.controller import LanePlan
 from bionav.robot.oracle import GeometricHoming, GeometricHomingConfig, oracle_camera
 from bionav.robot.recording import ReplayMismatch, load_logged_runs, replay_episode
+from bionav.robot.worldview import oracle_world
+from bionav.validation import typed_config
 
 PROG = "bionav.experiments.cleaning_replay"  # as run_main names every command in its messages
 
@@ -33,7 +36,8 @@ def record(tmp_path, make_controller, homing, *, log_images=False, name="triangu
     path = tmp_path / "run.mcap"
     with McapLog(path) as log:
         ctx = RunContext(dir=tmp_path, log=log, rng=np.random.default_rng(3), cfg=cfg, show_progress=False)
-        results = simulate(cfg, ctx, oracle_world(PLAN), PLAN, make_controller, homing)
+        ex = typed_config(cfg.experiment, CleaningConfig, key="experiment")
+        results = simulate(ex, cfg, ctx, oracle_world(PLAN), PLAN, make_controller, homing)
     return results, load_logged_runs(read_messages(path))
 
 
@@ -161,7 +165,7 @@ def test_a_log_recorded_with_the_controllers_track_width_still_replays(tmp_path)
 
 def test_a_legacy_track_width_that_disagrees_is_one_clear_error(tmp_path):
     from bionav.errors import UserError
-    from bionav.experiments.configs import config_from_recorded
+    from bionav.experiments.settings import config_from_recorded
 
     recorded = OmegaConf.create({"experiment": {"name": "cleaning", "track_width": 0.3},
                                  "controller": {"name": "odometry", "track_width": 0.35}})
@@ -175,7 +179,7 @@ def test_a_legacy_track_width_that_disagrees_is_one_clear_error(tmp_path):
 
 
 def test_a_config_without_legacy_keys_is_read_as_it_is(caplog):
-    from bionav.experiments.configs import config_from_recorded
+    from bionav.experiments.settings import config_from_recorded
 
     recorded = OmegaConf.create({"experiment": {"name": "cleaning", "track_width": 0.3}, "controller": {"name": "x"}})
     with caplog.at_level("INFO"):

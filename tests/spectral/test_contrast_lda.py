@@ -6,10 +6,9 @@ import json
 import numpy as np
 import pytest
 from omegaconf import OmegaConf
-from spectral_ctx import FakeContext
+from spectral_ctx import FakeContext, run_with
 
 from bionav.errors import UserError
-from bionav.experiments import contrast_lda
 from bionav.light.bands import feature_subsets
 
 
@@ -18,7 +17,7 @@ def test_contrast_lda_small_simulated_run(tmp_path):
     cfg = OmegaConf.create({"experiment": {"name": "contrast_lda", "sigma": 30.0, "n_resamples": 200},
                             "data": {"name": "sim_natural", "seed": 3, "n_objects": 60, "n_sky": 50}})
     ctx = FakeContext(tmp_path)
-    m = contrast_lda.run(cfg, ctx)
+    m = run_with(cfg, ctx)
     names = list(feature_subsets())
     assert set(m["J"]) == set(names) == set(m["J_sigma"]) == set(m["n_f"])
     for n in names:
@@ -51,14 +50,14 @@ def test_contrast_lda_csv_round_trip_and_errors(tmp_path):
     p.write_text("\n".join(lines) + "\n")
     cfg = OmegaConf.create({"experiment": {"name": "contrast_lda", "n_resamples": 0, "plots": False},
                             "data": {"name": "csv", "path": str(p)}})
-    m = contrast_lda.run(cfg, FakeContext(tmp_path))
+    m = run_with(cfg, FakeContext(tmp_path))
     assert m["n_f"]["UV"] == 0.0 and m["J"]["UV"] > 50
     bad = OmegaConf.create({"experiment": {"name": "contrast_lda"}, "data": {"name": "csv", "path": "???"}})
     with pytest.raises(UserError, match="data.path"):
-        contrast_lda.run(bad, FakeContext(tmp_path))
+        run_with(bad, FakeContext(tmp_path))
     bad = OmegaConf.create({"experiment": {"name": "contrast_lda"}, "data": {"name": "nope"}})
     with pytest.raises(UserError, match="sim_natural"):
-        contrast_lda.run(bad, FakeContext(tmp_path))
+        run_with(bad, FakeContext(tmp_path))
 
 
 @pytest.mark.slow

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from omegaconf import OmegaConf
-from spectral_ctx import FakeContext
+from spectral_ctx import FakeContext, run_with
 
 from bionav.light.clouds import CloudLayer
 from bionav.light.daylight import SkyState
@@ -106,7 +106,7 @@ def test_contrast_scan_experiment_small(tmp_path):
             return Spectral5Sim(Spectral5Sim.Config())
 
     ctx = Ctx(tmp_path)
-    m = __import__("bionav.experiments.contrast_scan", fromlist=["run"]).run(cfg, ctx)
+    m = run_with(cfg, ctx)
     assert m["n_scans"] == 2 and m["n_readings"] == 2 * 12 * 6
     assert set(m["logMSEvar"]) == {"UV", "B", "G", "R", "IR", "UV-B", "UV-G", "UV-R", "UV-IR", "B-G", "B-R",
                                    "B-IR", "G-R", "G-IR", "R-IR"}
@@ -137,7 +137,6 @@ def _small_scan_cfg():
 
 def test_recorded_scan_replays_to_identical_metrics(tmp_path):
     """Record a simulated session in a real run.mcap, replay it with sensor=replay pantilt=replay."""
-    from bionav.experiments import contrast_scan
     from bionav.experiments.context import RunContext
     from bionav.logs.writer import McapLog
     from bionav.plugins.sensors.replay import Replay, ReplayConfig
@@ -153,14 +152,14 @@ def test_recorded_scan_replays_to_identical_metrics(tmp_path):
             return self.make(kind)
 
     live = Ctx(tmp_path / "live", lambda kind: Spectral5Sim(Spectral5Sim.Config()))
-    m1 = contrast_scan.run(_small_scan_cfg(), live)
+    m1 = run_with(_small_scan_cfg(), live)
     live.log.close()
 
     cfg = _small_scan_cfg()
     cfg.sensor = {"name": "replay", "path": str(tmp_path / "live" / "run.mcap")}
     cfg.pantilt = {"name": "replay", "path": str(tmp_path / "live" / "run.mcap")}
     replay = Ctx(tmp_path / "replay", lambda kind: Replay(ReplayConfig(path=str(tmp_path / "live" / "run.mcap"))))
-    m2 = contrast_scan.run(cfg, replay)
+    m2 = run_with(cfg, replay)
     replay.log.close()
     assert m1 == m2 and "sky_accuracy" in m2
     np.testing.assert_array_equal(np.load(tmp_path / "live" / "scans.npz")["counts"],
@@ -181,7 +180,7 @@ def test_scan_with_the_simulated_ptu46_quantisation(scene):
     direct = run_scan(sensor, ptu, grid, on_move=moves.append)
     res = np.deg2rad(185.1428 / 3600)
     assert all(abs(m["pan"] / res - round(m["pan"] / res)) < 1e-9 for m in moves)
-    from bionav.experiments.contrast_scan import _reached
+    from bionav.experiments.contrast_scan.run import _reached
 
     calls = []
     original = scene.render
@@ -197,7 +196,6 @@ def test_scan_with_the_simulated_ptu46_quantisation(scene):
 
 def test_contrast_scan_over_the_serial_drivers_and_fakes(tmp_path, scene):
     """experiment=contrast_scan with sensor=spectral5_serial and pantilt=ptu46 against fakes on ptys."""
-    from bionav.experiments import contrast_scan
     from bionav.plugins.sensors.fakes.ptu46 import FakePTU46
     from bionav.plugins.sensors.ptu46 import PTU46, PTU46Config
 
@@ -221,7 +219,7 @@ def test_contrast_scan_over_the_serial_drivers_and_fakes(tmp_path, scene):
                 return Spectral5Serial(Spectral5Serial.Config(port=node.port, timeout_s=1.0))
 
         ctx = Ctx(tmp_path)
-        m = contrast_scan.run(cfg, ctx)
+        m = run_with(cfg, ctx)
     finally:
         board.close()
         ptu_fake.stop()

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from omegaconf import OmegaConf
-from spectral_ctx import FakeContext
+from spectral_ctx import FakeContext, run_with
 
 from bionav.spectral.representations import representation_image, representation_names
 from bionav.stats import fisher_lda
@@ -41,7 +41,7 @@ def test_representations():
 
 
 def test_skyline_homing_tiny(tmp_path):
-    from bionav.experiments import common, skyline_homing
+    from bionav.experiments import common
     from bionav.plugins.homing.mfdid import MfdidHoming
 
     cfg = OmegaConf.create({
@@ -66,7 +66,7 @@ def test_skyline_homing_tiny(tmp_path):
     common.make_homing = lambda cfg, ctx, geometry: ctx.plugin("homing", cfg.homing, geometry=geometry)
     try:
         ctx = Ctx(tmp_path)
-        m = skyline_homing.run(cfg, ctx)
+        m = run_with(cfg, ctx)
     finally:
         common.make_homing = original
     assert m["n_positions"] == 9 and m["n_snapshots"] == 4 and m["n_conditions"] == 2
@@ -84,7 +84,7 @@ def test_skyline_homing_tiny(tmp_path):
 def test_campus_world_in_five_bands():
     """The world renderer's outdoor campus with bionav.spectral albedos and sky (when the campus exists)."""
     pytest.importorskip("bionav.world.worlds.outdoor")
-    from bionav.experiments.skyline_homing import campus_world, render_campus_counts
+    from bionav.world.worlds.outdoor import campus_world, render_campus_counts
     from bionav.geometry import PanoramaGeometry
     from bionav.light.clouds import CloudLayer
     from bionav.light.daylight import SkyState

@@ -306,7 +306,7 @@ def test_fig4_5_shows_the_raw_first_candidate():
     """Fig. 4.5 plots the first candidate of eq. 4.6 (jumping by 180 degrees), fig. 4.4 the nearest one."""
     import numpy as np
 
-    from bionav.experiments.pol_compass_plots import displayed_heading_deg
+    from bionav.experiments.pol_compass.plots import displayed_heading_deg
 
     truth = np.deg2rad(np.arange(-170.0, 180.0, 20.0))
     first = np.where(np.abs(truth) > np.pi / 2, truth - np.pi, truth)  # an axial sensor: one 180-degree window
@@ -392,7 +392,9 @@ def test_run_pool_renders_each_database_once_before_its_other_runs(tmp_path, mon
     monkeypatch.setattr(runs_mod, "execute_local", fake_execute)
     specs = [runs_mod.RunSpec((f"db={db}", f"homing={h}")) for db in ("sim_original", "sim_hall1")
              for h in ("mfdid", "hiss", "sift")]
-    runner = runs_mod.Runner(out=tmp_path, jobs=3, echo=lambda s: None)
+    from bionav.thesis.plan import task_cpu_s
+
+    runner = runs_mod.Runner(out=tmp_path, jobs=3, echo=lambda s: None, cost=lambda s: task_cpu_s(s).cpu_s)
     results = runner.run_all(specs)
     assert set(results) == {s.key for s in specs} and all(r.ok for r in results.values())
     start = {k: t for e, k, t in events if e == "start"}
@@ -405,8 +407,6 @@ def test_run_pool_renders_each_database_once_before_its_other_runs(tmp_path, mon
     assert max(busy) <= 3  # never over --jobs
     assert max(busy) >= 2  # overlapping, not one after the other
     # longest expected task first: the plan's largest estimate starts the pool
-    from bionav.thesis.plan import task_cpu_s
-
     estimate = {s.key: task_cpu_s(s).cpu_s for s in specs}
     assert min(start, key=start.get) == max(estimate, key=estimate.get)
     first = next(s for s in specs if s.key == min(start, key=start.get))

@@ -20,22 +20,20 @@ import json
 
 import numpy as np
 
-from bionav.experiments.pol_recordings import GROUPS
+from bionav.polcompass.recordings_config import CONDITIONS as GROUPS
 
 
 def _prepared(path: str):
-    from omegaconf import OmegaConf
+    from bionav.polcompass import sessions as ps
+    from bionav.polcompass.recordings_config import recordings_config
 
-    from bionav.experiments import pol_recordings as pr
-    from bionav.experiments import pol_recordings_session as ps
-
-    rc = pr.recordings_config(OmegaConf.create({"recordings": {"path": path}}))
+    rc = recordings_config({"path": path})
     return rc, ps.prepared_sessions(rc)[0]
 
 
 def _decoded(prepared, dec, calibration=None):
     """``(session data, heading, sun azimuth in the device frame, errors)`` per session, through ``calibration``."""
-    from bionav.experiments import pol_recordings_session as ps
+    from bionav.polcompass import sessions as ps
     from bionav.polcompass.decoders import heading_from_sun
 
     out = []
@@ -62,7 +60,7 @@ def _learn(decoded, n_harmonics: int, form: str, *, leave_out_day=None):
 def main(argv=None) -> int:
     from bionav import registry
     from bionav.bench._cli import BenchParser, bounded_int
-    from bionav.experiments import pol_recordings_session as ps
+    from bionav.polcompass import sessions as ps
     from bionav.polcompass.deviation import corrected_heading
 
     parser = BenchParser(prog="python -m bionav.bench.decoders.deviation",

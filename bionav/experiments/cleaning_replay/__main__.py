@@ -10,7 +10,7 @@ _DESCRIPTION = "replay logged cleaning runs and check that the controller emits 
 
 
 def main(argv: list[str] | None = None) -> int:
-    from bionav.experiments.cleaning import replay_log
+    from bionav import registry
 
     parser = argparse.ArgumentParser(prog="python -m bionav.experiments.cleaning_replay", description=_DESCRIPTION)
     parser.add_argument("log", help="run.mcap of an experiment=cleaning run, or its run directory")
@@ -20,7 +20,8 @@ def main(argv: list[str] | None = None) -> int:
     path = Path(args.log)
     if path.is_dir():
         path = path / "run.mcap"
-    results = replay_log(path, runs=args.run)  # a UserError becomes "<prog>: error: ..." in run_main
+    cleaning = registry.load_plugin("experiment", "cleaning")  # the experiment's own replay, from the registry
+    results = cleaning.replay(path, runs=args.run)  # a UserError becomes "<prog>: error: ..." in run_main
     for k, r in results.items():
         print(f"run {k}: {r.n_ticks} ticks replayed, every command identical")
     return 0

@@ -305,7 +305,7 @@ def _cross_spec(preset: Preset, homing: str) -> RunSpec:
           f"experiment.snapshot_stride={preset.cross_db_stride}", *size_arg(preset.cross_db_size)]
     nx, ny = db_meta(preset.cross_db_family[0])["grid_shape"]
     stride = preset.cross_db_stride
-    # (snapshot, database pair) units, never a block without one (bionav.experiments.cross_db.task_units)
+    # (snapshot, database pair) units, never a block without one (bionav.experiments.cross_db.run.task_units)
     units = max(1, int(-(-nx // stride) * -(-ny // stride) * 0.85)) * len(preset.cross_db_family) ** 2
     return RunSpec(tuple(ov), group="cross_db", blocks=min(int(preset.cross_db_blocks.get(homing, 1)), units))
 

@@ -1,17 +1,24 @@
-"""What a world builder returns, and the seeding helper every builder uses."""
+"""What a world builder returns, and the seeding helper every builder uses.
+
+A world whose light changed while its database was recorded has a capture light
+(:class:`~bionav.light.capture.CaptureLight`: the sun, the clouds and the sky at each capture) and an
+aperture where that light enters: the whole sky outdoors (:class:`OpenSky`), a room's windows indoors
+(:class:`Windows`). :meth:`World.capture_scenes` is the one capture interface of both: the world as it
+was at each capture of a recording session (with the person who supervised it, :class:`Supervisor`).
+"""
 
 from __future__ import annotations
 
 import copy
 import math
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
 
 from bionav.light.capture import CaptureLight
-from bionav.world.lights import DirectionalLight
+from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.scene import CompiledScene, Scene
 
 
@@ -61,10 +68,10 @@ class Windows:
     across the room and come and go with passing clouds, and the brightness
     of the sky seen through the windows changes. The light itself (sun path,
     clouds, skylight factor per capture) is the world's
-    :class:`~bionav.light.capture.CaptureLight` (``World.daylight``); this
-    class is the room's side: which openings let the sun in, which lights
+    :class:`~bionav.light.capture.CaptureLight` (``World.capture_light``); this
+    class is the room's side, the world's ``aperture``: which openings let the sun in, which lights
     and panes stand for the sky outside. Used by the camera model only
-    (``db.realism=camera``, :func:`bionav.db.camera.capture_scenes`);
+    (``db.realism=camera``, :meth:`World.capture_scenes`);
     ``db.realism=ideal`` renders the scene as built.
 
     Parameters
@@ -145,6 +152,34 @@ class Windows:
         emission = session.mat_emission.copy()
         emission[list(self.panes)] *= sky
         return {"light_params": params, "light_power": power, "mat_emission": emission}
+
+
+@dataclass(frozen=True)
+class OpenSky:
+    """Where the capture light enters outdoors: the whole sky (the aperture of an outdoor world).
+
+    Each capture relights the scene as :meth:`CaptureLight.conditions
+    <bionav.light.capture.CaptureLight.conditions>` gives the light at its cell: the sun (direction,
+    irradiance after the clouds), the sky's ambient light above and ``ground_ambient`` times it below
+    (light reflected by the ground), and the sky seen by rays that hit nothing (:meth:`Scene.relit`,
+    which keeps the compiled geometry). Used by the camera model only (``db.realism=camera``).
+
+    Parameters
+    ----------
+    ground_ambient : float
+        Ambient light from below relative to the sky's from above (dimensionless).
+    """
+
+    ground_ambient: float = 0.4
+
+    def capture_scene(self, scene: Scene, light: CaptureLight, cell) -> Scene:
+        """``scene`` relit as at the capture of grid cell ``cell = (i, j)``."""
+        i, j = (int(v) for v in cell)
+        cond = light.conditions(i, j)
+        up = np.asarray(cond["sky_irradiance"], float)
+        return scene.relit(lights=[DirectionalLight(tuple(float(v) for v in cond["sun"]),
+                                                    tuple(float(v) for v in cond["sun_irradiance"]))],
+                           ambient=Ambient(up=tuple(up), down=tuple(self.ground_ambient * up)), sky=cond["sky"])
 
 
 @dataclass(frozen=True)
@@ -265,13 +300,13 @@ class World:
         ``(x0, y0, x1, y1)`` of an obstacle-free floor rectangle (apartment).
     info : dict
         Free-form facts about the world (room size, sun position ...).
-    daylight : CaptureLight, optional
+    capture_light : CaptureLight, optional
         The light during the recording (sun path, clouds; camera model only),
-        entering through ``windows``.
-    windows : Windows, optional
-        The room's windows through which ``daylight`` enters (given with it).
+        entering through ``aperture``.
+    aperture : Windows or OpenSky, optional
+        Where ``capture_light`` enters (given with it): a room's windows, or the whole sky outdoors.
     supervisor : Supervisor, optional
-        The person supervising the recording (camera model only).
+        The person supervising the recording (camera model only, indoors).
     floor_tilt_deg : float
         Standard deviation in degrees, about each horizontal axis, of the
         camera's tilt where the robot stands: the unevenness of the floor
@@ -295,11 +330,6 @@ class World:
         compensates within ``max_exposure`` x ``max_gain`` and adds the noise
         of a dim scene (:func:`bionav.db.camera.camera_images`).
         ``db.realism=ideal`` ignores it. 1 for every world but the night hall.
-    capture_scene : callable, optional
-        ``capture_scene(i, j) -> Scene``: the world as lit when cell ``(i, j)``
-        was captured, for worlds whose light changed during the capture (the
-        outdoor *uni*: sun, clouds). The camera model renders every capture
-        with it; ``None`` (and ``db.realism=ideal``) use ``scene``.
     """
 
     scene: Scene
@@ -313,20 +343,84 @@ class World:
     floor_tilt_deg: float = 0.0
     heading_drift_deg: float = 0.0
     light_level: float = 1.0
-    daylight: CaptureLight | None = None
-    windows: Windows | None = None
+    capture_light: CaptureLight | None = None
+    aperture: Windows | OpenSky | None = None
     supervisor: Supervisor | None = None
-    capture_scene: Callable[[int, int], Scene] | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.light_level) and self.light_level > 0):
             raise ValueError(f"World.light_level must be a finite number > 0, got {self.light_level!r}")
-        if (self.daylight is None) != (self.windows is None):
-            raise ValueError("World.daylight and World.windows come together (the capture light and the "
-                             "windows it enters through); give both or neither")
+        if (self.capture_light is None) != (self.aperture is None):
+            raise ValueError("World.capture_light and World.aperture come together (the capture light and where "
+                             "it enters: a room's Windows or the OpenSky); give both or neither")
         if self.cells is None:
             self.cells = np.ones(self.grid_shape, bool)
 
     def cell_position(self, i: float, j: float) -> tuple[float, float, float]:
         """World position ``(x, y, z)`` of the camera at grid cell ``(i, j)``."""
         return (self.grid_origin[0] + self.spacing * i, self.grid_origin[1] + self.spacing * j, self.camera_height)
+
+    def capture_scenes(self, positions: np.ndarray, *, seed: int) -> Callable[[int], Scene | CompiledScene] | None:
+        """``scene_at(k)``: the world as it was at capture ``k`` of a recording session; None if it did not change.
+
+        The one capture interface of indoor and outdoor worlds (the camera model,
+        :func:`bionav.db.camera.camera_images`). Outdoors (:class:`OpenSky`) each capture relights a
+        copy of the scene (a :class:`Scene`). Indoors (:class:`Windows`) the sun, the clouds and the
+        sky through the windows, and the :attr:`supervisor`, are added once to a compiled copy of the
+        scene and each capture only moves lights and the person in its arrays (a
+        :class:`CompiledScene`, which renders without the scene's exposure).
+
+        Parameters
+        ----------
+        positions : ndarray, shape (N, 2), int
+            Grid cells ``(i, j)`` in capture order of the database (not the time order).
+        seed : int
+            The recording session's seed (:func:`bionav.db.camera.session_seed`): the clouds along the
+            capture order indoors and where the supervisor stood.
+        """
+        if self.capture_light is None and self.supervisor is None:
+            return None
+        if isinstance(self.aperture, OpenSky):
+            if self.supervisor is not None:
+                raise ValueError("a supervisor is modelled for indoor worlds only")
+            light, sky = self.capture_light, self.aperture
+            return lambda k: sky.capture_scene(self.scene, light, positions[k])
+        if getattr(self.scene, "sky", None) is not None:
+            raise ValueError("recording-session changes through windows (capture light, supervisor) are modelled for "
+                             "indoor worlds only (a compiled scene renders without the world's sky)")
+        return self._indoor_session(positions, seed)
+
+    def _indoor_session(self, positions: np.ndarray, seed: int) -> Callable[[int], CompiledScene]:
+        """:meth:`capture_scenes` of a room: its compiled session scene, changed per capture."""
+        daylight, supervisor, windows = self.capture_light, self.supervisor, self.aperture
+        scene = (windows.session_scene(self.scene, sun_irradiance=daylight.sun_irradiance) if daylight is not None
+                 else copy.deepcopy(self.scene))
+        scene.info.pop("_compiled", None)
+        parts = supervisor.add_to(scene, seed=seed) if supervisor is not None else None
+        session = scene.compiled()
+        if daylight is not None:
+            kinds = session.light_params[:, 0]
+            sun = int(np.flatnonzero(kinds == 1)[-1])
+            sky = []
+            for idx in windows.sky_lights:
+                pos = np.asarray(self.scene.lights[idx].position, float)
+                hit = np.flatnonzero((kinds == 0) & np.all(np.isclose(session.light_params[:, 1:4], pos), axis=1))
+                sky.append(int(hit[0]))
+            sky = np.asarray(sky, np.int64)
+            cond = daylight.session_conditions(positions, rng=stream(seed, "daylight/clouds"))
+        if supervisor is not None:
+            xy = np.array([self.cell_position(i, j)[:2] for i, j in positions], float).reshape(-1, 2)
+            feet, yaw = supervisor.stances(positions, xy, seed=seed)
+
+        def scene_at(k: int) -> CompiledScene:
+            kw = {}
+            if daylight is not None:
+                kw.update(windows.capture_lighting(session, sun_index=sun, sky_index=sky, sun_dir=cond["sun_dir"][k],
+                                                   transmission=float(cond["transmission"][k]),
+                                                   sky=float(cond["sky"][k])))
+            if supervisor is not None:
+                boxes, ell = Supervisor.place(session.boxes, session.ellipsoids, parts, feet[k], float(yaw[k]))
+                kw.update(boxes=boxes, ellipsoids=ell, prim_kind=None, prim_idx=None, spheres=None, casters=None)
+            return replace(session, **kw, shadow_grids=None, shadow_starts=None, shadow_items=None)
+
+        return scene_at

@@ -408,3 +408,20 @@ def render_spectral_panorama(scene: OutdoorScene, geometry, *, position, heading
     el = geometry.row_elevations()
     ee, aa = np.meshgrid(el, az, indexing="ij")
     return scene.render(direction_from_angles(aa, ee), position=position)
+
+
+def render_garden_counts(scene: OutdoorScene, geometry, world_positions, *, sensor_model, rng, progress=None):
+    """Five-channel sensor counts ``(N, H, W, 5)`` and true sky masks ``(N, H, W)`` of ``scene`` at world positions.
+
+    ``world_positions`` ``(N, 2)`` or ``(N, 3)`` in metres; each panorama is
+    :func:`render_spectral_panorama` at heading 0, read by ``sensor_model``
+    (``read(radiance, rng=rng)``, e.g. :class:`bionav.spectral.sensor_model.LogSensorModel`) with ``rng``;
+    ``progress`` wraps the loop over positions.
+    """
+    counts, skies = [], []
+    it = world_positions if progress is None else progress(world_positions, desc="render", total=len(world_positions))
+    for p in it:
+        rad, sky = render_spectral_panorama(scene, geometry, position=tuple(p))
+        counts.append(sensor_model.read(rad, rng=rng)[0, ..., :5].astype(np.float32))
+        skies.append(sky)
+    return np.stack(counts), np.stack(skies)

@@ -193,7 +193,7 @@ def build_living_room(seed: int = 0) -> World:
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 22),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["living"],
                  heading_drift_deg=HEADING_DRIFT_DEG["living"],
-                 daylight=daylight, windows=openings, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
+                 capture_light=daylight, aperture=openings, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
                                                           jitter_m=SUPERVISOR_JITTER, lane_axis=1))
 
 
@@ -234,7 +234,7 @@ def build_living_kitchen(seed: int = 0) -> World:
     return World(scene=scene, grid_origin=(gx0, gy0), spacing=SPACING, grid_shape=(11, 36),
                  camera_height=CAMERA_HEIGHT, info={"room": (lx, ly, lz)}, floor_tilt_deg=FLOOR_TILT_DEG["kitchen"],
                  heading_drift_deg=HEADING_DRIFT_DEG["kitchen"],
-                 daylight=daylight, windows=openings, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
+                 capture_light=daylight, aperture=openings, supervisor=Supervisor(room=(lx, ly), distance_m=SUPERVISOR_DISTANCE,
                                                           jitter_m=SUPERVISOR_JITTER, lane_axis=1))
 
 

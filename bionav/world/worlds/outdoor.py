@@ -24,7 +24,7 @@ from bionav.light.simple_sky import SKY_GAIN, SUN_GAIN, SimpleSky
 from bionav.world import textures as tx
 from bionav.world.lights import Ambient, DirectionalLight
 from bionav.world.scene import Scene, SkyFunction
-from bionav.world.worlds.common import World, lane_order, stream
+from bionav.world.worlds.common import OpenSky, World, lane_order, stream
 from bionav.world.worlds.furniture import tree
 
 GRID_SHAPE = (10, 17)
@@ -113,15 +113,6 @@ def uni_capture_light(cells: np.ndarray, seed: int) -> CaptureLight:
     """
     return CaptureLight(order=capture_order(cells), clouds=campus_clouds(seed), site_deg=SITE_DEG,
                         start_utc=CAPTURE_START_UTC, seconds_per_capture=SECONDS_PER_CAPTURE)
-
-
-def relit_at(scene: Scene, light: CaptureLight, i: int, j: int) -> Scene:
-    """``scene`` relit as at cell ``(i, j)``'s capture (:meth:`Scene.relit`; ambient below 0.4 of above)."""
-    cond = light.conditions(i, j)
-    up = np.asarray(cond["sky_irradiance"], float)
-    return scene.relit(lights=[DirectionalLight(tuple(float(v) for v in cond["sun"]),
-                                                tuple(float(v) for v in cond["sun_irradiance"]))],
-                       ambient=Ambient(up=tuple(up), down=tuple(0.4 * up)), sky=cond["sky"])
 
 
 def build_campus(seed: int = 0, *, channels: Sequence[str] = ("grey",),
@@ -305,14 +296,56 @@ def _campus_props(seed: int, scene: Scene, mat: Callable[..., int], glass: int) 
 def build_uni(seed: int = 0) -> World:
     """The *uni* stand-in: :func:`build_campus` (grey) plus the light changing while the grid was captured.
 
-    ``World.capture_scene(i, j)`` gives the scene as lit at cell ``(i, j)``'s
-    capture time (:func:`uni_capture_light`, :func:`relit_at`); the camera model
-    (``db.realism=camera``) renders each capture with it. ``world.scene``
+    The capture light (:func:`uni_capture_light`) enters through the whole sky
+    (:class:`~bionav.world.worlds.common.OpenSky`): :meth:`World.capture_scenes
+    <bionav.world.worlds.common.World.capture_scenes>` gives the scene as lit at each cell's
+    capture time, which the camera model (``db.realism=camera``) renders. ``world.scene``
     itself (used by ``db.realism=ideal``) is the campus of :func:`build_campus`
     unchanged.
     """
     world = build_campus(seed)
-    light = uni_capture_light(world.cells, seed)
-    world.capture_scene = lambda i, j: relit_at(world.scene, light, i, j)
-    world.info["capture_light"] = light.describe()
+    world.capture_light, world.aperture = uni_capture_light(world.cells, seed), OpenSky()
+    world.info["capture_light"] = world.capture_light.describe()
     return world
+
+
+def campus_world(sky, *, seed: int) -> World:
+    """The campus (:func:`build_campus`) in five bands under a spectral sky (:class:`bionav.light.daylight.SkyState`).
+
+    Per-kind albedos are the campus' default five-band albedos
+    (:func:`bionav.light.materials.band_albedos`: the reflectances of the
+    kinds' materials), the sun and the hemispherical ambient light from
+    :func:`bionav.light.daylight.illumination` (``E/pi``, so that pixel values are
+    band radiances in the unit of the sensor model), rays that hit nothing from
+    :func:`bionav.light.daylight.band_sky_radiance`.
+    """
+    from bionav.light.bands import CHANNELS, band_integrate
+    from bionav.light.daylight import band_sky_radiance, illumination
+
+    ill = illumination(sky)
+    e_dir = band_integrate(ill.direct_normal) / np.pi
+    e_dif = band_integrate(ill.diffuse_horizontal) / np.pi
+    world = build_campus(seed, channels=CHANNELS, sky=lambda d: band_sky_radiance(sky, d),
+                         sun_elevation=float(sky.sun_elevation), sun_azimuth=float(sky.sun_azimuth),
+                         sun_irradiance=e_dir, sky_irradiance=e_dif, exposure=1.0)
+    return world
+
+
+def render_campus_counts(world, geometry, cells, *, sensor_model, rng, progress=None):
+    """Five-channel sensor counts ``(N, H, W, 5)`` and true sky masks ``(N, H, W)`` of a :func:`campus_world`.
+
+    ``cells`` ``(N, 2)`` are grid cells (may be fractional: :meth:`World.cell_position`); each
+    panorama is rendered at heading 0 without clipping and read by ``sensor_model``
+    (``read(radiance, rng=rng)``) with ``rng``; ``progress`` wraps the loop.
+    """
+    from bionav.world.render import render_depth, render_panorama
+
+    counts, skies = [], []
+    it = cells if progress is None else progress(cells, desc="render", total=len(cells))
+    for i, j in it:
+        pos = world.cell_position(float(i), float(j))
+        rad = render_panorama(world.scene, position=pos, geometry=geometry, clip=False, exposure=1.0)
+        depth, _, _ = render_depth(world.scene, position=pos, geometry=geometry)
+        counts.append(sensor_model.read(np.asarray(rad, float), rng=rng)[0, ..., :5].astype(np.float32))
+        skies.append(~np.isfinite(depth))
+    return np.stack(counts), np.stack(skies)
