@@ -261,5 +261,5 @@ def test_every_db_preset_uses_every_key_it_sets():
     names = config_options("db")
     assert {"sim_original", "sim_uni", "original", "mesh", "sim_seville", "seville_route"} <= set(names)
     for name in names:
-        extra = {"folder": ["db.path=."], "mesh": ["db.world=seville2009"]}.get(name, [])
+        extra = {"folder": ["db.path=."], "mesh": ["db.world=seville2009"], "bag": ["db.path=robot.bag"]}.get(name, [])
         assert as_database_config(compose([f"db={name}", *extra]).db).name == name
