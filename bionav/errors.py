@@ -21,3 +21,36 @@ class PluginError(UserError):
 
 class DeviceError(UserError):
     """A serial device is missing, busy, silent or speaks garbage."""
+
+
+def require_extra(module: str, *, extra: str, what: str):
+    """Import an optional dependency, or raise the one message that names its install line.
+
+    Parameters
+    ----------
+    module : str
+        The module to import (``rosbags``, ``foxglove``).
+    extra : str
+        The bionav extra that installs it (``ros``, ``live``).
+    what : str
+        What needs it, as the user asked for it (``db=bag``, ``bionav.live=8765``).
+
+    Returns
+    -------
+    module
+        The imported module.
+
+    Raises
+    ------
+    UserError
+        ``<what> needs <module>, which is not installed: pip install "bionav[<extra>]"``.
+    """
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        raise UserError(
+            f"{what} needs the Python package {module.split('.')[0]!r}, which is not installed here ({exc}); "
+            f"install it with: pip install \"bionav[{extra}]\" (in a clone of bionav: pip install \".[{extra}]\")."
+        ) from None

@@ -347,7 +347,7 @@ def unknown_key_message(node: str, bad: str, valid: Sequence[str], *, what: str 
 
 
 def _schema_file(schema: type) -> str:
-    """The source file of a config dataclass as users find it (``bionav/experiments/configs/grid.py``)."""
+    """The source file of a config dataclass as users find it (``bionav/experiments/grid_homing/config.py``)."""
     import sys
 
     module = schema.__module__

@@ -86,12 +86,14 @@ def _parser():
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all", "scaling", "stages", "calibrate") + RUN_METHODS,
+    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all", "scaling", "stages", "calibrate") + RUN_METHODS
+                        + ("bag",),
                         default="minwarping",
                         help="method to time (default: minwarping; all = the pair methods, not sift); "
                              "sweep and cleaning time whole runs; scaling: CPU per home vector against image "
                              "and grid size for each method; stages: min-warping's stages against the arithmetic "
-                             "floor; calibrate: the plan's calibration workloads (python -m bionav.thesis --plan)")
+                             "floor; calibrate: the plan's calibration workloads (python -m bionav.thesis --plan); "
+                             "bag: a ROS bag read into a grid database")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -152,6 +154,9 @@ def _parser():
     scaling.add_argument("--clock-ghz", type=float, default=None, metavar="F",
                          help="--method stages: the core clock of the floor (default: measured)")
     add_arguments(parser)
+    from bionav.bench.bag import add_bag_arguments
+
+    add_bag_arguments(parser)
     return parser
 
 
@@ -194,6 +199,15 @@ def _check_args(parser, args) -> None:
         from bionav.bench.runs import check_arguments
 
         check_arguments(parser, args)
+    if args.method == "bag":
+        if not 0.001 <= args.bag_gb <= 64:
+            parser.error(f"--bag-gb {args.bag_gb} must lie in 0.001..64 (GB of bag written to a temporary folder); "
+                         "e.g. --bag-gb 0.5")
+        if not 0.01 <= args.bag_cell <= 100:
+            parser.error(f"--bag-cell {args.bag_cell} must lie in 0.01..100 metres; e.g. --bag-cell 0.5")
+        fw, fh = args.bag_frame
+        if not (16 <= fw <= 8192 and 16 <= fh <= 8192):
+            parser.error(f"--bag-frame {fw} {fh} must lie in 16..8192 pixels per side; e.g. --bag-frame 1280 960")
     if args.method == "scaling":
         from bionav.bench.scaling import parse_sizes
 
@@ -241,9 +255,11 @@ def main(argv=None) -> int:
     _check_args(parser, args)
     if args.cpu_name is not None and os.environ.get(_CHILD) != args.cpu_name:
         return _run_for_cpu(parser, args, argv)
-    if args.method in ("sweep", "cleaning"):
+    if args.method in ("sweep", "cleaning", "bag"):
         from bionav.bench.runs import run_benchmark
 
+        if args.method == "bag":
+            from bionav.bench.bag import bag_rows as run_benchmark
         for row in run_benchmark(args):
             print(json.dumps(row) if args.json else "  ".join(f"{k}={v}" for k, v in row.items()))
         return 0

@@ -94,8 +94,8 @@ class DatabaseConfig:
     """
 
     name: str = "sim_original"
-    source: str = bounded("synthetic", choices=("synthetic", "folder", "mesh", "route"))
-    path: Optional[str] = None  # folder databases: the directory
+    source: str = bounded("synthetic", choices=("synthetic", "folder", "mesh", "route", "bag"))
+    path: Optional[str] = None  # folder databases: the directory; bag: the ROS bag (file or ROS 2 folder)
     image_size: Optional[list[int]] = bounded(None, **IMAGE_SIZE)  # [W, H]; None: native
     seed: int = bounded(0, ge=0, le=2**32 - 1)  # synthetic worlds: which world of this kind
     noise: float = bounded(0.01, ge=0.0, le=1.0)  # synthetic, realism=ideal: noise std before 8-bit quantisation
@@ -130,6 +130,16 @@ class DatabaseConfig:
     route: Optional[str] = None  # route databases: Ant<a>_Route<r>
     routes_path: Optional[str] = None  # .mat of routes; None = the packaged Seville routes
     step_m: float = bounded(0.1, gt=0.0, le=10.0)  # route databases: path length between views, metres
+    # ROS bags (source: bag; bionav/db/bag, docs/ros.md)
+    image_topic: Optional[str] = None  # sensor_msgs/Image or CompressedImage topic
+    pose_topic: Optional[str] = None  # nav_msgs/Odometry, geometry_msgs/PoseStamped(WithCovariance) or /tf
+    pose_frame: Optional[str] = None  # with /tf: the robot's frame (None: base_link)
+    world_frame: Optional[str] = None  # the frame positions are given in (None: the pose topic's, the tf root)
+    pose_tolerance_s: float = bounded(0.1, gt=0.0, le=60.0)  # an image needs a pose this close before and after it
+    stamps: str = bounded("header", choices=("header", "bag"))  # message times: header.stamp or the bag's record time
+    grid_cell_m: Optional[float] = bounded(None, gt=0.0, le=1000.0)  # grid database: cell size, metres
+    route_step_m: float = bounded(0.1, gt=0.0, le=100.0)  # route: path length between route views, metres
+    align: bool = True  # grid: turn every view to the world frame by its heading (column 0 along world +x)
 
     def unused_keys(self) -> tuple[list[str], tuple[str, ...]]:
         """Keys given a value this database does not use, and the keys its source uses.
@@ -165,6 +175,9 @@ class DatabaseConfig:
         if self.source in ("mesh", "route") and self.path is None and self.world is None:
             raise UserError(f"db={self.name} needs the mesh file: pass db.path=FILE (.mat with X/Y/Z[/colp], .obj "
                             "or .ply), or db.world=seville2009 for the packaged Seville ant world.")
+        if self.source == "bag" and self.path is None:
+            raise UserError("db=bag needs the bag: pass db.path=BAG (a ROS 1 .bag, a ROS 2 bag folder, or a .mcap / "
+                            ".db3 file), with db.image_topic=TOPIC and db.pose_topic=TOPIC (docs/ros.md).")
         if self.source == "mesh" and self.grid_shape is None:
             raise UserError(f"db={self.name} needs its grid: pass db.grid_shape=[nx,ny], e.g. db.grid_shape=[10,10].")
 
@@ -201,4 +214,8 @@ USED_KEYS: dict[str, tuple[str, ...]] = {
                             "channels", "clearance_m", "noise", "seed", "rotate_current", "rotation_seed"),
     "route": _ALL_SOURCES + ("path", "world", "route", "routes_path", "step_m", "camera_height_m", "ground",
                              "channels", "clearance_m", "noise", "seed"),
+    "bag": _ALL_SOURCES + ("path", "image_topic", "pose_topic", "pose_frame", "world_frame", "pose_tolerance_s",
+                           "stamps", "grid_cell_m", "route_step_m", "align", "origin_m", "grid_shape", "azimuth",
+                           "x_axis_column", "horizon_row", "rad_per_row", "unfold", "on_bad_image", "rotate_current",
+                           "rotation_seed"),
 }

@@ -27,7 +27,7 @@ from bionav.db.conventions import to_canonical
 from bionav.db.database import ImageDatabase
 from bionav.db.imageio import ImageReadError, read_image
 from bionav.db.naming import Entry, not_a_file_reason, scan_folder
-from bionav.db.unfold import unfold_panorama
+from bionav.db.unfold import unfold_frames
 from bionav.errors import UserError
 from bionav.geometry import TWO_PI, PanoramaGeometry
 
@@ -117,7 +117,7 @@ def load_folder(cfg: DatabaseConfig, folder: Path) -> ImageDatabase:
     unfold = cfg.unfold
     raw = None
     if unfold is not None and unfold.enabled:
-        frames = _unfold_all(frames, unfold, kept[0].path)
+        frames = unfold_frames(frames, unfold, first=str(kept[0].path))
         raw = RawFrames(e.path for e in kept)
     disk = np.stack(frames).astype(np.float32, copy=False)
     height, width = disk.shape[1:]
@@ -260,19 +260,3 @@ def _check_grid_extent(cfg: DatabaseConfig, folder: Path, entries: list[Entry], 
             f"handles.{culprit}; {fix}."
         )
     check_allocation(64.0 * cells, what=f"the per-cell arrays of a {nx} x {ny} grid", fix=fix)
-
-
-def _unfold_all(frames, unfold, first_path: Path) -> list[np.ndarray]:
-    h, w = frames[0].shape
-    center = unfold.center if unfold.center is not None else [(w - 1) / 2.0, (h - 1) / 2.0]
-    outer = float(unfold.outer_radius) if unfold.outer_radius else min(w, h) / 2.0 - 1.0
-    inner = float(unfold.inner_radius)
-    if len(center) != 2 or not 0 <= inner < outer or len(unfold.size) != 2 or min(unfold.size) < 1:
-        raise UserError(
-            f"db.unfold is inconsistent (center={list(center)}, inner_radius={inner}, "
-            f"outer_radius={outer}, size={list(unfold.size)}): need center=[cx,cy], "
-            "0 <= inner_radius < outer_radius in pixels of the raw frame, and size=[W,H]."
-        )
-    log.debug("unfolding %d raw frames of %d x %d (first: %s)", len(frames), w, h, first_path)
-    return [unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size)
-            for f in frames]

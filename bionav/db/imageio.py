@@ -161,6 +161,25 @@ def read_image(path: Path) -> np.ndarray:
         data = Path(path).read_bytes()
     except OSError as exc:
         raise ImageReadError(f"the file cannot be read ({exc.strerror or exc})") from None
+    return decode_image(data)
+
+
+def decode_image(data: bytes) -> np.ndarray:
+    """Decode the bytes of one image file (PNG, PNM, JPEG, BMP) as :func:`read_image` does.
+
+    The one decoding path of image files and of compressed images in ROS bags
+    (``sensor_msgs/CompressedImage``), so both give the same pixels bit for bit.
+
+    Returns
+    -------
+    ndarray, shape (H, W), float32 in ``[0, 1]``
+
+    Raises
+    ------
+    ImageReadError
+        Empty, truncated or undecodable data (the message says which).
+    """
+    data = bytes(data)
     _check_complete(data)
     image = cv2.imdecode(np.frombuffer(data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
     if image is None or image.size == 0:

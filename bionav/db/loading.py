@@ -84,7 +84,8 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
         the cache) the stand-in ``cfg.name`` through
         :func:`bionav.db.synthetic.synthetic_database`; ``source: folder``
         reads ``cfg.path``, or ``data_dir / cfg.name`` when no path is given
-        (:func:`bionav.db.folder.load_folder`).
+        (:func:`bionav.db.folder.load_folder`); ``source: bag`` reads a ROS bag's
+        views and poses into a grid (:func:`bionav.db.bag.grid.load_bag_database`).
     data_dir : Path
         Where real databases live (``data_dir=`` / ``BIONAV_DATA``).
     cache_dir : Path
@@ -137,6 +138,10 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
 
         db = mesh_grid_database(cfg, cache_dir=Path(cache_dir), progress=_render_progress(cfg.name))
         size = None  # rendered directly at db.image_size
+    elif source == "bag":
+        from bionav.db.bag.grid import load_bag_database
+
+        db = load_bag_database(cfg)
     else:  # route (db.source is one of its declared choices)
         raise UserError(f"db={cfg.name} holds views along a route, not a grid; evaluate it with "
                         "experiment=route_homing (grid experiments need a grid database such as db=sim_seville).")
@@ -144,7 +149,7 @@ def load_database(cfg, *, data_dir: Path, cache_dir: Path, preprocess=None) -> I
     db = preprocess_database(db, preprocess)
     if size is not None:
         db = resize_database(db, size)
-    if source == "folder" and cfg.rotate_current:
+    if source in ("folder", "bag") and cfg.rotate_current:
         db = rotate_views(db, seed=cfg.rotation_seed)
     return db
 

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
+
+log = logging.getLogger(__name__)
 
 
 def _unfold_maps(center: tuple[float, float], inner_radius: float, outer_radius: float,
@@ -18,22 +22,33 @@ def _unfold_maps(center: tuple[float, float], inner_radius: float, outer_radius:
     return map_x, map_y
 
 
-def _bilinear(src: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
-    """Bilinear samples of ``src`` at ``(map_x, map_y)`` (column, row), pixels outside the frame 0.
+class _Bilinear:
+    """Bilinear sampling at fixed ``(map_x, map_y)`` (column, row) of frames of one shape, pixels outside 0.
 
-    Exact in float64 (``cv2.remap`` rounds coordinates to 1/32 pixel before OpenCV 5).
+    The indices, weights and the inside masks are computed once; each call gathers the four neighbours
+    of every sample. Exact in float64 (``cv2.remap`` rounds coordinates to 1/32 pixel before OpenCV 5).
     """
-    h, w = src.shape
-    x0, y0 = np.floor(map_x).astype(np.int64), np.floor(map_y).astype(np.int64)
-    fx, fy = map_x - x0, map_y - y0
 
-    def at(rows, cols):
-        inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
-        return np.where(inside, src[np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)], 0.0)
+    def __init__(self, shape, map_x: np.ndarray, map_y: np.ndarray) -> None:
+        h, w = shape
+        x0, y0 = np.floor(map_x).astype(np.int64), np.floor(map_y).astype(np.int64)
+        self.fx, self.fy = map_x - x0, map_y - y0
+        self.corners = []
+        for rows, cols in ((y0, x0), (y0, x0 + 1), (y0 + 1, x0), (y0 + 1, x0 + 1)):
+            inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+            self.corners.append((inside, np.clip(rows, 0, h - 1) * w + np.clip(cols, 0, w - 1)))
 
-    top = (1.0 - fx) * at(y0, x0) + fx * at(y0, x0 + 1)
-    bottom = (1.0 - fx) * at(y0 + 1, x0) + fx * at(y0 + 1, x0 + 1)
-    return (1.0 - fy) * top + fy * bottom
+    def __call__(self, src: np.ndarray) -> np.ndarray:
+        flat = src.reshape(-1)
+        a, b, c, d = (np.where(inside, flat[index], 0.0) for inside, index in self.corners)
+        top = (1.0 - self.fx) * a + self.fx * b
+        bottom = (1.0 - self.fx) * c + self.fx * d
+        return (1.0 - self.fy) * top + self.fy * bottom
+
+
+def _bilinear(src: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
+    """Bilinear samples of ``src`` at ``(map_x, map_y)`` (column, row), pixels outside the frame 0 (:class:`_Bilinear`)."""
+    return _Bilinear(src.shape, map_x, map_y)(src)
 
 
 def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = None,
@@ -99,3 +114,54 @@ def unfold_panorama(raw: np.ndarray, *, center, inner_radius: float | None = Non
         map_y = float(center[1]) + radius * np.sin(phi)[None, :]
     src = np.asarray(raw, dtype=np.float64)
     return _bilinear(src, map_x, map_y).astype(np.float32)
+
+
+def unfold_frames(frames, unfold, *, first: str, threads: int = 1) -> list[np.ndarray]:
+    """Unfold raw mirror frames with the ``db.unfold`` settings (:func:`unfold_panorama`).
+
+    ``db.unfold.center`` defaults to the frame's centre, ``db.unfold.outer_radius`` (0) to half the
+    shorter side less one pixel. The one unfolding of real frames: folder databases and ROS bags.
+
+    Parameters
+    ----------
+    frames : sequence of ndarray, shape (h, w)
+        Raw frames of one size.
+    unfold : UnfoldConfig
+        ``center``, ``inner_radius``, ``outer_radius``, ``size``.
+    first : str
+        Where the first frame comes from (a file, a bag message), for the log.
+    threads : int
+        Frames unfolded at once on this many threads (NumPy releases the GIL); the results do not depend on it.
+
+    Raises
+    ------
+    UserError
+        Inconsistent ``db.unfold`` values.
+    """
+    from bionav.errors import UserError
+
+    h, w = frames[0].shape
+    center = unfold.center if unfold.center is not None else [(w - 1) / 2.0, (h - 1) / 2.0]
+    outer = float(unfold.outer_radius) if unfold.outer_radius else min(w, h) / 2.0 - 1.0
+    inner = float(unfold.inner_radius)
+    if len(center) != 2 or not 0 <= inner < outer or len(unfold.size) != 2 or min(unfold.size) < 1:
+        raise UserError(
+            f"db.unfold is inconsistent (center={list(center)}, inner_radius={inner}, "
+            f"outer_radius={outer}, size={list(unfold.size)}): need center=[cx,cy], "
+            "0 <= inner_radius < outer_radius in pixels of the raw frame, and size=[W,H]."
+        )
+    log.debug("unfolding %d raw frames of %d x %d (first: %s)", len(frames), w, h, first)
+    width, height = int(unfold.size[0]), int(unfold.size[1])
+    sample = _Bilinear((h, w), *_unfold_maps((float(center[0]), float(center[1])), inner, outer, (width, height)))
+
+    def one(f):  # unfold_panorama's arithmetic, the maps computed once
+        if f.shape != (h, w):
+            return unfold_panorama(f, center=center, inner_radius=inner, outer_radius=outer, size=unfold.size)
+        return sample(np.asarray(f, dtype=np.float64)).astype(np.float32)
+
+    if threads > 1 and len(frames) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(min(threads, len(frames))) as pool:
+            return list(pool.map(one, frames))
+    return [one(f) for f in frames]

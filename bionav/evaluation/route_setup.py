@@ -1,14 +1,18 @@
-"""A route in a mesh world set up for following: its snapshots, the world, and what an agent sees.
+"""A route set up for following: its snapshots, the world, and what an agent sees.
 
-:func:`setup_route` renders the snapshots along a recorded route (:func:`bionav.db.mesh.route_database`)
-and builds the world once; :func:`route_renderer` renders the agent's canonical panorama at a
-pose and :func:`scan_renderer` the preprocessed views of a scan around a heading, as the protocol
-of Ardin et al. 2016 (doi:10.1371/journal.pcbi.1004683) sees them (:func:`scan_geometry`,
-:func:`box_panorama`); :func:`travel_headings` gives the training headings along the route.
+:func:`setup_route` renders the snapshots along a recorded route in a mesh world
+(:func:`bionav.db.mesh.route_database`) and builds the world once; :func:`setup_bag_route` takes a
+robot's drive from a ROS bag (``db=bag``) as the route, its recorded views as the world
+(:class:`bionav.db.bag.route.RecordedViews`). :func:`route_renderer` gives the agent's canonical
+panorama at a pose and :func:`scan_renderer` the preprocessed views of a scan around a heading, as
+the protocol of Ardin et al. 2016 (doi:10.1371/journal.pcbi.1004683) sees them (:func:`scan_geometry`,
+:func:`box_panorama`; in a recorded world cut from the nearest recorded view, :func:`recorded_world`);
+:func:`travel_headings` gives the training headings along the route.
 
-Conventions: positions in metres (world frame of the mesh), headings radians counter-clockwise from
-world ``+x``; panoramas canonical (:mod:`bionav.geometry`), column 0 along the heading rendered at;
-camera noise and 8-bit quantisation as the databases' (:func:`bionav.db.synthetic.quantise`).
+Conventions: positions in metres (world frame of the mesh or of the bag's poses), headings radians
+counter-clockwise from world ``+x``; panoramas canonical (:mod:`bionav.geometry`), column 0 along the
+heading rendered at; camera noise and 8-bit quantisation as the databases'
+(:func:`bionav.db.synthetic.quantise`; a recorded world adds none: its views carry the camera's own).
 """
 
 from __future__ import annotations
@@ -37,9 +41,9 @@ class RouteSetup:
     Attributes
     ----------
     name : str
-        ``Ant<a>_Route<r>``.
-    world : MeshWorld
-        The mesh world (:func:`bionav.db.mesh.world_from_spec`).
+        ``Ant<a>_Route<r>``; a bag's drive: the bag's name and image topic (:func:`setup_bag_route`).
+    world : MeshWorld or RecordedViews
+        The mesh world (:func:`bionav.db.mesh.world_from_spec`), or a drive's recorded views.
     db : ImageDatabase
         The snapshots along the route.
     xy : ndarray, shape (K, 2)
@@ -49,11 +53,11 @@ class RouteSetup:
     dense_xy : ndarray, shape (M, 2)
         The whole recorded route, metres.
     height : float
-        Camera height over the terrain, metres.
+        Camera height over the terrain, metres (0 for a recorded world).
     geometry : PanoramaGeometry
         The snapshots' geometry.
     noise : float
-        Camera noise std before 8-bit quantisation.
+        Camera noise std before 8-bit quantisation (0 for a recorded world).
     """
 
     name: str
@@ -99,13 +103,41 @@ def setup_route(db_node: dict, name: str, *, cache_dir: str) -> RouteSetup:
                       spec.camera_height_m, db.geometry, spec.noise)
 
 
+def setup_bag_route(db_node: dict) -> RouteSetup:
+    """The drive of a ROS bag (``db=bag``; ``db_node`` its resolved ``db`` node) as a route to follow.
+
+    The route views are the drive's views every ``db.route_step_m`` of path length, the world its
+    recorded views (:func:`bionav.db.bag.route.load_bag_route`): at any pose an agent sees the recorded
+    view nearest to it, turned to its heading.
+    """
+    from bionav.db.bag.route import load_bag_route
+    from bionav.db.loading import as_database_config
+
+    route = load_bag_route(as_database_config(dict(db_node)))
+    db = route.db
+    return RouteSetup(route.name, route.world, db, np.asarray(db.meta["world_xy"]), np.asarray(db.headings),
+                      route.dense_xy, 0.0, db.geometry, 0.0)
+
+
+def recorded_world(setup: RouteSetup) -> bool:
+    """Whether the route's world is a recording (``db=bag``: :func:`setup_bag_route`) rather than a mesh to render."""
+    from bionav.db.bag.route import RecordedViews
+
+    return isinstance(setup.world, RecordedViews)
+
+
 def _camera_z(setup: RouteSetup, xy) -> float:
     z = float(setup.world.terrain_height(np.array([xy]))[0])
     return (setup.world.ground_z if not np.isfinite(z) else z) + setup.height
 
 
 def route_renderer(setup: RouteSetup, rng: np.random.Generator):
-    """``render(xy, heading) -> panorama (H, W)`` float32 in [0, 1] in the snapshots' geometry, with their camera noise."""
+    """``render(xy, heading) -> panorama (H, W)`` float32 in [0, 1] in the snapshots' geometry, with their camera noise.
+
+    In a recorded world (:func:`recorded_world`) the recorded view nearest to ``xy`` turned to ``heading``.
+    """
+    if recorded_world(setup):
+        return setup.world.render
 
     def render(xy, heading):
         z = _camera_z(setup, xy)
@@ -156,8 +188,12 @@ def scan_renderer(setup: RouteSetup, rng: np.random.Generator, *, scan_step_deg:
 
     A scan of ``+-scan_half_deg`` in ``scan_step_deg`` around the heading, each view ``view_size``
     ``[W, H]`` (:func:`bionav.evaluation.route.scan_views`), cut from the panorama of
-    :func:`scan_geometry` (``supersample`` rays per pixel and axis) with the snapshots' camera noise.
+    :func:`scan_geometry` (``supersample`` rays per pixel and axis) with the snapshots' camera noise;
+    in a recorded world (:func:`recorded_world`) from the nearest recorded view (:func:`_recorded_scan_renderer`).
     """
+    if recorded_world(setup):
+        return _recorded_scan_renderer(setup, scan_step_deg=scan_step_deg, scan_half_deg=scan_half_deg,
+                                       view_size=view_size)
     geometry, col, shift = scan_geometry(scan_step_deg=scan_step_deg, supersample=supersample)
 
     def views(xy, heading):
@@ -167,6 +203,28 @@ def scan_renderer(setup: RouteSetup, rng: np.random.Generator, *, scan_step_deg:
         if supersample > 1:
             img = box_panorama(img, supersample=supersample, column_deg=col)
         img = quantise(img, noise=setup.noise, rng=rng).astype(np.float32) / np.float32(255.0)
+        return scan_views(img, column_deg=col, scan_half_deg=scan_half_deg, scan_step_deg=col, size=view_size)
+
+    return views
+
+
+def _recorded_scan_renderer(setup: RouteSetup, *, scan_step_deg: float, scan_half_deg: float, view_size):
+    """The scan views of a recorded world: the nearest recorded view resampled to columns of ``scan_step_deg``.
+
+    Columns are area averages (:func:`bionav.homing.imageops.resize_images`) centred on their azimuths;
+    rows are the camera's own, resized to ``view_size`` as the rendered scans'.
+    """
+    from bionav.homing.imageops import resize_images
+
+    col = float(scan_step_deg)
+    columns = int(round(360.0 / col))
+    width = setup.world.images.shape[-1]
+    # area averages of columns j*s .. (j+1)*s - 1 are centred 0.5*col - 0.5*(360/width) deg after the render heading
+    centre = math.radians(0.5 * col - 0.5 * 360.0 / width)
+
+    def views(xy, heading):
+        pano = setup.world.render(xy, heading - centre)
+        img = resize_images(pano[None], (columns, pano.shape[0]))[0]
         return scan_views(img, column_deg=col, scan_half_deg=scan_half_deg, scan_step_deg=col, size=view_size)
 
     return views

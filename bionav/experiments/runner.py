@@ -209,6 +209,7 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
         mcap.attach("config.yaml", OmegaConf.to_yaml(cfg, resolve=True).encode(), media_type="application/yaml")
         mcap.metadata("plugins", plugin_versions(cfg))
         config = validate_run_config(cfg)
+        attach_live_view(mcap, cfg)
         from bionav.experiments.settings import check_group_nodes, experiment_class
 
         cls = experiment_class(name)  # from the registry (bionav.experiments)
@@ -256,6 +257,18 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
     log.info("%s completed in %.1f s: %s", name, metrics["wall_time_s"], ", ".join(
         f"{k}={v:.4g}" for k, v in metrics.items() if isinstance(v, float) and k != "wall_time_s") or "no scalar metrics")
     return metrics
+
+
+def attach_live_view(mcap: McapLog, cfg: DictConfig) -> None:
+    """With ``bionav.live=PORT``, serve every message of the run over the Foxglove WebSocket protocol as well
+    (:mod:`bionav.logs.live`); without it nothing listens."""
+    from bionav.logs.live import live_server
+
+    server = live_server(OmegaConf.select(cfg, "bionav.live", default=None),
+                         host=OmegaConf.select(cfg, "bionav.live_host", default=None),
+                         linger_s=OmegaConf.select(cfg, "bionav.live_linger_s", default=None))
+    if server is not None:
+        mcap.add_sink(server)
 
 
 def _finish(run_dir: Path, mcap: McapLog | None, metrics: dict[str, Any], started: float, *, failing: bool) -> None:

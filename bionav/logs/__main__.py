@@ -1,4 +1,4 @@
-"""``python -m bionav.logs info FILE.mcap`` and ``python -m bionav.logs recover IN OUT``."""
+"""``python -m bionav.logs info FILE.mcap``, ``recover IN OUT``, ``export-ros2 RUN OUT`` and ``layout NAME``."""
 
 from __future__ import annotations
 
@@ -72,10 +72,29 @@ def main(argv: list[str] | None = None) -> int:
     p_rec.add_argument("input")
     p_rec.add_argument("output")
     p_rec.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p_exp = sub.add_parser("export-ros2", help="write a run's views, poses, home vectors and other messages as a "
+                                                "ROS 2 bag of standard message types (needs bionav[ros])")
+    p_exp.add_argument("run", help="a run directory or its run.mcap")
+    p_exp.add_argument("output", help="the ROS 2 bag folder to create")
+    p_exp.add_argument("--storage", choices=("mcap", "sqlite3"), default="mcap", help="the bag's storage (default mcap)")
+    p_exp.add_argument("--force", action="store_true", help="replace an existing output folder")
+    p_lay = sub.add_parser("layout", help="print a Foxglove layout shipped with bionav (import it in Foxglove: "
+                                          "Layouts, Import from file)")
+    p_lay.add_argument("name", choices=("grid_homing", "compass"))
     args = parser.parse_args(argv)
     try:
         if args.command == "info":
             _info(args.file)
+        elif args.command == "layout":
+            from bionav.logs.foxglove import foxglove_layout
+
+            print(foxglove_layout(args.name), end="")
+        elif args.command == "export-ros2":
+            from bionav.logs.ros2 import export_ros2
+
+            counts = export_ros2(args.run, args.output, storage=args.storage, overwrite=args.force)
+            print(f"wrote {sum(counts.values())} messages to the ROS 2 bag {args.output} ({args.storage}): "
+                  + ", ".join(f"{n} {t}" for t, n in sorted(counts.items())))
         else:
             from bionav.logs.recover import recover
 

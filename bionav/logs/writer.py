@@ -96,6 +96,8 @@ class McapLog:
         self._writer.start(profile=profile, library="bionav")
         self._schemas: dict[tuple[str, str], int] = {}
         self._channels: dict[str, int] = {}
+        self._topic_schemas: dict[str, tuple[str, bytes]] = {}
+        self._sinks: list = []
         self._sequence: dict[str, int] = {}
         self._flush_interval = float(flush_interval_s)
         self._last_flush = time.monotonic()
@@ -146,6 +148,7 @@ class McapLog:
         self._channels[topic] = self._writer.register_channel(
             topic=topic, message_encoding="json", schema_id=self._schemas[key]
         )
+        self._topic_schemas[topic] = (schema_name, schema_json.encode())
         self._sequence[topic] = 0
         return self._channels[topic]
 
@@ -196,6 +199,32 @@ class McapLog:
             self._dirty = True
             if time.monotonic() - self._last_flush >= self._flush_interval:
                 self.flush()
+            sinks = list(self._sinks)
+        for sink in sinks:
+            self._publish(sink, topic, data, t)
+
+    # -- sinks ----------------------------------------------------------------
+    def add_sink(self, sink) -> None:
+        """Also send every message to ``sink`` (e.g. :class:`bionav.logs.live.LiveServer`).
+
+        A sink has ``publish(topic, schema_name, schema_json, data, log_time_ns)`` (the message's
+        JSON bytes, its schema as written to the log) and ``close()``, which :meth:`close` calls.
+        A sink that raises is detached with one warning: the log goes on.
+        """
+        with self._lock:
+            self._sinks.append(sink)
+
+    def _publish(self, sink, topic: str, data: bytes, t: int) -> None:
+        name, schema = self._topic_schemas[topic]
+        try:
+            sink.publish(topic, name, schema, data, t)
+        except Exception as exc:  # a viewer's trouble never stops the run
+            import logging
+
+            with self._lock:
+                if sink in self._sinks:
+                    self._sinks.remove(sink)
+            logging.getLogger(__name__).warning("live sink %s detached after an error: %s", type(sink).__name__, exc)
 
     @staticmethod
     def _encode(topic: str, schema_name: str, message: Mapping[str, Any]) -> bytes:
@@ -236,10 +265,13 @@ class McapLog:
                 return
             self._closed = True
             self._stop.set()
+            sinks, self._sinks = self._sinks, []
             try:
                 self._writer.finish()
             finally:
                 self._file.close()
+                for sink in sinks:
+                    sink.close()
 
     def __enter__(self) -> "McapLog":
         return self

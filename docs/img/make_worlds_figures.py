@@ -7,7 +7,7 @@ import numpy as np
 from bionav.config import compose
 from bionav.db.mesh import load_route, mesh_world, seville_world_path
 from bionav.experiments.common import load_configured_database
-from bionav.experiments.route_plots import draw_world
+from bionav.experiments.route_homing.plots import draw_world
 from bionav.geometry import PanoramaGeometry
 from bionav.report.figures import pyplot, save_figure
 from bionav.world.mesh_render import render_mesh_panorama

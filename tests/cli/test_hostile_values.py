@@ -142,9 +142,9 @@ def test_check_config_names_key_value_and_range(field, value, needle):
 
 #: string options that are free text (paths, ports, names resolved elsewhere, times)
 #: keys whose values are free text or paths (``calibration``: none | auto | a calibration.json path, checked where
-#: the file is read)
+#: the file is read; ``db=bag``'s topic and frame names: checked against the bag where it is read, db/bag/)
 FREE_TEXT = {"port", "path", "topic", "signature", "time", "name", "calibration_path", "world", "grid", "route",
-             "routes_path", "calibration"}
+             "routes_path", "calibration", "image_topic", "pose_topic", "pose_frame", "world_frame"}
 
 
 def _all_config_classes():
@@ -261,5 +261,5 @@ def test_every_db_preset_uses_every_key_it_sets():
     names = config_options("db")
     assert {"sim_original", "sim_uni", "original", "mesh", "sim_seville", "seville_route"} <= set(names)
     for name in names:
-        extra = {"folder": ["db.path=."], "mesh": ["db.world=seville2009"]}.get(name, [])
+        extra = {"folder": ["db.path=."], "mesh": ["db.world=seville2009"], "bag": ["db.path=robot.bag"]}.get(name, [])
         assert as_database_config(compose([f"db={name}", *extra]).db).name == name

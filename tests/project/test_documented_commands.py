@@ -274,7 +274,7 @@ def _jobs() -> list[Job]:
                     smoked_files.add(cmd.file)
                     add(cmd, ["bionav", *combo, "--cfg", "job"])
             continue
-        first = args[0] if args and re.fullmatch(r"[a-z_]+", args[0]) else None
+        first = args[0] if args and re.fullmatch(r"[a-z_][a-z0-9_-]*", args[0]) else None  # sub-commands: info, export-ros2
         add(cmd, [module, *([first] if first else []), "--help"])
         if module in REAL_RUN_MODULES and args[1 if first else 0:] and "--help" not in args:
             add(cmd, [module, *args])  # a real run (not a mere mention such as `python -m bionav.logs recover`)

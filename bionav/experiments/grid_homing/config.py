@@ -23,6 +23,8 @@ class GridHomingConfig:
     block : ``[i, n]``: only every n-th of those snapshots, starting at the i-th (0 <= i < n): one
         task of a run split into n; ``python -m bionav.experiments.merge`` joins the
         tasks into the unsplit run's files, with identical measures.
+    log_views : also write every view to run.mcap (``/grid_homing/views``, ``foxglove.RawImage``, 32-bit float):
+        for Foxglove, the live view (``bionav.live``) and ``python -m bionav.logs export-ros2``.
     """
 
     name: str = "grid_homing"
@@ -31,3 +33,4 @@ class GridHomingConfig:
     n_quiver_plots: int = bounded(4, ge=0, le=1000)
     snapshots: Optional[list[int]] = bounded(None, length=(1, 1_000_000), item=Range(ge=0, le=10**8))
     block: Optional[list[int]] = bounded(None, length=(2, 2), item=Range(ge=0, le=10**6))
+    log_views: bool = False

@@ -10,6 +10,7 @@ With ``experiment.block=[i,n]`` a run is task i of n (every n-th snapshot);
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +27,7 @@ from bionav.experiments.grid_homing.plots import plot_fields
 from bionav.experiments.grid_homing.resume import ROWS_TOPIC, resumed_rows, with_resumed_rows
 from bionav.experiments.tasks import block_of
 from bionav.files import write_csv_atomic
+from bionav.logs.foxglove import poses_in_frame
 
 HOME_VECTOR_SCHEMA = {
     "type": "object",
@@ -90,6 +92,10 @@ def _row_loggers(ctx, db):
             schema_name="bionav.HomeVectorRow",
             schema=HOME_VECTOR_ROW_SCHEMA,
         )
+        ns = time.time_ns()  # the home vectors as arrows (Foxglove's 3D panel; a ROS 2 PoseArray on export)
+        ctx.log.write("/grid_homing/home_vector_poses",
+                      poses_in_frame(db.positions * db.spacing_m, angles, timestamp_ns=ns, frame_id="grid"),
+                      schema_name="foxglove.PosesInFrame", log_time_ns=ns)
 
     def log_partial(si: int, currents: np.ndarray, angles: np.ndarray, compass: np.ndarray) -> None:
         """Pairs of a row still being computed, every ~2 s (a crash loses at most that much of a long row)."""
@@ -104,6 +110,23 @@ def _row_loggers(ctx, db):
         ctx.log.flush()  # to the file now: the ~2 s of this period are all a crash can lose
 
     return log_row, log_partial
+
+
+def _log_views(ctx, db, log_views: bool) -> None:
+    """The views' poses (metres in the grid frame, heading CCW from grid +x) and, with ``experiment.log_views``,
+    the views themselves (``foxglove.RawImage``, frame ``cell_<x>_<y>``): what Foxglove and a ROS 2 export show."""
+    ns = time.time_ns()
+    ctx.log.write("/grid_homing/view_poses",
+                  poses_in_frame(db.positions * db.spacing_m, db.headings, timestamp_ns=ns, frame_id="grid"),
+                  schema_name="foxglove.PosesInFrame", log_time_ns=ns)
+    if log_views:
+        from bionav.robot.recording import raw_image_from_array
+
+        for (x, y), image in zip(db.positions, db.images):
+            grey = image if image.ndim == 2 else image.mean(axis=-1)
+            ctx.log.write("/grid_homing/views", raw_image_from_array(np.asarray(grey, np.float32), timestamp_ns=ns,
+                                                                      frame_id=f"cell_{x}_{y}"),
+                          schema_name="foxglove.RawImage", log_time_ns=ns)
 
 
 def _log_fields(ctx, db, hv, ae, success, paths) -> None:
@@ -145,6 +168,7 @@ def run(exp: GridHomingConfig, ctx) -> dict[str, Any]:
     if exp.block is not None:
         snapshots = block_of(exp.block, range(len(db)) if snapshots is None else snapshots)
 
+    _log_views(ctx, db, exp.log_views)
     log_row, log_partial = _row_loggers(ctx, db)
     wanted = list(range(len(db))) if snapshots is None else [int(v) for v in snapshots]
     done = resumed_rows(ctx, db, wanted, resume=bool(OmegaConf.select(cfg, "bionav.resume", default=False)))

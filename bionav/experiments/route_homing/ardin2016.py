@@ -38,6 +38,7 @@ from bionav.experiments.route_homing.shared import (
     check_step_budget,
     route_setup,
     routes_file,
+    routes_to_follow,
     with_protocol_step,
     write_rows,
 )
@@ -141,14 +142,15 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
 
     cfg = ctx.cfg
     exp = with_protocol_step(exp)
-    routes = exp.routes or list(ARDIN_ROUTES)
+    routes = routes_to_follow(cfg, exp, list(ARDIN_ROUTES))
     kinds = _agent_kinds(exp.agents)
     _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, routes_file(cfg))
     rows, paths, setups = [], {}, []
     timing = {a: [0.0, 0.0] for a in exp.agents}
     for name in ctx.progress(routes, desc="ardin2016 routes"):
-        setup = route_setup(cfg, name)
+        setup = route_setup(cfg, name, exp)
+        name = setup.name
         setups.append(setup)
         length = float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum())
         max_steps = int(math.ceil(exp.max_steps_factor * length / exp.agent_step_m))
@@ -175,6 +177,7 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
                 ctx.log.write(PATH_TOPIC, {"route": name, "method": agent_name, "xy": res.path.tolist(),
                                            "completed": bool(res.reached_nest)},
                               schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
+    routes = [s.name for s in setups]  # db=bag: the drive's own name
     write_rows(ctx.dir / ARDIN_CSV, rows, ARDIN_KEYS)
     if exp.plots:
         from bionav.experiments.route_homing.plots import plot_world_routes

@@ -8,11 +8,15 @@ from bionav.report.figures import pyplot, save_figure
 
 
 def draw_world(ax, world, *, color="0.15") -> None:
-    """The mesh world from above: every triangle filled (x, y in metres)."""
+    """The mesh world from above: every triangle filled (x, y in metres); a recorded drive (``db=bag``): where
+    its views were taken."""
     from matplotlib.collections import PolyCollection
 
-    tri = world.mesh.triangles[:, :, :2]
-    ax.add_collection(PolyCollection(tri, facecolors=color, edgecolors="none"))
+    if hasattr(world, "mesh"):
+        tri = world.mesh.triangles[:, :, :2]
+        ax.add_collection(PolyCollection(tri, facecolors=color, edgecolors="none"))
+    else:
+        ax.plot(world.xy[:, 0], world.xy[:, 1], ".", color="0.8", ms=3, label="recorded views")
     (x0, y0), (x1, y1) = world.extent()
     ax.set_xlim(x0 - 0.2, x1 + 0.2)
     ax.set_ylim(y0 - 0.2, y1 + 0.2)
@@ -47,7 +51,7 @@ def plot_world_routes(path, world, setups, paths) -> None:
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8, frameon=False)
     ax.set_title(f"{len(setups)} route{'s' if len(setups) != 1 else ''} (grey) with snapshots (black)"
                  + (" and agent paths" if any(p is not None for p in paths.values()) else "")
-                 + "; world from above (dark)", fontsize=9)
+                 + ("; world from above (dark)" if hasattr(world, "mesh") else "; recorded views (light)"), fontsize=9)
     save_figure(fig, path, dpi=110)
 
 

@@ -57,6 +57,7 @@ import zlib
 from typing import Any
 
 import numpy as np
+from omegaconf import OmegaConf
 
 from bionav.evaluation.route import catchment_width
 from bionav.evaluation.route_setup import route_renderer
@@ -73,14 +74,15 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     """Run ``experiment=route_homing`` (``protocol=bionav``) with the checked ``exp`` (the rest in ``ctx.cfg``)."""
     cfg = ctx.cfg
     exp = shared.with_protocol_step(exp)
-    routes = exp.routes or [str(cfg.db.route)]
+    routes = shared.routes_to_follow(cfg, exp, [str(OmegaConf.select(cfg, "db.route", default=None))])
     if exp.closed_loop:  # open-loop runs take no agent steps
         shared.check_step_budget(routes, exp, shared.routes_file(cfg))
     rows = []
     per_route = {}
     for name in routes:
         log.info("route %s: loading its world and route views (rendered once, then cached) ...", name)
-        setup = shared.route_setup(cfg, name)
+        setup = shared.route_setup(cfg, name, exp)
+        name = setup.name
         homing = make_homing(cfg, ctx, setup.geometry) if "homing" in exp.methods else None
         zernike = Zernike({"order": exp.zernike_order}) if "zernike" in exp.methods else None
         per_route[name] = {"setup": setup, "results": {}}
@@ -112,6 +114,7 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
                               schema_name="bionav.RoutePath", schema=shared.PATH_SCHEMA)
             per_route[name]["results"][method] = res
             rows.append(row)
+    routes = list(per_route)  # db=bag: the drive's own name
     _write_csv(ctx.dir / "route_homing.csv", rows)
     if exp.plots:
         from bionav.experiments.route_homing.plots import plot_error_maps, plot_headings, plot_world_routes

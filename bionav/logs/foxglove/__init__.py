@@ -41,3 +41,57 @@ def foxglove_schema(name: str) -> dict[str, Any]:
 def foxglove_schema_names() -> list[str]:
     """Every schema name Foxglove defines (``foxglove.<Name>``)."""
     return sorted(_all())
+
+
+def foxglove_time(ns: int) -> dict[str, int]:
+    """A ``foxglove.Timestamp`` (``{"sec", "nsec"}``) of nanoseconds since the Unix epoch."""
+    return {"sec": int(ns // 1_000_000_000), "nsec": int(ns % 1_000_000_000)}
+
+
+def poses_in_frame(xy, yaw, *, timestamp_ns: int, frame_id: str) -> dict[str, Any]:
+    """A ``foxglove.PosesInFrame`` message: planar poses (the 3D panel draws each as an arrow).
+
+    Parameters
+    ----------
+    xy : array_like, shape (N, 2)
+        Positions in metres in ``frame_id`` (z = 0).
+    yaw : array_like, shape (N,)
+        Headings, radians counter-clockwise about +z from the frame's +x; rows with a
+        non-finite position or heading are left out (Foxglove's schema takes numbers only).
+    timestamp_ns : int
+        Nanoseconds since the Unix epoch.
+    frame_id : str
+
+    Returns
+    -------
+    dict
+        ``{"timestamp", "frame_id", "poses": [{"position", "orientation"}, ...]}``.
+    """
+    import math
+
+    poses = []
+    for (x, y), h in zip(xy, yaw):
+        x, y, h = float(x), float(y), float(h)
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(h)):
+            continue
+        poses.append({"position": {"x": x, "y": y, "z": 0.0},
+                      "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(h / 2.0), "w": math.cos(h / 2.0)}})
+    return {"timestamp": foxglove_time(timestamp_ns), "frame_id": frame_id, "poses": poses}
+
+
+#: the Foxglove layouts the package ships (``layouts/<name>.json``)
+LAYOUTS = ("grid_homing", "compass")
+
+
+def foxglove_layout(name: str) -> str:
+    """The text of a shipped Foxglove layout (``grid_homing``: the 3D grid with home vectors, the views and the
+    rows; ``compass``: pan, reference bearing and POL-OP readings of ``experiment=pol_compass``).
+
+    Raises
+    ------
+    KeyError
+        For a name not in :data:`LAYOUTS`.
+    """
+    if name not in LAYOUTS:
+        raise KeyError(f"no layout {name!r}; shipped: {', '.join(LAYOUTS)}")
+    return files(__name__).joinpath("layouts", f"{name}.json").read_text()

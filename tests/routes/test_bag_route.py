@@ -1,0 +1,89 @@
+"""experiment=route_homing db=bag: a drive recorded in a rosbags-written bag, followed with the published protocol."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from helpers import assert_fails_cleanly, run_bionav
+from rosbag_helpers import T0_NS, write_drive
+
+pytest.importorskip("rosbags")
+
+from bionav.db.bag.route import RecordedViews, route_stations  # noqa: E402
+
+
+def test_route_stations_every_step_of_path_length():
+    xy = np.array([[0.0, 0.0], [0.04, 0.0], [0.09, 0.0], [0.11, 0.0], [0.2, 0.0], [0.2, 0.15], [0.2, 0.18]])
+    # path length 0, .04, .09, .11, .2, .35, .38: the first view at or after 0, .1, .2, .3; the last view
+    assert route_stations(xy, 0.1).tolist() == [0, 3, 4, 5, 6]
+    assert route_stations(xy, 1.0).tolist() == [0, 6]
+
+
+def test_recorded_views_turned_to_a_heading():
+    rng = np.random.default_rng(0)
+    images = rng.random((3, 4, 36)).astype(np.float32)
+    world = RecordedViews(images, np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), np.array([0.0, 0.5, 1.0]))
+    assert world.nearest([1.4, 0.3]) == 1 and world.nearest([0.5, 0.0]) == 0  # a tie goes to the earlier view
+    # view 2 was taken at heading 1.0; asked for heading 1.0 + 3 columns it is that view rolled by -3 columns
+    turned = world.render([2.2, 0.0], 1.0 + 3 * 2 * math.pi / 36)
+    assert np.array_equal(turned, np.roll(images[2], -3, axis=-1))
+    half = world.render([0.0, 0.0], 0.5 * 2 * math.pi / 36)  # half a column: the mean of two neighbours
+    assert np.allclose(half, 0.5 * (images[0] + np.roll(images[0], -1, axis=-1)), atol=1e-6)
+
+
+def _path(s: float):
+    x = -2.2 + 4.0 * s
+    return x, -0.3 + 0.25 * math.sin(2.0 * x)
+
+
+@pytest.fixture(scope="module")
+def drive(tmp_path_factory):
+    """81 views along a 4.3 m wavy drive through the pillar room (one every 5.4 cm), odometry at 20 Hz."""
+    from bionav.testing import render_pillar_panorama
+
+    n = 81
+    images = []
+    for k in range(n):
+        img, _ = render_pillar_panorama(_path(k / (n - 1)), width=360, height=40, supersample=1)
+        images.append((T0_NS + k * 2 * 10**8, np.uint8(np.rint(img * 255))))
+    poses = []
+    for k in range(4 * n + 4):
+        t = T0_NS - 10**8 + k * 5 * 10**7 + 3 * 10**6
+        poses.append((t, *_path(min(max((t - T0_NS) / (2 * 10**8 * (n - 1)), 0.0), 1.0)), 0.0))
+    return write_drive(tmp_path_factory.mktemp("route") / "drive", "sqlite3", images=images, poses=poses,
+                       encoding="png")
+
+
+ROUTE = ("experiment=route_homing", "experiment.protocol=ardin2016", "db=bag", "db.image_topic=/camera/image",
+         "db.pose_topic=/odom", "db.route_step_m=0.1", "db.azimuth=counterclockwise")
+
+
+@pytest.mark.slow
+def test_a_drive_from_a_bag_is_followed(tmp_path, drive):
+    proc = run_bionav(*ROUTE, f"db.path={drive}", "experiment.agents=[perfect_memory,infomax,mfdid]",
+                      f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    m = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    assert m["routes"] == ["drive_camera_image"] and m["protocol"] == "ardin2016"
+    for agent in ("perfect_memory", "infomax", "mfdid"):
+        assert m[f"reached_nest_{agent}"] == 1.0, agent
+    assert m["errors_per_route_perfect_memory"] == 0 and m["errors_per_route_infomax"] == 0
+    rows = (tmp_path / "run" / "route_following.csv").read_text().splitlines()
+    assert len(rows) == 4 and rows[1].startswith("drive_camera_image,perfect_memory,0,")
+    views = np.array([_path(k / 80) for k in range(81)])
+    length = np.linalg.norm(np.diff(views, axis=0), axis=1).sum()  # 4.29 m
+    assert int(rows[1].split(",")[8]) == math.ceil(length / 0.1) + 1  # a route view every 0.1 m, and the last
+    assert (tmp_path / "run" / "plots" / "world_routes.png").is_file()
+
+
+@pytest.mark.slow
+def test_route_options_that_do_not_fit_a_bag(tmp_path, drive):
+    bionav = [a for a in ROUTE if not a.startswith("experiment.protocol")]
+    proc = run_bionav(*bionav, f"db.path={drive}", f"hydra.run.dir={tmp_path / 'a'}", cwd=tmp_path)
+    assert_fails_cleanly(proc, "experiment.protocol=ardin2016", "recorded drive")
+    proc = run_bionav(*ROUTE, f"db.path={drive}", "experiment.routes=[Ant1_Route1]", f"hydra.run.dir={tmp_path / 'b'}",
+                      cwd=tmp_path)
+    assert_fails_cleanly(proc, "drop experiment.routes")
