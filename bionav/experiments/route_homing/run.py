@@ -69,7 +69,7 @@ from bionav.plugins.signatures.zernike import Zernike
 def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     """Run ``experiment=route_homing`` (``protocol=bionav``) with the checked ``exp`` (the rest in ``ctx.cfg``)."""
     cfg = ctx.cfg
-    exp = shared.with_protocol_step(exp)
+    exp = shared.with_protocol_defaults(exp)
     routes = exp.routes or [str(cfg.db.route)]
     if exp.closed_loop:  # open-loop runs take no agent steps
         shared.check_step_budget(routes, exp, shared.routes_file(cfg))
