@@ -59,7 +59,7 @@ def _examples():
 
     from bionav.evaluation import agent
     from bionav.homing import sift_kernels
-    from bionav.homing.warping import distance, kernels
+    from bionav.homing.warping import distance, kernels, vkernels
     from bionav.robot import coverage
     from bionav.world import intersect, mesh_kernels
     from bionav.world import kernels as world
@@ -100,6 +100,15 @@ def _examples():
                                      (z(n_planes, 9, w, dtype=f32), z(n_planes, 9, 2 * w, dtype=f32),
                                       z(n_planes, w, dtype=f32), z(n_planes, 2 * w, dtype=f32), step,
                                       z(n_planes, w, step, n, dtype=f32)))
+    # the explicit-vector kernels (issue 42): search and distance sums, padded buffers as the search gives them
+    ex["minwarp_search_u8"] = (vkernels.minwarp_search_u8,
+                               (z(2 * n_planes * w * step * n + vkernels.TABLE_PAD, dtype=u8), n_planes, w, step, n,
+                                z(4, dtype=i64), *windows(), z(4, vkernels.padded_lanes(n), dtype=u16),
+                                z(vkernels.search_scratch_size(n), dtype=u8)))
+    ex["diagonal_distances_u8"] = (vkernels.diagonal_distances_u8,
+                                   (z(n_planes, 9, w, dtype=np.int16), z(n_planes, 9, 2 * w + 4, dtype=np.int16),
+                                    z(n_planes, w, dtype=np.int32), z(n_planes, 2 * w + 4, dtype=np.int32), step, 227,
+                                    z(n_planes, w, step, n, dtype=u8), z(w + 4, w, dtype=u16)))
     ex["warping1d_scores"] = (warping1d._warp1d_scores, (z(w), z(4 * w + 1), z(3), z(3), z(3)))
     # SIFT matching: descriptors float32, keys int64
     xa, da, na = z(16), z(16, 128, dtype=f32), z(16, dtype=i64)

@@ -86,9 +86,12 @@ def _parser():
         description="Time homing methods: CPU and wall ms per home vector (per-image work and "
                     "warm-up excluded), variants interleaved, median and minimum over the rounds.",
     )
-    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all",) + RUN_METHODS, default="minwarping",
+    parser.add_argument("--method", choices=METHODS + GRID_METHODS + ("all", "scaling", "stages", "calibrate") + RUN_METHODS,
+                        default="minwarping",
                         help="method to time (default: minwarping; all = the pair methods, not sift); "
-                             "sweep and cleaning time whole runs")
+                             "sweep and cleaning time whole runs; scaling: CPU per home vector against image "
+                             "and grid size for each method; stages: min-warping's stages against the arithmetic "
+                             "floor; calibrate: the plan's calibration workloads (python -m bionav.thesis --plan)")
     parser.add_argument("--json", action="store_true",
                         help="print one JSON object per line instead of a table")
     parser.add_argument("--threads", type=int, default=1,
@@ -139,6 +142,15 @@ def _parser():
                       help="comma-separated SIFT variants: plain, histeq (default: both)")
     sift.add_argument("--images", type=int, default=None, metavar="N",
                       help="use the first N images of the grid (default: all)")
+    scaling = parser.add_argument_group("--method scaling (CPU against image and grid size)")
+    scaling.add_argument("--scaling-sizes", default="144x25,288x50,576x100", metavar="WxH,...",
+                         help="image sizes of the pair table (default: 144x25,288x50,576x100)")
+    scaling.add_argument("--scaling-snapshots", type=int, default=4, metavar="N",
+                         help="snapshots of the larger whole run (the smaller has 1; default: 4)")
+    scaling.add_argument("--scaling-runs", type=int, default=1, choices=(0, 1),
+                         help="1: also time whole grid-homing runs on --db (default); 0: the pair table only")
+    scaling.add_argument("--clock-ghz", type=float, default=None, metavar="F",
+                         help="--method stages: the core clock of the floor (default: measured)")
     add_arguments(parser)
     return parser
 
@@ -182,6 +194,17 @@ def _check_args(parser, args) -> None:
         from bionav.bench.runs import check_arguments
 
         check_arguments(parser, args)
+    if args.method == "scaling":
+        from bionav.bench.scaling import parse_sizes
+
+        try:
+            parse_sizes(args.scaling_sizes)
+        except ValueError as exc:
+            parser.error(f"--scaling-sizes: {exc}; e.g. --scaling-sizes 144x25,288x50")
+        bounded_int(parser, "--scaling-snapshots", args.scaling_snapshots, 2, 1000)
+    if args.clock_ghz is not None and not 0.1 <= args.clock_ghz <= 10.0:
+        parser.error(f"--clock-ghz {args.clock_ghz} is out of range: give the core clock in GHz, 0.1..10; e.g. "
+                     "--clock-ghz 2.6")
 
 
 def _run_for_cpu(parser, args, argv: list[str]) -> int:
@@ -220,7 +243,21 @@ def main(argv=None) -> int:
             print(json.dumps(row) if args.json else "  ".join(f"{k}={v}" for k, v in row.items()))
         return 0
     if args.repeat is None:
-        args.repeat = 1 if args.method in GRID_METHODS else 15
+        args.repeat = 1 if args.method in GRID_METHODS else 5 if args.method in ("scaling", "stages") else 15
+    if args.method == "scaling":
+        from bionav.bench.scaling import scaling_rows
+
+        return _print_scaling(scaling_rows(args), args)
+    if args.method == "calibrate":
+        from bionav.bench.calibration import run_calibration
+
+        cal = run_calibration()
+        print(json.dumps(cal) if args.json else "  ".join(f"{k}={v}" for k, v in cal.items()))
+        return 0
+    if args.method == "stages":
+        from bionav.bench.stages import stage_rows
+
+        return _print_stages(stage_rows(args), args)
     batch = args.batch if args.batch is not None else 6 * args.threads
     if args.grid is not None:
         if args.method != "minwarping":
@@ -244,15 +281,24 @@ def main(argv=None) -> int:
     return _print_rows(pair_rows(args, batch), args)
 
 
+def _load_line(row: dict) -> str:
+    return f"load average (1 min) {row['loadavg_1min'][0]} -> {row['loadavg_1min'][1]}"
+
+
+def _json_lines(rows: list[dict]) -> int:
+    """Print one JSON object per row (``--json``); status 0."""
+    for row in rows:
+        print(json.dumps(row))
+    return 0
+
+
 def _fmt(x) -> str:
     return "-" if x is None else f"{x:.2f}"
 
 
 def _print_rows(rows: list[dict], args) -> int:
     if args.json:
-        for row in rows:
-            print(json.dumps(row))
-        return 0
+        return _json_lines(rows)
     last, key = (("workers speedup", "workers_speedup") if args.grid is not None
                  else ("prepare CPU ms/image", "prepare_cpu_ms_per_image"))
     header = ("method", "variant", "image", "steps", "threads", "CPU ms/hv (median)", "CPU ms (min)",
@@ -267,16 +313,46 @@ def _print_rows(rows: list[dict], args) -> int:
                  for c, r in zip(cells, rows)]
     _print_aligned(header, cells)
     print(f"numba target CPU {rows[0]['cpu']} ({rows[0]['isa']})")
-    print(f"load average (1 min) {rows[0]['loadavg_1min'][0]} -> {rows[0]['loadavg_1min'][1]}, "
-          f"background load {args.background_load}, {rows[0]['machine']}")
+    print(_load_line(rows[0]) + f", background load {args.background_load}, {rows[0]['machine']}")
+    return 0
+
+
+def _print_scaling(rows: list[dict], args) -> int:
+    if args.json:
+        return _json_lines(rows)
+    pairs = [r for r in rows if r["table"] == "pairs"]
+    _print_aligned(("method", "image", "pixels", "CPU ms/hv (min)", "CPU ms/hv (median)", "growth exponent",
+                    "prepare CPU ms/image"),
+                   [(r["method"], r["image"], str(r["pixels"]), f"{r['cpu_ms_min']:.3f}",
+                     f"{r['cpu_ms_per_home_vector']:.3f}", _fmt(r.get("growth_exponent")),
+                     f"{r['prepare_cpu_ms_per_image']:.1f}") for r in pairs])
+    runs = [r for r in rows if r["table"] == "runs"]
+    if runs:
+        print()
+        _print_aligned(("method", "db", "snapshots", "home vectors", "run CPU s", "CPU ms/hv (slope)",
+                        "fixed CPU s per run"),
+                       [(r["method"], r["db"], " / ".join(map(str, r["snapshots"])),
+                         " / ".join(map(str, r["home_vectors"])), " / ".join(map(str, r["cpu_s"])),
+                         f"{r['cpu_ms_per_home_vector']:.3f}", f"{r['fixed_cpu_s']:.2f}") for r in runs])
+    print(f"numba target CPU {rows[0]['cpu']} ({rows[0]['isa']}); " + _load_line(rows[0]) + f", {rows[0]['machine']}")
+    return 0
+
+
+def _print_stages(rows: list[dict], args) -> int:
+    if args.json:
+        return _json_lines(rows)
+    _print_aligned(("stage", "byte-lane ops", "floor ms", "CPU ms (min)", "fraction of the floor"),
+                   [(r["stage"], "-" if r["byte_lane_ops"] is None else f"{r['byte_lane_ops'] / 1e6:.1f} M",
+                     f"{r['floor_ms']:.3f}", f"{r['cpu_ms']:.3f}", f"{100 * r['fraction_of_floor']:.1f} %")
+                    for r in rows])
+    print(f"min-warping at {rows[0]['image']}, {rows[0]['steps']} x {rows[0]['steps']} steps; floor: 2 x 64 byte lanes "
+          f"per cycle at {rows[0]['clock_ghz']} GHz; load average (1 min) {rows[0]['loadavg_1min']}")
     return 0
 
 
 def _print_sift(rows: list[dict], args) -> int:
     if args.json:
-        for row in rows:
-            print(json.dumps(row))
-        return 0
+        return _json_lines(rows)
     header = ("variant", "image", "images", "keypoints/image", "threads", "grid wall s", "grid CPU s",
               "SIFT CPU ms/image", "pairs wall s", "pairs CPU s", "CPU ms/hv", "speedup", "db load s")
     cells = [(r["variant"], r["image"], str(r["n_images"]), f"{r['keypoints_per_image']['mean']:.0f}",

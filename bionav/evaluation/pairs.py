@@ -113,6 +113,7 @@ def home_vector_matrix(
     on_partial: Callable[[int, np.ndarray, np.ndarray, np.ndarray], None] | None = None,
     partial_period_s: float = 2.0,
     batch: bool = True,
+    device: str = "cpu",
 ) -> HomeVectorMatrix:
     """Home vectors from every current view to every (selected) snapshot.
 
@@ -156,6 +157,9 @@ def home_vector_matrix(
         Use the method's batch path (:meth:`HomingMethod.all_pairs_angles`)
         when it has one and snapshots and current views are one database;
         ``False`` forces the per-pair calls.
+    device : str
+        ``"cpu"``, or ``"cuda"``: the pairs on an NVIDIA GPU (:mod:`bionav.gpu`; min-warping,
+        2D-warping and SIFT), the per-image work on the CPU.
 
     Returns
     -------
@@ -165,10 +169,22 @@ def home_vector_matrix(
     same = currents is None or currents is snapshots
     currents = snapshots if currents is None else currents
     s_idx = np.arange(len(snapshots)) if snapshot_index is None else np.asarray(snapshot_index, dtype=np.int64)
+    if device == "cuda":  # before the per-image work: a method the GPU does not compute is refused at once
+        from bionav.gpu import check_method
+
+        check_method(getattr(method, "name", type(method).__name__))
     t0 = time.perf_counter()
     snap_prep, cur_prep = prepared if prepared is not None else _prepare_both(method, snapshots, currents, same,
                                                                               workers, progress, cache)
     timing = _Timing(t0, time.perf_counter(), _n_pairs(snapshots, currents, s_idx), _prepared_stats(method, cur_prep))
+    if device == "cuda":
+        from bionav.gpu.pairs import gpu_matrix
+
+        angles, compass = gpu_matrix(method, snapshots, currents, s_idx, snap_prep, cur_prep, on_row=on_row)
+        has_compass = bool(np.any(np.isfinite(compass)))
+        return HomeVectorMatrix(snapshot_index=s_idx, angles=angles, compass_error=compass if has_compass else None,
+                                prepare_s=timing.t1 - timing.t0, pairs_s=time.perf_counter() - timing.t1,
+                                n_pairs=timing.n_pairs, prepared_stats=timing.prepared_stats)
     if batch and same:
         matrix = _batch_matrix(method, snapshots, currents, s_idx, cur_prep, timing, workers, progress, on_row)
         if matrix is not None:

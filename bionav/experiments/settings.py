@@ -20,6 +20,7 @@ with zone.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass
 from typing import Any
@@ -40,17 +41,24 @@ LEGACY_KEYS: dict[str, str] = {
 
 @dataclass
 class RunSettings:
-    """Top-level keys of every run (``conf/config.yaml``): ``seed=``, ``workers=``."""
+    """Top-level keys of every run (``conf/config.yaml``): ``seed=``, ``workers=``, ``device=``."""
 
     seed: int = bounded(0, ge=0, le=2**32 - 1)
     workers: int = bounded(2, ge=1, le=1024)
+    device: str = bounded("cpu", choices=("cpu", "cuda"))
 
 
 def check_run_settings(cfg: DictConfig) -> RunSettings:
-    """The top-level ``seed`` and ``workers`` as :class:`RunSettings` (key, value and range named)."""
-    values = {f: cfg.get(f) for f in ("seed", "workers")} if isinstance(cfg, DictConfig) else {}
-    return typed_config({f: v for f, v in values.items() if v is not None}, RunSettings, key="",
-                        what="the run settings")
+    """The top-level ``seed``, ``workers`` and ``device`` as :class:`RunSettings` (key, value and range named);
+    ``device=cuda`` also needs numba-cuda and a GPU (:func:`bionav.gpu.check_device`)."""
+    values = {f: cfg.get(f) for f in ("seed", "workers", "device")} if isinstance(cfg, DictConfig) else {}
+    settings = typed_config({f: v for f, v in values.items() if v is not None}, RunSettings, key="",
+                            what="the run settings")
+    if settings.device != "cpu":
+        from bionav.gpu import check_device
+
+        check_device(settings.device)
+    return settings
 
 
 def config_from_recorded(cfg: DictConfig, *, source: str, recorded_by: str | None = None) -> DictConfig:
@@ -142,8 +150,6 @@ def experiment_config(cfg: DictConfig) -> Any:
     node = cfg.get("experiment") if isinstance(cfg, DictConfig) else None
     if node is None:
         return None
-    import dataclasses
-
     name = str(node.get("name") or "")
     schema = experiment_class(name).Config
     root = cfg if "seed" in cfg else OmegaConf.merge(OmegaConf.create({"seed": 0}), cfg)

@@ -48,7 +48,14 @@ def build_parser() -> argparse.ArgumentParser:
                       help="print the tasks, the CPU each needs, the critical path and the expected wall time")
     plan.add_argument("--nodes", type=int, default=1, help="machines of the plan (default 1)")
     plan.add_argument("--cores", type=int, default=None, help="cores per machine (default: this machine's)")
-    plan.add_argument("--json", action="store_true", help="with --plan: one JSON object")
+    plan.add_argument("--json", action="store_true", help="with --plan or --calibrate: one JSON object")
+    plan.add_argument("--cpu-factor", type=float, default=None, metavar="F",
+                      help="plan for a machine F times slower (F > 1) or faster (F < 1) than the reference machine "
+                           "the figures come from, instead of calibrating this one")
+    plan.add_argument("--calibration", default=None, metavar="FILE",
+                      help="plan for the machine whose calibration FILE holds (written there with --calibrate --json)")
+    plan.add_argument("--calibrate", action="store_true",
+                      help="time the calibration workloads on this machine (about 2 s of CPU), cache and print them")
     return p
 
 
@@ -112,9 +119,13 @@ def run(args) -> int:
 
         raise UserError(f"--jobs {args.jobs} is out of range; give 1 (one run after the other) up to the number "
                         f"of runs to execute at once, e.g. --jobs {usable_cpus()}.")
+    if args.calibrate:
+        return _calibrate(args)
     items = select_items(args.only)
     if args.plan:
         return _plan(args, items, preset)
+    if args.cpu_factor is not None or args.calibration is not None:
+        raise UserError("--cpu-factor and --calibration belong to --plan (e.g. --plan --cpu-factor 2).")
     if args.out is None:
         raise UserError("--out DIR is needed: the report directory (runs go to DIR/runs), e.g. --out thesis_report.")
     out = user_path(args.out).resolve()
@@ -138,6 +149,7 @@ def run(args) -> int:
 
 def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> int:
     from bionav.machine import usable_cpus
+    from bionav.thesis.diagnoses import load_diagnoses
     from bionav.thesis.items import Context
     from bionav.thesis.outcome import Outcome
     from bionav.thesis.reference import load_reference
@@ -173,6 +185,7 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         return 0
 
     sections = []
+    diagnoses = load_diagnoses()
     for it in items:
         ref = ref_all.get(it.id, {})
         ctx = Context(preset=preset, out=out, ref=ref, results=results, ref_id=it.id)
@@ -189,7 +202,8 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         if it.id.startswith("tableB"):
             claims += list(ref_all.get("appendix_b_claims", []))
         sections.append(Section(it.id, it.label, ref.get("title", it.label), ref.get("source", ""), it.rule,
-                                outcome, [results[s.key] for s in {s.key: s for s in specs[it.id]}.values()], claims))
+                                outcome, [results[s.key] for s in {s.key: s for s in specs[it.id]}.values()], claims,
+                                diagnoses.get(it.id)))
     wall = time.time() - started
     command = "python -m bionav.thesis " + " ".join(argv_for_display(args))
     cpu = sum(r.cpu_seconds or 0.0 for r in results.values())
@@ -214,11 +228,44 @@ def _plan(args, items, preset) -> int:
     from bionav.thesis.plan import format_plan, plan_for
 
     specs = [s for it in items for s in it.runs(preset)]
-    plan = plan_for(specs, nodes=args.nodes, cores=args.cores or usable_cpus())
+    plan = plan_for(specs, nodes=args.nodes, cores=args.cores or usable_cpus(), factors=_factors(args))
     if args.json:
         print(json.dumps({"preset": preset.name, **plan}))
     else:
         print(format_plan(plan, preset=preset.name))
+    return 0
+
+
+def _factors(args) -> dict:
+    """The plan's CPU factors: ``--cpu-factor``, ``--calibration FILE`` or this machine's (cached) calibration."""
+    from bionav.thesis.calibration import factors, load_calibration
+
+    if args.cpu_factor is not None and args.calibration is not None:
+        raise UserError("give --cpu-factor or --calibration, not both.")
+    if args.cpu_factor is not None:
+        if not 0.01 <= args.cpu_factor <= 100.0:
+            raise UserError(f"--cpu-factor {args.cpu_factor:g} is out of range; give how many times slower the "
+                            "planned machine is than the reference machine, 0.01..100, e.g. --cpu-factor 1.5.")
+        return factors(cpu_factor=args.cpu_factor)
+    if args.calibration is not None:
+        return factors(load_calibration(args.calibration))
+    return factors()
+
+
+def _calibrate(args) -> int:
+    """``--calibrate``: time the workloads anew, cache and print them (and the factors)."""
+    import json
+
+    from bionav.thesis.calibration import cache_path, factors, machine_calibration
+
+    cal = machine_calibration(refresh=True)
+    if args.json:
+        print(json.dumps(cal))
+        return 0
+    f = factors(cal)
+    print(f"calibration of {cal['machine']} (numba target {cal['cpu']}), CPU ms (cached in {cache_path()}):")
+    for fam in ("minwarping", "warping2d", "sift", "python"):
+        print(f"  {fam:10s} {cal[fam]:8.2f} ms   x{f[fam]:.2f} the reference machine's")
     return 0
 
 

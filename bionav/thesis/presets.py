@@ -17,6 +17,10 @@ CROSS_DB_FAMILY = ("sim_original", "sim_arboreal", "sim_chairs", "sim_day", "sim
 #: fig. 5.4: 0.03 ... 0.1 in steps of 0.01, then 0.2 ... 1.0 in steps of 0.1
 THESIS_CUTOFFS = tuple(round(0.03 + 0.01 * i, 2) for i in range(8)) + tuple(round(0.2 + 0.1 * i, 1) for i in range(9))
 DAY_SERIES = 14
+#: the one-day series' scan grid (thesis 6.4.1: pan in 1-degree steps over 200 degrees, tilt in 2-degree steps
+#: over 102 degrees, 40 minutes per scan); experiment=contrast_scan's defaults are the example data sets' grid
+ONE_DAY_SCAN = {"experiment.n_pan": 200, "experiment.pan_step_deg": 1.0, "experiment.n_tilt": 51,
+                "experiment.tilt_step_deg": 2.0, "experiment.scan_minutes": 40.0}
 
 
 @dataclass(frozen=True)
@@ -80,11 +84,11 @@ FULL = Preset(
     b_sizes=((1672, 206), (836, 103), (418, 52), (209, 52)),
     cross_db_family=CROSS_DB_FAMILY,
     cross_db_stride=1,
-    cross_db_size=None,
+    cross_db_size=(1122, 162),  # thesis 5.3: SIFT at 1122 x 162; warping2d_thesis resizes to its 346 x 50 itself
     cross_db_homing=("sift", "warping2d_thesis"),
     param_grid="full",
     lda_resamples=10000,
-    scan={},
+    scan=ONE_DAY_SCAN,
     scan_times=DAY_SERIES,
     example_scan={},
     skyline=(),
@@ -138,7 +142,8 @@ QUICK = Preset(
         "tables 5.5-5.7: the reduced parameter grid experiment.grid=ci (one image size, no preprocessing, "
         "two ring counts and two Fourier-coefficient counts; thesis: 5202 configurations per database)",
         "tables 6.3/6.5: 1000 bootstrap resamples (thesis: 10000)",
-        "figs. 6.10-6.15: scans of 38 x 9 points (6 and 9 degree steps) instead of 200 x 51; "
+        "figs. 6.10-6.15: scans of 38 x 9 points (6 and 9 degree steps, 20 minutes) instead of 200 x 51 "
+        "(1 and 2 degree steps, 40 minutes); "
         "figs. 6.16-6.25: 57 x 13 points instead of 113 x 26",
         "figs. 6.26/6.27: the skyline-homing grid with snapshot stride 4 (the square test itself is complete)",
         "figs. 7.3/7.4: 2 cleaning runs per layout (thesis: 10)",
@@ -204,6 +209,33 @@ STANDINS = dataclasses.replace(
     ),
 )
 
-PRESETS = {p.name: p for p in (QUICK, FULL, TINY, STANDINS)}
+#: the quick preset with the thesis' sizes and counts where the quick reduction could decide a verdict (issue 44,
+#: docs/thesis.md "Why"): appendix B's four image sizes, fig. 5.4's 17 cutoffs, the one-day scans' grid, 10,000
+#: bootstrap resamples,
+#: fig. 5.6's SIFT homing on all eight databases at the thesis' 1122 x 162 (its 2D-warping claims hold in quick)
+DIAGNOSE = dataclasses.replace(
+    QUICK,
+    name="diagnose",
+    summary="quick with the thesis' sizes where the reduction could decide a verdict (issue 44)",
+    b_sizes=FULL.b_sizes,
+    fig54_cutoffs=THESIS_CUTOFFS,
+    lda_resamples=FULL.lda_resamples,
+    scan=ONE_DAY_SCAN,
+    cross_db_family=CROSS_DB_FAMILY,
+    cross_db_size=(1122, 162),
+    cross_db_homing=("sift",),
+    cross_db_blocks={"sift": 4},
+    reductions=(
+        "grid homing: 6 snapshots per database (evenly spread over the images) instead of all (as quick); "
+        "appendix B at the thesis' four image sizes; fig. 5.4 at the thesis' 17 cutoffs (346 x 50 and 561 x 81)",
+        "fig. 5.6: SIFT homing only, on all eight databases at the thesis' 1122 x 162, 4 snapshots per database "
+        "(stride 9, as quick)",
+        "figs. 6.10-6.15: the thesis' one-day grid (200 x 51 points, 1 and 2 degree steps, 40 minutes per scan)",
+        "tables 6.3/6.5: 10000 bootstrap resamples, as the thesis",
+        "every other item as the quick preset",
+    ),
+)
+
+PRESETS = {p.name: p for p in (QUICK, FULL, TINY, STANDINS, DIAGNOSE)}
 #: presets offered by ``--help`` (tiny: the whole report in minutes, numbers that mean nothing; the tests use it)
-PUBLIC_PRESETS = ("quick", "full", "standins", "tiny")
+PUBLIC_PRESETS = ("quick", "full", "standins", "diagnose", "tiny")

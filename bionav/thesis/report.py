@@ -11,10 +11,12 @@ from pathlib import Path
 from typing import Sequence
 
 from bionav.files import write_csv_atomic
-from bionav.thesis.outcome import MISSING, VERDICT_RULE, Outcome, fmt
+from bionav.thesis.diagnoses import EVIDENCE_DOC, Diagnosis, evidence_link
+from bionav.thesis.outcome import FAILS, MISSING, PARTLY, VERDICT_RULE, Outcome, fmt
 from bionav.thesis.presets import Preset
 
-CSV_COLUMNS = ("item", "label", "quantity", "thesis", "bionav", "difference", "tolerance", "verdict", "level")
+CSV_COLUMNS = ("item", "label", "quantity", "thesis", "bionav", "difference", "tolerance", "verdict", "level", "why",
+               "evidence")
 
 
 @dataclass
@@ -29,6 +31,20 @@ class Section:
     outcome: Outcome
     runs: list  # RunResult
     claims: list[str]
+    #: why the item does not hold (bionav/thesis/diagnoses.yaml); shown for the verdicts partly and does not hold
+    diagnosis: Diagnosis | None = None
+
+    @property
+    def needs_why(self) -> bool:
+        return self.outcome.verdict in (PARTLY, FAILS)
+
+    def why(self) -> str:
+        """The reason for the verdict in words ("" when the item holds or was not produced)."""
+        if not self.needs_why:
+            return ""
+        if self.diagnosis is None:
+            return "not diagnosed (no entry in bionav/thesis/diagnoses.yaml)"
+        return self.diagnosis.line()
 
 
 def csv_rows(sections: Sequence[Section]) -> list[dict[str, str]]:
@@ -37,9 +53,10 @@ def csv_rows(sections: Sequence[Section]) -> list[dict[str, str]]:
     for s in sections:
         o = s.outcome
         passed, total = o.score
+        evidence = f"{EVIDENCE_DOC}#{s.diagnosis.evidence}" if s.needs_why and s.diagnosis else ""
         rows.append({"item": s.id, "label": s.label, "quantity": "(item verdict)", "thesis": "",
                      "bionav": f"{passed}/{total} checks pass", "difference": "", "tolerance": "",
-                     "verdict": o.verdict, "level": "item"})
+                     "verdict": o.verdict, "level": "item", "why": s.why(), "evidence": evidence})
         for c in o.checks:
             rows.append({"item": s.id, "label": s.label, "quantity": c.rule, "thesis": "claim", "bionav": c.detail,
                          "difference": "", "tolerance": "",
@@ -100,7 +117,7 @@ def section_markdown(s: Section, out: Path) -> str:
     verdict = (f"*Verdict:* **{o.verdict}** ({passed} of {total} checks pass).  " if o.produced else
                f"*Verdict:* **{o.verdict}** (none of this item's runs completed; nothing was compared).  ")
     md = [f"## {md_text(_heading(s))}", "", f"*Source:* {md_text(s.source)}.  ", verdict,
-          f"*Rule:* {md_text(s.rule)}.", ""]
+          *_why_lines(s, out), f"*Rule:* {md_text(s.rule)}.", ""]
     if s.claims:
         md += ["The thesis claims:", *[f"- {md_text(c)}" for c in s.claims], ""]
     if o.missing:
@@ -131,6 +148,24 @@ def section_markdown(s: Section, out: Path) -> str:
     return "\n".join(md)
 
 
+def _why_lines(s: Section, out: Path) -> list[str]:
+    """The section's "Why" line (verdicts partly and does not hold) with the link to its evidence."""
+    if not s.needs_why:
+        return []
+    d = s.diagnosis
+    if d is None:
+        return [f"*Why:* {md_text(s.why())}.  "]
+    return [f"*Why ({md_text(d.kind_words)}; diagnosed on the {d.preset} preset):* {md_text(d.why)} "
+            f"Evidence: {evidence_link(d, out)}.  "]
+
+
+def _why_cell(s: Section, out: Path) -> str:
+    """The summary table's reason: its kinds, linked to the evidence."""
+    if not s.needs_why:
+        return ""
+    return "not diagnosed" if s.diagnosis is None else evidence_link(s.diagnosis, out, md_text(s.diagnosis.kind_words))
+
+
 def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, wall_s: float, command: str,
                     cpu_s: float | None = None, machine: str = "") -> str:
     counts = verdict_counts(sections)
@@ -148,10 +183,10 @@ def report_markdown(sections: Sequence[Section], *, preset: Preset, out: Path, w
     ]
     if preset.reductions:
         head += ["Reductions of this preset against the thesis:", *[f"- {md_text(r)}" for r in preset.reductions], ""]
-    head += ["| item | verdict | checks |", "|---|---|---|"]
+    head += ["| item | verdict | checks | why |", "|---|---|---|---|"]
     head += [f"| [{s.label}](#{_anchor(s)}) | {s.outcome.verdict} | "
              + (f"{s.outcome.score[0]}/{s.outcome.score[1]} |" if s.outcome.produced else "no run completed |")
-             for s in sections]
+             + f" {_why_cell(s, out)} |" for s in sections]
     head.append("")
     return "\n".join(head + [section_markdown(s, out) for s in sections])
 

@@ -140,3 +140,52 @@ def test_bench_sweep_with_more_workers_than_cpus(tmp_path):
     assert row["workers"] == cpus + 2
     assert row["workers_used"] == [min(4, cpus)]  # 2 sizes x 2 preprocessings = 4 tasks
     assert row["configurations"] == 2 * 2 * 1  # [mean] at one ring count, per size and preprocessing
+
+
+def test_bench_scaling_prints_growth_and_fixed_cost_per_run(capsys, tmp_path):
+    """--method scaling (issue 42): CPU per home vector against the image size for every method (with the
+    growth exponent), and whole runs with 1 and N snapshots (slope and fixed part)."""
+    from helpers import write_tiny_folder
+
+    folder = write_tiny_folder(tmp_path / "tiny", shape=(16, 64), sigma=2.0)
+    assert main(["--json", "--method", "scaling", "--scaling-sizes", "32x8,64x16", "--steps", "8", "--repeat", "1",
+                 "--batch", "1", "--db", "folder", "--override", f"db.path={folder}", "--scaling-snapshots", "2"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    pairs = [r for r in rows if r["table"] == "pairs"]
+    assert {r["method"] for r in pairs} == {"minwarping", "warping2d", "warping1d", "hiss", "sift"}
+    for r in pairs:
+        assert r["cpu_ms_min"] > 0 and r["pixels"] in (32 * 8, 64 * 16)
+        assert ("growth_exponent" in r) == (r["image"] == "64x16")
+    runs = {r["method"]: r for r in rows if r["table"] == "runs"}
+    assert set(runs) == {"minwarping", "sift"}
+    for r in runs.values():
+        assert r["home_vectors"] == [8, 16] and r["cpu_s"][1] > 0  # 9 cells: 8 other cells per snapshot
+        slope = (r["cpu_s"][1] - r["cpu_s"][0]) / 8
+        assert r["cpu_ms_per_home_vector"] == pytest.approx(1e3 * slope, abs=2.0)  # cpu_s rounded to 10 ms
+        assert r["fixed_cpu_s"] == pytest.approx(r["cpu_s"][0] - 8 * slope, abs=0.05)
+
+
+def test_bench_scaling_rejects_bad_sizes(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--method", "scaling", "--scaling-sizes", "288x50,abc"])
+    assert exc.value.code == 2 and "--scaling-sizes" in capsys.readouterr().err
+
+
+def test_bench_stages_sets_every_stage_against_its_floor(capsys):
+    """--method stages (issue 42): byte-lane operations counted from the sizes, floor at the given clock."""
+    assert main(["--json", "--method", "stages", "--size", "48", "16", "--steps", "16", "--repeat", "1", "--batch", "1",
+                 "--clock-ghz", "2.0"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    by = {r["stage"]: r for r in rows}
+    assert {"home vector, single", "home vector, compass", "home vector, double_fine"} <= set(by)
+    per_ms = 64 * 2 * 2.0e6  # byte lanes per ms at 2 GHz, two 512-bit instructions per cycle
+    d = by["distances (sums + normalisation)"]
+    # K = 9 planes, R = 15 rows (16 - 1 for the edge filter), W = 48: 3 ops x 2 bytes per term, 6 x 4 per entry
+    k, w = 9, 48
+    r = (d["byte_lane_ops"] - k * w * w * 24) // (k * w * w * 6)
+    assert d["byte_lane_ops"] == k * r * w * w * 6 + k * w * w * 24 and 8 <= r <= 16
+    for row in rows:
+        assert row["cpu_ms"] > 0 and row["clock_ghz"] == 2.0
+        if row["byte_lane_ops"] is not None:
+            assert row["floor_ms"] == pytest.approx(row["byte_lane_ops"] / per_ms, abs=1e-4)
+        assert row["fraction_of_floor"] == pytest.approx(row["floor_ms"] / row["cpu_ms"], rel=0.01, abs=1e-3)

@@ -36,6 +36,10 @@ PACKED = {
     "diagonal_distances[u8]": ["vpsubw", "vpabsw", "vpaddw", "vcvtdq2ps"],
     "diagonal_distances[f32]": ["vsubps", "vaddps"],
     "sift_match_sorted": ["vfmadd231ps"],  # descriptor dot products
+    # explicit vectors (issue 42): the search's running minima and 16-bit sums stay in registers (byte minima,
+    # bytes widened and added to words); the distance sums of 32 columns x 4 diagonals over all rows
+    "minwarp_search_u8": ["vpminub", "vpmovzxbw", "vpaddw"],
+    "diagonal_distances_u8": ["vpsubw", "vpabsw", "vpaddw", "vcvtdq2ps"],
     "warping1d_scores": ["vfmadd231pd"],
 }
 #: int64 minima of the SIFT keys: compare and blend on AVX2, vpminsq (AVX-512 only) on AVX-512
@@ -132,3 +136,10 @@ def test_the_checks_catch_a_conditional_running_minimum():
     assert not _k_masked_stores(_instructions("vpscatterqq\t%ymm17, (,%ymm11) {%k1}\n"))
     assert not _packed(_instructions("vpminub\t%xmm1, %xmm2, %xmm3\n"), "vpminub", "avx2")  # 128-bit only
     assert _packed(_instructions("vpminub\t(%rax), %ymm2, %ymm3\n"), "vpminub", "avx2")
+
+
+def test_explicit_vectors_fill_the_widest_registers(asm):
+    """The distance sums are <32 x i16> vectors: one zmm per vector with AVX-512, two ymm with AVX2 (issue 42)."""
+    assert _packed(asm["avx512"]["diagonal_distances_u8"], "vpabsw", "avx512")
+    assert [s for s in asm["avx512"]["diagonal_distances_u8"] if s.startswith("vpabsw") and "%zmm" in s]
+    assert [s for s in asm["avx2"]["diagonal_distances_u8"] if s.startswith("vpabsw") and "%ymm" in s]

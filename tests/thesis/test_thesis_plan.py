@@ -9,20 +9,74 @@ from bionav.thesis import plan as plan_mod
 from bionav.thesis.runs import RunSpec
 
 
-def test_grid_task_cpu_is_home_vectors_times_the_unit_cost():
+def _fixed(images: int, homing: str, size=plan_mod.DEFAULT_SIZE) -> float:
+    """Hand-computed fixed part of a task: start-up, loading the database(s), per-image work."""
+    return (plan_mod.RUN_START_S + images * size[0] * size[1] / 1e6 * plan_mod.DB_LOAD_S_PER_MPX
+            + images * plan_mod.PREPARE_MS.get(homing, 0.0) / 1e3)
+
+
+def test_grid_task_cpu_is_start_up_plus_home_vectors_times_the_unit_cost():
     ms = plan_mod.HOME_VECTOR_MS["minwarping"][0]
+    start = _fixed(170, "minwarping")
     spec = RunSpec(("experiment=grid_homing", "db=sim_original", "homing=minwarping", "experiment.snapshots=[0,5,9]"))
     est = plan_mod.task_cpu_s(spec)
-    assert est.cpu_s == pytest.approx(3 * 170 * ms / 1e3)  # sim_original: a 10 x 17 grid
+    assert est.cpu_s == pytest.approx(start + 3 * 170 * ms / 1e3)  # sim_original: a 10 x 17 grid
     split = RunSpec(spec.overrides, blocks=3).tasks()
-    assert [plan_mod.task_cpu_s(t).cpu_s for t in split] == pytest.approx([170 * ms / 1e3] * 3)
+    assert [plan_mod.task_cpu_s(t).cpu_s for t in split] == pytest.approx([start + 170 * ms / 1e3] * 3)
+    # two tasks of three snapshots: every 2nd from the 0th (2 snapshots) and from the 1st (1), not 2 and 2
+    split = RunSpec(spec.overrides, blocks=2).tasks()
+    assert [plan_mod.task_cpu_s(t).cpu_s for t in split] == pytest.approx([start + 2 * 170 * ms / 1e3,
+                                                                          start + 1 * 170 * ms / 1e3])
+
+
+def test_blocks_hold_every_nth_item_as_the_experiments_split_them():
+    """Hand-computed: 170 snapshots in 64 tasks are 42 tasks of 3 and 22 of 2 (ceil(170/64) = 3 for all
+    charged 192); the shares always add up to the whole."""
+    from bionav.experiments.tasks import block_of
+
+    shares = [plan_mod.block_share(170, [i, 64]) for i in range(64)]
+    assert shares == [3] * 42 + [2] * 22 and sum(shares) == 170
+    for total, n in ((7, 3), (144, 16), (144, 5), (10, 10)):
+        got = [plan_mod.block_share(total, [i, n]) for i in range(n)]
+        assert got == [len(block_of([i, n], range(total), what="x")) for i in range(n)] and sum(got) == total
+    assert plan_mod.block_share(5, None) == 5
+
+
+def test_cross_db_tasks_by_unit_hold_every_nth_unit():
+    """6 databases (36 pairs) x 4 snapshots = 144 (snapshot, pair) units; 5 tasks hold 29, 29, 29, 29, 28."""
+    fam = "experiment.family=[sim_original,sim_arboreal,sim_chairs,sim_doorlit,sim_screen,sim_winlit]"
+    spec = RunSpec(("experiment=cross_db", "homing=warping2d", fam, "experiment.snapshot_stride=9"), blocks=5)
+    ms = plan_mod.HOME_VECTOR_MS["warping2d"][0]
+    cpu = [plan_mod.task_cpu_s(t).cpu_s - _fixed(6 * 170, "warping2d") for t in spec.tasks()]
+    assert cpu == pytest.approx([u * 170 * ms / 1e3 for u in (29, 29, 29, 29, 28)])
+
+
+def test_costs_scale_with_the_machine_factors():
+    spec = RunSpec(("experiment=grid_homing", "db=sim_original", "homing=warping2d", "experiment.snapshots=[0]"))
+    base = plan_mod.task_cpu_s(spec)
+    f = {"minwarping": 3.0, "warping2d": 2.0, "sift": 5.0, "python": 0.5, "source": "test"}
+    scaled = plan_mod.task_cpu_s(spec, f)
+    start = _fixed(170, "python")  # start-up and database: the python family; home vectors and per-image work: warping2d
+    assert scaled.cpu_s == pytest.approx(start * 0.5 + (base.cpu_s - start) * 2.0)
+    assert scaled.render_cpu_s == pytest.approx(base.render_cpu_s * 0.5)
+
+
+def test_sift_is_costed_by_keypoints_not_pixels():
+    """Half the width and height: a quarter of the pixels, but the keypoints (and their square) fall less."""
+    big = plan_mod.sift_costs((1122, 162))
+    small = plan_mod.sift_costs((561, 81))
+    kp_ratio = plan_mod.keypoints_per_image((561, 81)) / plan_mod.keypoints_per_image((1122, 162))
+    assert kp_ratio == pytest.approx(0.25 ** plan_mod.SIFT_KEYPOINTS_EXPONENT)
+    assert small[0] / big[0] == pytest.approx(kp_ratio ** 2)  # matching: keypoints of both images
+    assert small[1] / big[1] == pytest.approx(0.25 ** plan_mod.SIFT_IMAGE_EXPONENT)  # detection: pixels
+    assert plan_mod.keypoints_per_image((561, 81), histeq=True) > plan_mod.keypoints_per_image((561, 81))
 
 
 def test_schedule_longest_first_after_the_renders(monkeypatch):
     """Hand-computed: a 4 s render, then tasks of 10, 6, 6 and 4 s (one needs no render) on 2 slots."""
     costs = {"a": (10.0, ("db1",)), "b": (6.0, ("db1",)), "c": (6.0, ()), "d": (4.0, ())}
 
-    def fake(spec):
+    def fake(spec, factors=None):
         name = spec.overrides[0]
         cpu, render = costs[name]
         return plan_mod.TaskEstimate(name, "x", cpu, "test", render, 4.0 if render else 0.0)
@@ -80,5 +134,26 @@ def test_a_database_without_a_preset_grid_gets_an_assumed_one_not_an_error():
     for db in ("folder", "no_such_database"):
         est = plan_mod.task_cpu_s(RunSpec(("experiment=grid_homing", f"db={db}", "homing=mfdid",
                                            "db.image_size=[64,16]", "experiment.snapshots=[0,1]")))
-        assert est.cpu_s == pytest.approx(2 * nx * ny * ms / 1e3)
+        assert est.cpu_s == pytest.approx(_fixed(nx * ny, "mfdid", (64, 16)) + 2 * nx * ny * ms / 1e3)
         assert f"grid of {db} assumed {nx} x {ny}" in est.basis
+
+
+def test_plan_for_another_machine_through_the_command(tmp_path):
+    """--cpu-factor scales every figure; --calibrate --json writes the file --calibration reads (issue 42)."""
+    def plan(*extra):
+        proc = run_bionav("--preset", "tiny", "--only", "table5_3", "--plan", "--json", *extra, cwd=tmp_path,
+                          module="bionav.thesis")
+        assert proc.returncode == 0, proc.stderr
+        return json.loads(proc.stdout)
+
+    one, two = plan("--cpu-factor", "1"), plan("--cpu-factor", "2")
+    assert two["total_cpu_s"] == pytest.approx(2 * one["total_cpu_s"])
+    assert two["cpu_factors"]["source"] == "--cpu-factor 2"
+    cal = run_bionav("--calibrate", "--json", cwd=tmp_path, module="bionav.thesis")
+    assert cal.returncode == 0, cal.stderr
+    (tmp_path / "here.json").write_text(cal.stdout)
+    here = plan("--calibration", str(tmp_path / "here.json"))
+    assert "calibration of" in here["cpu_factors"]["source"] and here["total_cpu_s"] > 0
+    bad = run_bionav("--preset", "tiny", "--plan", "--calibration", str(tmp_path / "nope.json"), cwd=tmp_path,
+                     module="bionav.thesis")
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr and "--calibrate --json" in bad.stderr

@@ -84,7 +84,7 @@ def run(exp: CrossDbConfig, ctx) -> dict[str, Any]:
     for (i, j), snap_idx in snaps_of.items():
         hv = home_vector_matrix(
             method, dbs[i], dbs[j], snapshot_index=snap_idx, workers=int(cfg.workers),
-            prepared=(prepared[i], prepared[j]),
+            prepared=(prepared[i], prepared[j]), device=str(cfg.get("device") or "cpu"),
         )
         ae = angular_errors(hv.angles, ideal_home_angles(dbs[i].positions[snap_idx], dbs[j].positions))
         success, _ = evaluate_agents(

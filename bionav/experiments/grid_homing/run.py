@@ -146,7 +146,7 @@ def run(exp: GridHomingConfig, ctx) -> dict[str, Any]:
     log_row, log_partial = _row_loggers(ctx, db)
     hv = home_vector_matrix(
         method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
-        cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial,
+        cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial, device=str(cfg.get("device") or "cpu"),
     )
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))

@@ -25,6 +25,8 @@ import threading
 import numpy as np
 from numba import njit
 
+from bionav.homing.warping.normalise import _normalise_plane
+
 
 def column_distance_matrix(snapshot, current):
     """Reference column distances, plain numpy.
@@ -107,46 +109,13 @@ def _add_row_distances(af, a0, c0, width):
             af[ab + ui] += np.uint16(abs(np.int16(a0[ui] - c0[ud + ui])))
 
 
-@njit(nogil=True, fastmath=True, cache=True, inline="always")
-def _normalise_plane(acc, na, cn2, qf, t, out_k, step):
-    """One plane's diagonal sums ``acc`` (W, W) to 8-bit NSAD, de-interleaved into
-    ``out_k[d, i % step, i // step]``; ``t`` (W,) is scratch."""
-    width = na.shape[0]
-    n = width // step
-    for d in range(width):
-        nb = cn2[d:d + width]
-        ac = acc[d]
-        for i in range(width):
-            # the norms' sum in 32 bits (AVX2 has no packed 64-bit integer to float
-            # conversion, so an int64 sum kept this loop scalar there); a zero sum
-            # means two zero columns, whose distance sum is 0 as well: dividing it by 1
-            # gives the old 0.5 without a branch
-            den = np.float32(max(np.int32(na[i] + nb[i]), np.int32(1)))
-            t[i] = np.uint8(np.float32(ac[i]) * qf / den + np.float32(0.5))
-        o = out_k[d]
-        if step == 1:
-            o0 = o[0]
-            for m in range(n):
-                o0[m] = t[m]
-        elif step == 3:  # constant stride, one phase at a time: byte shuffles
-            for rr in range(3):
-                orr = o[rr]
-                for m in range(n):
-                    orr[m] = t[3 * m + rr]
-        else:
-            for rr in range(step):
-                orr = o[rr]
-                for m in range(n):
-                    orr[m] = t[m * step + rr]
-
-
 @njit(nogil=True, fastmath=True, cache=True)
 def _diagonal_distances_q(sq, cq2, sn, cn2, step, quantum, out):
     """8-bit NSAD in diagonal layout from 16-bit stacks.
 
     ``sq`` (K, R, W) and ``sn`` (K, W): quantised snapshot planes and column
-    norms; ``cq2`` (K, R, 2 W + 1) and ``cn2`` (K, 2 W + 1): the current view's,
-    twice side by side (and one more column), so that the columns ``i + d`` of
+    norms; ``cq2`` (K, R, >= 2 W + 1) and ``cn2`` (K, >= 2 W + 1): the current view's,
+    twice side by side (and more columns), so that the columns ``i + d`` of
     all snapshot columns ``i`` are one contiguous run. The sums of a plane are kept for all diagonals
     (``W x W`` 16-bit, in L2 cache) and built eight rows at a time, so that
     those rows stay in L1 cache while every diagonal visits them; the inner
@@ -313,11 +282,17 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
         # per-thread scratch arrays: fresh ones would be new pages (page faults) on every call
         sq = _scratch("sq", (n_planes, n_rows, width), np.int16)
         sn = _scratch("sn", (n_planes, width), np.int32)
-        cq2 = _scratch("cq2", (n_planes, n_rows, 2 * width + 1), np.int16)
-        cn2 = _scratch("cn2", (n_planes, 2 * width + 1), np.int32)
+        cq2 = _scratch("cq2", (n_planes, n_rows, 2 * width + 4), np.int16)
+        cn2 = _scratch("cn2", (n_planes, 2 * width + 4), np.int32)
         _quantise(snap, scale, sq, sn)
         _quantise(cur, scale, cq2, cn2)
-        _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
+        if width >= 32:  # the vector kernel (same result; its blocks are 32 columns wide)
+            from bionav.homing.warping.vkernels import diagonal_distances_u8
+
+            acc = _scratch("acc", (width + 4, width), np.uint16)
+            diagonal_distances_u8(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out, acc)
+        else:
+            _diagonal_distances_q(sq, cq2, sn, cn2, int(step), distance_quantum(width)[0], out)
         return out
     cur_norm = np.asarray(current["cur_norm"], dtype=np.float32)
     _diagonal_distances(

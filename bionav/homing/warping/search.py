@@ -39,6 +39,7 @@ from bionav.homing.warping.kernels import (
 )
 from bionav.homing.warping.scaleplanes import check_scales
 from bionav.homing.warping.templates import minwarp_template, minwarp_windows, warp2d_template
+from bionav.homing.warping.vkernels import TABLE_PAD, minwarp_search_u8, padded_lanes, search_scratch_size
 
 
 @dataclass(frozen=True)
@@ -124,15 +125,32 @@ def _buffer(name, shape, dtype):
     return arr
 
 
+def _table(name, shape, dtype):
+    """A per-thread window table of ``shape`` followed by :data:`~bionav.homing.warping.vkernels.TABLE_PAD`
+    bytes (which the vector search reads past the last row); the table is a view of it."""
+    size = int(np.prod(shape))
+    flat = _buffer(name, (size * np.dtype(dtype).itemsize + TABLE_PAD,), np.dtype(np.uint8))
+    return flat[:size * np.dtype(dtype).itemsize].view(dtype).reshape(shape)
+
+
+def _padded(levels):
+    """The padded 1-D buffer of a table from :func:`_table`, or None for any other array."""
+    b = levels.base
+    if (b is not None and b.ndim == 1 and b.dtype == np.uint8 and levels.dtype == np.uint8
+            and b.ctypes.data == levels.ctypes.data and b.size >= levels.size + TABLE_PAD):
+        return b
+    return None
+
+
 def _window_minima(snapshot, current, step, windows, quantised, name="levels"):
     """Column distances (level 0) and the sliding minima the windows read.
 
-    The result is a per-thread buffer ``name``.
+    The result is a per-thread buffer ``name`` (a view of a padded one, :func:`_table`).
     """
     n_levels = int(windows[2].max(initial=0)) + 1
     n_planes, _, width = np.shape(snapshot["snap"])
     dtype = np.dtype(np.uint8 if quantised else np.float32)
-    levels = _buffer(name, (n_levels, n_planes, width, step, width // step), dtype)
+    levels = _table(name, (n_levels, n_planes, width, step, width // step), dtype)
     diagonal_distances(snapshot, current, step=step, out=levels[0], quantised=quantised)
     if n_levels > 1:
         fill_window_minima(levels)
@@ -144,6 +162,14 @@ def _search(levels, n_a_eff, p_cols, windows, quantised):
     width = levels.shape[2]
     if quantised:
         q, acc_dtype = distance_quantum(width)
+        flat = _padded(levels)
+        if acc_dtype == np.uint16 and flat is not None:
+            # the vector search (same values) on the padded table of _table
+            acc = _buffer("acc", (p_cols.size, padded_lanes(n_a_eff)), np.dtype(np.uint16))
+            scratch = _buffer("scratch", (search_scratch_size(n_a_eff),), np.dtype(np.uint8))
+            _, n_planes, _, step, _ = levels.shape
+            minwarp_search_u8(flat, n_planes, width, step, n_a_eff, p_cols, *windows, acc, scratch)
+            return acc[:, :n_a_eff].astype(np.float64)
         out = np.zeros((p_cols.size, n_a_eff), acc_dtype)
         minwarp_scores(levels, n_a_eff, p_cols, *windows, np.uint8(255), out)
     else:
@@ -354,7 +380,7 @@ def minwarping(
     scores = _search(levels, n_a_eff, p_cols, windows, quantised)
     levels2 = None
     if double_search:
-        levels2 = _buffer("levels2", levels.shape, levels.dtype)
+        levels2 = _table("levels2", levels.shape, levels.dtype)
         if symmetric:
             swap_roles(levels[0], levels2[0])
             if levels2.shape[0] > 1:

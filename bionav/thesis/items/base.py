@@ -176,18 +176,31 @@ def spearman(a: Sequence[float], b: Sequence[float]) -> float | None:
     return None if not math.isfinite(rho) else float(rho)
 
 
+#: fewest values an ordering check compares: over two values Spearman's rho is +-1 by construction (a sign,
+#: not an ordering), so a two-point "ordering" would pass or fail on one comparison
+MIN_ORDERING_VALUES = 3
+
+
 def rho_check(what: str, thesis: Sequence, bionav: Sequence, *, threshold: float = 0.8) -> Check:
     """The thesis' ordering claim over all values; not evaluable (None) when a bionav value is missing.
 
     An ordering of five databases is not checked on the three whose runs
-    completed: a missing run makes the claim unevaluated, never failed.
+    completed: a missing run makes the claim unevaluated, never failed. Fewer
+    than :data:`MIN_ORDERING_VALUES` values are not evaluated either (rho is
+    +-1 by construction). The threshold 0.8 is bionav's choice (the thesis
+    states no tolerance for its orderings): over five values it allows two
+    swaps of neighbours, over four one, over three none.
     """
     rule = f"ordering of {what} equal to the thesis' (Spearman rho >= {threshold})"
     missing = sum(b is None for b in bionav)
     if missing:
         return Check(rule, None, f"not evaluable: {missing} of {len(bionav)} values missing (runs not completed)")
+    if len(bionav) < MIN_ORDERING_VALUES:
+        return Check(rule, None, f"not evaluable: {len(bionav)} values (rho over two values is +-1 by construction; "
+                                 f"an ordering needs at least {MIN_ORDERING_VALUES})")
     rho = spearman(thesis, bionav)
-    return Check(rule, None if rho is None else rho >= threshold,
+    # rho is a ratio of integers computed in floating point: one swap over four values gives 0.7999999999999999
+    return Check(rule, None if rho is None else rho >= threshold - 1e-9,
                  "not evaluable (fewer than two values or ties)" if rho is None else f"rho = {rho:.2f}")
 
 

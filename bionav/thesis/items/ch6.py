@@ -124,9 +124,19 @@ def _not_different(sig: dict[tuple[str, str], str], group: Sequence[str], crit: 
                  ", ".join(f"{k}: {v}" for k, v in marks.items()))
 
 
+#: claims of 6.2.4 that the thesis' own table 6.2 refutes: each would fail on any data reproducing the table
+#: (evidence: `python scripts/thesis_diagnoses.py table6_3`, docs/thesis.md "Table 6.3")
+_REFUTED_BY_TABLE_6_2 = {
+    SINGLES: "the thesis' own J of the single channels (table 6.2: UV 4.36, B 3.35, G 2.37, R 0.67, IR 0.11, from "
+             "239 + 233 samples) differ at 0.1 % under any bootstrap test: two-class data with exactly these J give "
+             "non-overlapping 99.9 % intervals for 7 of the 10 pairs",
+}
+
+
 @item("table6_3", "Table 6.3",
       "the table is not in the transcribed text: the claims of the discussion 6.2.4 are checked on bionav's "
-      "bootstrap (each a check): pairs named 'not significantly different' in J have no mark at 5 %",
+      "bootstrap (each a check): pairs named 'not significantly different' in J have no mark at 5 %; a claim that "
+      "the thesis' own table 6.2 refutes (the single channels) is shown, not evaluated",
       aliases=("6.3",))
 class _Table63:
     @staticmethod
@@ -143,7 +153,10 @@ class _Table63:
                                "the run wrote no significance_J.csv (experiment.n_resamples=0?)")
             return out
         for g in [("UV-IR", "B-IR"), ("UV-G", "B-R", "G-IR"), ("UV-B", "B-G", "G-R", "R-IR"), SINGLES]:
-            out.checks.append(_not_different(sig, g, "J"))
+            check = _not_different(sig, g, "J")
+            if g in _REFUTED_BY_TABLE_6_2:  # reproducing table 6.2 would fail it: not a measure of agreement
+                check = Check(check.rule, None, f"not evaluated: {_REFUTED_BY_TABLE_6_2[g]} (bionav: {check.detail})")
+            out.checks.append(check)
         if (res.dir / "significance.md").is_file():
             shutil.copyfile(res.dir / "significance.md", ctx.out / "table6_3.md")
             out.tables.append("table6_3.md")
@@ -155,11 +168,22 @@ _DISCUSSION_6_3_4 = {"J": [("UV-IR", "UV-B")], "J_sigma": [("UV-G", "UV-B")],
                      "n_f": [("UV-B", "UV-G", "UV-R", "UV-IR"), ("B-G", "B-R", "B-IR")]}
 
 
+#: marks of table 6.5 that the thesis' own table 6.4 refutes (124 objects + 233 sky readings): "not significant"
+#: where the estimates are far apart; reproducing table 6.4 would fail them
+_REFUTED_BY_TABLE_6_4 = {
+    ("J_sigma", "IR"): "table 6.4 gives IR a J_sigma of 0.30 against All's 5.31: two-class data with these criteria "
+                       "and the thesis' 124 + 233 samples have 99.9 % bootstrap intervals 0.08-0.66 and 3.9-7.6",
+    ("n_f", "IR"): "table 6.4 gives IR 312 misclassified per mille against All's 47: 265 per mille apart, about "
+                   "ten binomial standard errors of 357 samples",
+}
+
+
 @item("table6_5", "Table 6.5",
       "per criterion and feature: bionav's significance mark of the difference to 'All' equals the thesis' "
       "(***, **, *, o); one check each; and the claims of the discussion 6.3.4 (UV-IR and UV-B do not differ in J, "
       "UV-IR differs from every other contrast in J, UV-G and UV-B do not differ in J_sigma, the UV contrasts and "
-      "the B contrasts do not differ among themselves in n_f)", aliases=("6.5",))
+      "the B contrasts do not differ among themselves in n_f); the two marks that the thesis' own table 6.4 refutes "
+      "(IR vs All not significant in J_sigma and n_f) are shown, not evaluated", aliases=("6.5",))
 class _Table65:
     @staticmethod
     def runs(p: Preset) -> list[RunSpec]:
@@ -177,8 +201,10 @@ class _Table65:
                 continue
             for f, mark in ref[crit].items():
                 got = sig.get(("all", f))
-                out.checks.append(Check(f"{crit}: {f} vs All marked {mark}", None if got is None else got == mark,
-                                        f"bionav: {got}"))
+                refuted = _REFUTED_BY_TABLE_6_4.get((crit, f))
+                out.checks.append(Check(f"{crit}: {f} vs All marked {mark}",
+                                        None if got is None or refuted else got == mark,
+                                        f"not evaluated: {refuted} (bionav: {got})" if refuted else f"bionav: {got}"))
                 out.rows.append(Row(f"{crit}: {f} vs All", mark, got))
             for group in _DISCUSSION_6_3_4.get(crit, ()):
                 out.checks.append(_not_different(sig, group, crit))
@@ -314,38 +340,7 @@ def _stability_item(fig: str):
             ax.set_title(f"{measure}{' after skyline separation' if separated else ''} (thesis {fig_name})", fontsize=9)
             save_figure(fig_, ctx.figure(f"{fig}.png"), dpi=100)
             out.figures.append(f"{fig}.png")
-            ok = {k: v for k, v in means.items() if v is not None}
-            uv = [ok.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
-            if fig == "fig6_10":
-                s = [ok[f] for f in SINGLES if f in ok]
-                d = [ok[f] for f in DUALS if f in ok]
-                out.checks.append(Check("every single channel above every dual contrast (time means)",
-                                        bool(s and d and min(s) > max(d)) if s and d else None,
-                                        f"min single {min(s):.2f}, max dual {max(d):.2f}" if s and d else ""))
-            elif fig in ("fig6_11", "fig6_12"):
-                for first in ("UV", "B", "G"):
-                    fam = [f for f in DUALS if f.startswith(first + "-")]
-                    vals = [ok.get(f) for f in fam]
-                    rho = spearman(list(range(len(fam))), vals) if len(fam) > 2 else (
-                        None if None in vals or len(fam) < 2 else (1.0 if vals[1] > vals[0] else -1.0))
-                    out.checks.append(Check(f"{first} contrasts ordered by wavelength difference (|rho| = 1)",
-                                            None if rho is None else abs(rho) > 0.999,
-                                            ", ".join(f"{f} {fmt(v, 2)}" for f, v in zip(fam, vals))))
-            elif fig == "fig6_13":
-                spread = [float(np.ptp(_series(stab, f, True, measure))) for f in DUALS
-                          if len(_series(stab, f, True, measure)) > 1]
-                out.checks.append(Check("dual contrasts nearly constant over time after separation "
-                                        "(max - min over the day <= 0.5 for every contrast)",
-                                        bool(max(spread) <= 0.5) if spread else None,
-                                        f"largest range {max(spread):.2f}" if spread else "no finite values"))
-            else:
-                raw = _stability_means(stab, measure, False)
-                uv_raw = [raw.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
-                r1 = spearman([0, 1, 2, 3], uv_raw)
-                r2 = spearman([0, 1, 2, 3], uv)
-                out.checks.append(Check("order of UV-B, UV-G, UV-R, UV-IR reversed by the separation",
-                                        None if r1 is None or r2 is None else bool(abs(r1) > 0.999 and r2 == -r1),
-                                        f"rho before {fmt(r1, 2)}, after {fmt(r2, 2)}"))
+            out.checks += _stability_checks(fig, stab, means, measure)
             return out
 
     return _S
@@ -360,12 +355,75 @@ def _stability_means(stab, measure: str, separated: bool) -> dict[str, float]:
     return out
 
 
+def _stability_checks(fig: str, stab, means: dict, measure: str) -> list[Check]:
+    """The claims of 6.4.4 on the day means (``means``: feature -> mean of ``measure``), one figure's checks."""
+    ok = {k: v for k, v in means.items() if v is not None}
+    uv = [ok.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
+    if fig == "fig6_10":
+        s = [ok[f] for f in SINGLES if f in ok]
+        d = [ok[f] for f in DUALS if f in ok]
+        return [Check("every single channel above every dual contrast (time means)",
+                      bool(min(s) > max(d)) if s and d else None,
+                      f"min single {min(s):.2f}, max dual {max(d):.2f}" if s and d else "")]
+    if fig in ("fig6_11", "fig6_12"):
+        return wavelength_order_checks(ok)
+    if fig == "fig6_13":
+        spread = [float(np.ptp(_series(stab, f, True, measure))) for f in DUALS
+                  if len(_series(stab, f, True, measure)) > 1]
+        return [Check("dual contrasts nearly constant over time after separation "
+                      "(max - min over the day <= 0.5 for every contrast)",
+                      bool(max(spread) <= 0.5) if spread else None,
+                      f"largest range {max(spread):.2f}" if spread else "no finite values")]
+    raw = _stability_means(stab, measure, False)
+    uv_raw = [raw.get(f) for f in ("UV-B", "UV-G", "UV-R", "UV-IR")]
+    r1 = spearman([0, 1, 2, 3], uv_raw)
+    r2 = spearman([0, 1, 2, 3], uv)
+    return [Check("order of UV-B, UV-G, UV-R, UV-IR reversed by the separation",
+                  None if r1 is None or r2 is None else bool(abs(r1) > 0.999 and abs(r1 + r2) < 1e-9),
+                  f"rho before {fmt(r1, 2)}, after {fmt(r2, 2)}")]
+
+
+def wavelength_order_checks(means: dict) -> list[Check]:
+    """6.4.4: "contrasts with the same first channel are ordered by the difference of the wavelength".
+
+    One check per first channel (UV: 4 contrasts, B: 3, G: 2), each against
+    the wavelength gap (the channels' order UV, B, G, R, IR). The claim is one
+    order for every first channel, so the UV family (four contrasts) sets the
+    direction: UV passes when monotone (|rho| = 1), B and G when monotone in
+    UV's direction. Two contrasts (G-R, G-IR) are always monotone one way or
+    the other, so without a direction their check could not fail.
+    """
+    checks, direction = [], None
+    for first in ("UV", "B", "G"):
+        fam = [f for f in DUALS if f.startswith(first + "-")]
+        vals = [means.get(f) for f in fam]
+        detail = ", ".join(f"{f} {fmt(v, 2)}" for f, v in zip(fam, vals))
+        if any(v is None for v in vals):
+            checks.append(Check(f"{first} contrasts ordered by wavelength difference", None, detail))
+            continue
+        steps = np.sign(np.diff(vals))
+        sign = int(steps[0]) if len(set(steps)) == 1 and steps[0] != 0 else 0  # +1 rising, -1 falling, 0 neither
+        if first == "UV":
+            rho = spearman(list(range(len(fam))), vals)
+            direction = None if rho is None or rho == 0 else (1 if rho > 0 else -1)
+            checks.append(Check("UV contrasts ordered by wavelength difference (|rho| = 1); their direction sets "
+                                "the other channels'", sign != 0, detail + f" (rho {fmt(rho, 2)})"))
+            continue
+        word = {1: "rising", -1: "falling", None: "undefined"}[direction]
+        checks.append(Check(f"{first} contrasts ordered by wavelength difference in the UV contrasts' direction "
+                            f"({word})", None if direction is None else sign == direction, detail))
+    return checks
+
+
 _STAB_RULES = {
     "fig6_10": "logNRMSD averaged over the day: every single channel above every dual-channel contrast",
     "fig6_11": "logMSEstd averaged over the day: the contrasts with first channel UV, B, G each ordered by their "
-               "wavelength difference (|Spearman rho| = 1), one check per first channel",
+               "wavelength difference, one check per first channel: UV's four monotone (|Spearman rho| = 1), B's "
+               "three and G's two monotone in UV's direction (a pair is monotone one way or the other)",
     "fig6_12": "as fig. 6.11 for logMSEvar",
-    "fig6_13": "logNRMSD after separation: every dual contrast nearly constant (max - min over the day <= 0.5)",
+    "fig6_13": "logNRMSD after separation: every dual contrast nearly constant (max - min over the day <= 0.5, "
+               "bionav's reading: on sky/object images logNRMSD is half the log of the fraction of pixels changing "
+               "class, so that fraction varies by less than a factor 10)",
     "fig6_14": "logMSEstd: the order of UV-B, UV-G, UV-R, UV-IR (day means) is monotone before separation and "
                "reversed after it",
     "fig6_15": "as fig. 6.14 for logMSEvar",
