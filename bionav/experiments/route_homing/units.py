@@ -213,11 +213,16 @@ def run_unit(unit: Unit) -> dict[str, Any]:
     max_steps = int(math.ceil(exp.max_steps_factor * length / exp.agent_step_m))
     wall0, cpu0 = time.perf_counter(), time.process_time()
     follower, shared = follower_of(unit, setup, heading)
+    learned_at = training_indices(len(setup.xy), exp.training_stride)
+
+    def put_back(index: int) -> None:  # the follower counts its own (training) views
+        follower.reset(int(np.argmin(np.abs(learned_at - int(index)))))
+
     res = follow_route(follower, route_xy=setup.xy, route_heading=heading, nest_xy=setup.dense_xy[-1],
                        step_m=exp.agent_step_m, putback_m=exp.putback_m, goal_m=exp.putback_m, max_steps=max_steps,
                        jitter_m=exp.position_jitter_m, heading_noise=math.radians(exp.heading_noise_deg),
                        start_offset_m=float(exp.start_offset_m or 0.0),
-                       rng=stream(unit.seed, unit.route, unit.agent, "jitter"), on_putback=follower.reset)
+                       rng=stream(unit.seed, unit.route, unit.agent, "jitter"), on_putback=put_back)
     cpu = time.process_time() - cpu0 - shared
     row = {"route": unit.route, "agent": unit.agent, "seed": int(unit.seed), "axis": unit.axis,
            "level": unit.level, "position_jitter_m": exp.position_jitter_m,
