@@ -192,6 +192,39 @@ def test_training_indices_keep_every_kth_view_and_the_nest():
 
 
 # --------------------------------------------------------------------------- the run: figure, tables, sweep
+def test_the_figures_draw_what_their_csv_files_hold(tmp_path):
+    """errors_per_route.png draws one dot per row of errors_per_route.csv per agent (written and read back as the
+    run does); each robustness_<axis>.png line goes through robustness.csv's medians and nest arrivals (in %)."""
+    import csv
+
+    from bionav.experiments.route_homing.plots import plot_errors_per_route, plot_robustness
+    from bionav.experiments.route_homing.robustness import ROBUSTNESS_KEYS
+    from bionav.experiments.route_homing.shared import write_rows
+
+    agents = ["perfect_memory", "random_choice"]
+    rows = [{"route": f"Ant{k}_Route1", "seed": 0, "perfect_memory": k % 3, "random_choice": 20 + 2 * k}
+            for k in range(1, 8)]
+    write_rows(tmp_path / "errors_per_route.csv", rows, ["route", "seed", *agents])
+    table = list(csv.DictReader((tmp_path / "errors_per_route.csv").open()))
+    drawn = plot_errors_per_route(tmp_path / "e.png", table, agents, title="t")
+    assert drawn["perfect_memory"].tolist() == [1, 2, 0, 1, 2, 0, 1]
+    assert drawn["random_choice"].tolist() == [22, 24, 26, 28, 30, 32, 34]
+    assert (tmp_path / "e.png").stat().st_size > 5_000
+    summary = [{"axis": "heading_noise_deg", "level": lv, "agent": a, "runs": 7, "errors_median": m,
+                "errors_q25": m - 1.0, "errors_q75": m + 1.0, "errors_mean": m, "error_free_routes": 0.0,
+                "reached_nest": nest, "cpu_s_per_route": 1.0}
+               for a, base in (("perfect_memory", 0.0), ("random_choice", 20.0))
+               for lv, m, nest in ((20.0, base + 3.0, 0.5), (0.0, base, 1.0), (10.0, base + 1.0, 6 / 7))]
+    write_rows(tmp_path / "robustness.csv", summary, ROBUSTNESS_KEYS)
+    back = list(csv.DictReader((tmp_path / "robustness.csv").open()))
+    lines = plot_robustness(tmp_path / "r.png", back, axis="heading_noise_deg", unit="deg", agents=agents)
+    for a, base in (("perfect_memory", 0.0), ("random_choice", 20.0)):
+        x, med, nest = lines[a]
+        np.testing.assert_allclose(x, [0.0, 10.0, 20.0])  # sorted by level
+        np.testing.assert_allclose(med, [base, base + 1.0, base + 3.0])
+        np.testing.assert_allclose(nest, [100.0, 100 * 6 / 7, 50.0], atol=1e-4)  # the CSV's 6 decimals
+
+
 @pytest.mark.slow
 def test_ardin2016_run_writes_the_figure_the_per_route_table_and_a_sweep(tmp_path):
     """One route, three agents, two seeds, a jitter axis and a training-stride axis on two workers. The
@@ -232,6 +265,14 @@ def test_ardin2016_run_writes_the_figure_the_per_route_table_and_a_sweep(tmp_pat
     assert (run / "plots" / "robustness_position_jitter_m.png").is_file()
     assert (run / "plots" / "robustness_training_stride.png").is_file()
     summary = list(csv.DictReader((run / "robustness.csv").open()))
+    from bionav.experiments.route_homing.plots import plot_robustness
+
+    lines = plot_robustness(tmp_path / "r.png", [s for s in summary if s["axis"] == "training_stride"],
+                            axis="training_stride", unit="", agents=["perfect_memory", "random_choice", "mfdid"])
+    for agent, (x, med, _nest) in lines.items():
+        mine = sorted((s for s in summary if s["axis"] == "training_stride" and s["agent"] == agent),
+                      key=lambda s: float(s["level"]))
+        assert x.tolist() == [1.0, 4.0] and med.tolist() == [float(s["errors_median"]) for s in mine]
     for s in summary:
         if s["axis"] == "training_stride" and float(s["level"]) == 4:
             mine = [int(r["errors"]) for r in rows if r["axis"] == "training_stride" and r["agent"] == s["agent"]]
@@ -246,10 +287,72 @@ def test_ardin2016_run_writes_the_figure_the_per_route_table_and_a_sweep(tmp_pat
     printed = dict(line.strip("| ").split(" | ") for line in sweep.stdout.splitlines()
                    if line.startswith("| errors_per_route") or line.startswith("| error_free_routes"))
     assert len(printed) == 3 * 5
-    for key, text in printed.items():  # whole counts print as integers ("1", not "1.0000")
-        if float(m[key]).is_integer():
-            assert isinstance(m[key], int) and text == str(int(m[key])), (key, text)
+    for key, text in printed.items():  # whole counts print as integers ("1", not "1.0000"); means stay floats
+        if "_mean_" in key:
+            assert isinstance(m[key], float) and float(text) == pytest.approx(m[key], abs=1e-4), (key, text)
+        elif float(m[key]).is_integer():
+            assert isinstance(m[key], int) and text == str(m[key]), (key, text)
     assert m["sweep"] == {"position_jitter_m": [0.0, 0.02], "training_stride": [1, 4]}
     same = list(csv.DictReader((tmp_path / "plain" / "route_following.csv").open()))
     keys = ("route", "agent", "seed", "errors", "reached_nest", "steps")
     assert [tuple(r[k] for k in keys) for r in same] == [tuple(r[k] for k in keys) for r in rows if not r["axis"]]
+
+
+# --------------------------------------------------------------------------- the mushroom body's KC thresholds
+def test_kenyon_thresholds_are_each_kcs_mean_and_std_with_a_floor_for_constant_kcs():
+    """Drives of 3 KCs over 4 training views: KC 0 is 0, 2, 4, 6 (mean 3, std sqrt(5)); KC 1 is constant (std 0:
+    gets floor x the median of the positive stds); KC 2 is 1, 1, 1, 5 (mean 2, std sqrt(3))."""
+    from bionav.homing.familiarity import kenyon_thresholds
+
+    d = np.array([[0.0, 7.0, 1.0], [2.0, 7.0, 1.0], [4.0, 7.0, 1.0], [6.0, 7.0, 5.0]])
+    centre, scale = kenyon_thresholds(d, floor=0.1)
+    np.testing.assert_allclose(centre, [3.0, 7.0, 2.0])
+    median_sd = (math.sqrt(5.0) + math.sqrt(3.0)) / 2
+    np.testing.assert_allclose(scale, [math.sqrt(5.0), 0.1 * median_sd, math.sqrt(3.0)])
+
+
+def test_per_kc_thresholds_rank_each_kc_against_its_own_training_drive_as_a_plain_loop():
+    """The ``n_active`` KCs with the largest ``(drive - mean) / std`` fire, exactly ``n_active`` per view (the
+    stated sparsity: 200 of 20,000 = 1 % in the agent), ties going to the lower KC index; written out KC by KC."""
+    from bionav.homing.familiarity import kenyon_activity, kenyon_connections, kenyon_matrix, kenyon_thresholds
+
+    rng = np.random.default_rng(4)
+    conn = kenyon_connections(16, 40, 3, rng=rng)
+    train, test = rng.random((6, 16)), rng.random((5, 16))
+    drive_train = np.array([[v[c].sum() for c in conn] for v in train])
+    mean = drive_train.mean(0)
+    sd = np.sqrt(((drive_train - mean) ** 2).mean(0))
+    thr = kenyon_thresholds(drive_train)
+    act = kenyon_activity(test, kenyon_matrix(conn, 16), n_active=6, thresholds=thr)
+    assert act.shape == (5, 40) and np.all(act.sum(1) == 6)
+    for a, v in zip(act, test):
+        z = [(v[c].sum() - m) / s for c, m, s in zip(conn, mean, sd)]
+        assert set(np.flatnonzero(a)) == set(np.argsort(z)[::-1][:6])
+    tied = kenyon_activity(np.zeros((1, 16)), conn, n_active=3)  # every drive 0: KCs 0, 1, 2 fire
+    np.testing.assert_array_equal(np.flatnonzero(tied[0]), [0, 1, 2])
+
+
+def test_per_kc_thresholds_stop_kcs_on_bright_pixels_from_firing_on_every_view():
+    """PN 0 is 100 times brighter than the rest on every view. Ranked by raw drive (``kc_threshold=shared``) only
+    KCs that sample PN 0 (about 4/20 of the 400) ever fire; ranked against their own training drive (``per_kc``)
+    a KC fires when its own inputs are unusually bright, so the firing KCs are drawn from all KCs alike: the
+    share of PN-0 KCs among them is near their share of all KCs, and far below 1."""
+    from bionav.config import plugin_config
+    from bionav.homing.familiarity import kenyon_activity
+
+    rng = np.random.default_rng(1)
+    views = rng.random((40, 4, 5)) * 0.1
+    views[:, 0, 0] = 10.0  # pixel 0: bright on every view
+    share = {}
+    for mode in ("shared", "per_kc"):
+        cls, config = plugin_config("route_agent", {"name": "mushroom_body", "n_kc": 400, "inputs_per_kc": 4,
+                                                    "n_active": 20, "kc_threshold": mode})
+        agent = cls(config, rng=np.random.default_rng(2))
+        agent.train(views[:30])
+        bright = np.asarray(agent.connections[0].todense()).ravel() > 0  # KCs sampling PN 0
+        act = kenyon_activity(views[30:].reshape(10, -1), agent.connections, n_active=20, thresholds=agent.thresholds)
+        assert np.all(act.sum(1) == 20)
+        share[mode] = act[:, bright].sum() / act.sum()
+        share["all"] = bright.mean()
+    assert share["shared"] == 1.0
+    assert 0.1 < share["all"] < 0.3 and share["per_kc"] < 2 * share["all"], share

@@ -79,7 +79,7 @@ def frozen(node: Any) -> str:
     return json.dumps(node, sort_keys=True)
 
 
-def stream(seed: int, *parts: str) -> np.random.Generator:
+def unit_stream(seed: int, *parts: str) -> np.random.Generator:
     """The random stream of ``seed`` and named parts (route, agent, purpose), independent of the order of work."""
     return np.random.default_rng(np.random.SeedSequence([int(seed), *(zlib.crc32(p.encode()) for p in parts)]))
 
@@ -131,7 +131,7 @@ def training_views(unit: Unit, name: str) -> tuple[np.ndarray, float]:
     cpu0 = time.process_time()
     setup = route_of(unit.db, unit.cache_dir, name)
     heading = route_headings(setup, exp)
-    one = scan_views_of(setup, exp, stream(unit.seed, name, "training"), half_deg=0.0)
+    one = scan_views_of(setup, exp, unit_stream(unit.seed, name, "training"), half_deg=0.0)
     idx = training_indices(len(setup.xy), exp.training_stride)
     views = np.concatenate([one(setup.xy[i], float(heading[i]))[0] for i in idx])
     if len(_VIEWS) >= _CACHE_ITEMS:
@@ -163,10 +163,10 @@ def _homing_follower(unit: Unit, setup, heading: np.ndarray):
     cfg = OmegaConf.create({"homing": json.loads(homing_node), "signature": json.loads(signature_node)})
     method = make_homing(cfg, _Plugins(), setup.geometry)
     idx = training_indices(len(setup.xy), exp.training_stride)
-    shoot = route_renderer(setup, stream(unit.seed, setup.name, "snapshots"))
+    shoot = route_renderer(setup, unit_stream(unit.seed, setup.name, "snapshots"))
     snapshots = np.stack([shoot(setup.xy[i], float(heading[i])) for i in idx])
     return HomingFollower(method, snapshots=snapshots, snapshot_headings=heading[idx],
-                          render=route_renderer(setup, stream(unit.seed, setup.name, unit.agent)),
+                          render=route_renderer(setup, unit_stream(unit.seed, setup.name, unit.agent)),
                           window=exp.follower_window, lookahead=exp.lookahead, test_step_m=exp.test_step_m,
                           max_turn=math.radians(exp.scan_half_deg), passed=exp.passed, route_weight=exp.route_weight)
 
@@ -182,7 +182,7 @@ def follower_of(unit: Unit, setup, heading: np.ndarray) -> tuple[Any, float]:
         return _homing_follower(unit, setup, heading), 0.0
     cls, config = plugin_config("route_agent", {"name": unit.agent, **dict(exp.agent_params.get(unit.agent) or {})},
                                 key=f"experiment.agent_params.{unit.agent}")
-    agent = cls(config, rng=stream(unit.seed, setup.name, unit.agent))
+    agent = cls(config, rng=unit_stream(unit.seed, setup.name, unit.agent))
     shared = 0.0
     if getattr(agent, "needs_views", True):
         parts = []
@@ -194,7 +194,7 @@ def follower_of(unit: Unit, setup, heading: np.ndarray) -> tuple[Any, float]:
     else:
         agent.train(np.zeros((0, 0), np.float32))
     offsets = scan_offsets(scan_half_deg=exp.scan_half_deg, scan_step_deg=exp.scan_step_deg)
-    views = scan_views_of(setup, exp, stream(unit.seed, setup.name, unit.agent))
+    views = scan_views_of(setup, exp, unit_stream(unit.seed, setup.name, unit.agent))
     return FamiliarityFollower(agent, views, offsets=offsets), shared
 
 
@@ -222,7 +222,7 @@ def run_unit(unit: Unit) -> dict[str, Any]:
                        step_m=exp.agent_step_m, putback_m=exp.putback_m, goal_m=exp.putback_m, max_steps=max_steps,
                        jitter_m=exp.position_jitter_m, heading_noise=math.radians(exp.heading_noise_deg),
                        start_offset_m=float(exp.start_offset_m or 0.0),
-                       rng=stream(unit.seed, unit.route, unit.agent, "jitter"), on_putback=put_back)
+                       rng=unit_stream(unit.seed, unit.route, unit.agent, "jitter"), on_putback=put_back)
     cpu = time.process_time() - cpu0 - shared
     row = {"route": unit.route, "agent": unit.agent, "seed": int(unit.seed), "axis": unit.axis,
            "level": unit.level, "position_jitter_m": exp.position_jitter_m,
