@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import logging
 import os
-import signal
 import sys
 import tempfile
 from pathlib import Path
@@ -67,6 +66,10 @@ def _precheck(argv: list[str]) -> list[tuple[Path, bool]]:
             groups.setdefault(group, [])
     for override in overrides:
         key = override.key_or_group
+        if key.startswith("hydra/") and isinstance(override.value(), str):
+            from bionav.clihelp import check_hydra_option
+
+            check_hydra_option(key, override.value())
         if key in groups and not override.is_delete():
             values = override.value()
             candidates = values if isinstance(values, list) else [values]
@@ -135,7 +138,7 @@ def _concrete_overrides(argv: list[str]) -> list[str] | None:
     return out
 
 
-def _check_composition(argv: list[str], *, validate: bool = True) -> None:
+def _check_composition(argv: list[str], *, validate: bool = True):
     """Compose the configuration once before Hydra runs; turn its errors into one paragraph.
 
     With ``validate``, also check every value against its declared range
@@ -147,15 +150,22 @@ def _check_composition(argv: list[str], *, validate: bool = True) -> None:
 
     overrides = _concrete_overrides(argv)
     if overrides is None:
-        return
+        return None
     try:
-        cfg = compose(overrides)
+        cfg = compose(overrides, return_hydra_config=True)
     except Exception as exc:
         raise UserError(composition_message(exc, overrides)) from None
+    from omegaconf import OmegaConf, open_dict
+
+    params = OmegaConf.select(cfg, "hydra.sweeper.params", default=None)
+    _STATE["sweeper_params"] = OmegaConf.to_container(params) if params is not None else None
+    with open_dict(cfg):
+        del cfg["hydra"]
     if validate:
         from bionav.experiments.runner import validate_run_config
 
         validate_run_config(cfg)
+    return cfg
 
 
 def _yaml_options(group: str) -> list[str]:
@@ -296,36 +306,12 @@ def _resuming(argv: list[str]) -> bool:
                for w in words if "=" in w)
 
 
-def _check_not_finished(path: Path, *, sweep: bool, resume: bool) -> None:
-    """Refuse to write a run or sweep into a directory that holds a finished one (unless resuming)."""
-    from bionav.experiments.runner import read_metrics
-
-    if resume or "${" in str(path) or not path.is_dir():
-        return
-    if sweep:
-        finished = (path / "summary.csv").is_file() or any(
-            (read_metrics(job) or {}).get("status") == "completed" for job in path.glob("*") if job.is_dir())
-        if finished:
-            raise UserError(
-                f"the sweep directory {path} holds a sweep with finished jobs; a new sweep there would overwrite "
-                f"them. Choose another directory with hydra.sweep.dir=..., or finish that sweep with the same "
-                f"command plus bionav.resume=true (finished jobs are kept)."
-            )
-        return
-    metrics = read_metrics(path)
-    if isinstance(metrics, dict) and metrics.get("status") == "completed":
-        raise UserError(
-            f"the run directory {path} holds a finished run (metrics.json says completed); a new run there would "
-            f"overwrite it. Choose another directory with hydra.run.dir=..., or add bionav.resume=true to keep it "
-            f"and show its results."
-        )
-
-
 def _task(cfg) -> float | None:
     """One job; returns the run's objective (config ``objective``) for sweepers, worst on failure."""
     from hydra.core.hydra_config import HydraConfig
     from hydra.types import RunMode
 
+    from bionav.clirecord import keep_record
     from bionav.experiments.objective import objective_from_config
     from bionav.experiments.runner import run_experiment
 
@@ -337,12 +323,13 @@ def _task(cfg) -> float | None:
     objective = None
     try:
         objective = objective_from_config(cfg.get("objective"))
+        keep_record(cfg, run_dir, multirun=multirun)
         metrics = run_experiment(cfg, run_dir, show_progress=sys.stderr.isatty() or not multirun)
     except UserError as exc:
         if multirun:
             log.error("job %s failed: %s", hc.job.num, exc)
             return objective.worst if objective else None
-        _fail(f"{exc} (run directory: {run_dir})")
+        _fail_refused(exc, run_dir, hc)
     except KeyboardInterrupt:
         if multirun:
             raise  # main() writes the summary of the finished jobs
@@ -373,6 +360,16 @@ def _task(cfg) -> float | None:
     return objective.value(metrics) if objective else None
 
 
+def _fail_refused(exc: UserError, run_dir: Path, hc) -> None:
+    """A single run's user error; a run refused at start leaves no directory behind."""
+    from bionav.clirecord import forget_refused
+
+    if getattr(exc, "refused_at_start", False) and forget_refused(
+            run_dir, existed=bool(_STATE.get("run_dir_existed")), job_log=f"{hc.job.name}.log"):
+        _fail(f"{exc} (nothing was recorded; no run directory was left behind)")
+    _fail(f"{exc} (run directory: {run_dir})")
+
+
 def _print_result(metrics: dict) -> None:
     from bionav.report.table import format_metrics
 
@@ -381,6 +378,8 @@ def _print_result(metrics: dict) -> None:
 
 #: the sweep directory of the multirun in progress (set by the first job; read after an interrupt)
 _SWEEP: dict[str, Path] = {}
+#: what the checks before Hydra found: "show" (a finished run to show), "run_dir_existed", "sweeper_params"
+_STATE: dict = {}
 
 
 def _interrupted_sweep() -> None:
@@ -409,11 +408,6 @@ def _sweep_failures() -> None:
     _fail(f"{n_failed} of {n_jobs} jobs failed: {', '.join(LAST_SWEEP['failed'])} (their errors are in "
           f"{LAST_SWEEP['summary']}); the other jobs' results are kept. Fix and re-run them with bionav.resume=true, "
           f"or pass bionav.fail_on_job_error=false to exit with status 0 anyway.", 1)
-
-
-def _terminate(signum, frame) -> None:  # noqa: ARG001
-    """SIGTERM (``kill``, a cluster's time limit) ends a run like Ctrl-C: results so far are kept."""
-    raise KeyboardInterrupt
 
 
 def _completion_query(hydra_main) -> None:
@@ -486,37 +480,37 @@ def _check_before_running(argv: list[str]) -> bool | None:
         a in ("--help", "-h", "--hydra-help", "--info", "--cfg", "-c") or a.startswith("--info") for a in argv
     ):
         output_dirs = _precheck(argv)
+    cfg = None
     if not completion and not any(a in ("--help", "-h", "--hydra-help", "-cp", "-cn", "-cd", "--config-path",
                                         "--config-name", "--config-dir") or a.startswith("--info") for a in argv):
-        _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
+        cfg = _check_composition(argv, validate=not any(a in ("--cfg", "-c") for a in argv))
     # only after every value passed: a refused run leaves no directory behind
     if any(a in ("-m", "--multirun") for a in argv):
         _check_sweep_overrides(argv)
-    resume = _resuming(argv)
-    for path, sweep in output_dirs:
-        _check_name_lengths(path, "hydra.sweep.dir" if sweep else "hydra.run.dir")
-        _check_writable(path, sweep=sweep)  # a live writer first: "in use" says more than "finished"
-        _check_not_finished(path, sweep=sweep, resume=resume)
+    _check_records(argv, output_dirs, cfg)
     return completion
 
 
-def _end_on_termination_signals() -> None:
-    """SIGTERM (kill, a cluster's time limit) and SIGHUP (the terminal closed) end a run as Ctrl-C does.
+def _check_records(argv: list[str], output_dirs: list[tuple[Path, bool]], cfg) -> None:
+    """Output directories: writable, not in use, and any run recorded there kept (:mod:`bionav.clirecord`)."""
+    from bionav.clirecord import check_run_dir, check_sweep_dir
 
-    A signal the caller chose to ignore stays ignored (``nohup python -m bionav ...`` survives the hangup).
-    """
-    for name in ("SIGTERM", "SIGHUP"):
-        try:
-            sig = getattr(signal, name)
-            if signal.getsignal(sig) != signal.SIG_IGN:
-                signal.signal(sig, _terminate)
-        except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
-            pass
+    resume = _resuming(argv)
+    for path, sweep in output_dirs:
+        _check_name_lengths(path, "hydra.sweep.dir" if sweep else "hydra.run.dir")
+        existed = path.is_dir()
+        _check_writable(path, sweep=sweep)  # a live writer first: "in use" says more than "finished"
+        if sweep:
+            check_sweep_dir(path, _override_words(argv), _STATE.get("sweeper_params"), resume=resume)
+            continue
+        _STATE["run_dir_existed"] = existed
+        if check_run_dir(path, cfg, resume=resume):
+            _STATE["show"] = path
 
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point of ``python -m bionav`` and the ``bionav`` console script."""
-    from bionav.cli_main import guard_closed_pipe
+    from bionav.cli_main import end_on_termination_signals, guard_closed_pipe
 
     guard_closed_pipe()  # `python -m bionav --help | head -1` ends quietly
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -539,11 +533,18 @@ def main(argv: list[str] | None = None) -> None:
         _fail(f"{shows[0]} shows one composed config, so it cannot be combined with -m (a sweep): drop -m and "
               f"give one value per key, e.g. homing=sift instead of homing=sift,mfdid.")
 
+    if _STATE.get("show") is not None:
+        from bionav.clirecord import show_finished
+
+        return show_finished(_STATE["show"])
+    if not shows and not completion and not any(a.split("=", 1)[0] == "hydra.output_subdir" for a in argv):
+        argv.append("hydra.output_subdir=null")  # bionav writes the record itself, and never over a resumed run's
+
     import hydra
 
     hydra_main = hydra.main(version_base="1.3", config_path=None, config_name="config")(_task)
     sys.argv = [sys.argv[0] or "bionav", *argv]
-    _end_on_termination_signals()
+    end_on_termination_signals()
     try:
         if completion and any(a.startswith("query=") for a in argv):
             _completion_query(hydra_main)

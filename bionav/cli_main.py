@@ -62,14 +62,43 @@ class _ClosedPipeGuard:
 def guard_closed_pipe() -> None:
     """Make output into a closed pipe end the process quietly (the one home of this handling).
 
+    Text that cannot be encoded (a file name holding a byte that is not UTF-8, which Python
+    carries as a lone surrogate) is written with backslash escapes instead of raising.
+
     Called by :func:`run_main` and :func:`bionav.cli.main`: ``python -m bionav --help | head -1``,
     ``python -m bionav.plugins | head -1`` and ``python -m bionav.logs info ... | head -1`` exit
     with status :data:`EXIT_CLOSED_PIPE` and no ``BrokenPipeError`` traceback.
     """
     import sys
 
+    for stream in (sys.stdout, sys.stderr):  # a path with a byte that is not UTF-8 is printed, escaped, never a crash
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):  # not a text stream of the interpreter's own
+            pass
     if not isinstance(sys.stdout, _ClosedPipeGuard) and sys.stdout is not None:
         sys.stdout = _ClosedPipeGuard(sys.stdout)
+
+
+def _terminate(signum, frame) -> None:  # noqa: ARG001
+    raise KeyboardInterrupt
+
+
+def end_on_termination_signals() -> None:
+    """SIGTERM (``kill``, a cluster's time limit) and SIGHUP (the terminal closed) end a command as Ctrl-C does.
+
+    The one home of this handling: every ``python -m bionav...`` command keeps what it wrote and says so.
+    A signal the caller chose to ignore stays ignored (``nohup python -m bionav ...`` survives the hangup).
+    """
+    import signal
+
+    for name in ("SIGTERM", "SIGHUP"):
+        try:
+            sig = getattr(signal, name)
+            if signal.getsignal(sig) != signal.SIG_IGN:
+                signal.signal(sig, _terminate)
+        except (ValueError, AttributeError):  # not the main thread; no SIGHUP on this platform
+            pass
 
 
 def run_main(main: Callable[[], "int | None"], prog: str, *,
@@ -80,11 +109,13 @@ def run_main(main: Callable[[], "int | None"], prog: str, *,
       ``--help | head -1``;
     * a :class:`UserError` that escapes ``main`` becomes ``<prog>: error: <message>``
       on stderr and exit status 2;
-    * Ctrl-C becomes ``<prog>: <interrupted>`` and exit status 130, never a traceback.
+    * Ctrl-C, SIGTERM and SIGHUP (:func:`end_on_termination_signals`) become ``<prog>: <interrupted>``
+      and exit status 130, never a traceback.
     """
     import sys
 
     guard_closed_pipe()
+    end_on_termination_signals()
     try:
         try:
             code = main()

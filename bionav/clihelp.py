@@ -112,3 +112,34 @@ def composition_message(exc: BaseException, overrides: list[str]) -> str:
         return (f"{first}. Pick one of the available options (`python -m bionav --help` lists them, "
                 "`python -m bionav.plugins` the installed plugins).")
     return f"the configuration cannot be composed: {first}. Check the overrides on the command line."
+
+
+#: Hydra plugins bionav documents, and the line that installs each (``hydra/<group>=<option>``)
+HYDRA_PLUGIN_INSTALL = {
+    "hydra/sweeper": {"optuna": 'pip install "bionav[tune]"', "nevergrad": "pip install hydra-nevergrad-sweeper",
+                      "ax": "pip install hydra-ax-sweeper"},
+    "hydra/launcher": {"joblib": 'pip install "bionav[parallel]"', "submitit_local": 'pip install "bionav[slurm]"',
+                       "submitit_slurm": 'pip install "bionav[slurm]"', "ray": "pip install hydra-ray-launcher",
+                       "rq": "pip install hydra-rq-launcher"},
+}
+
+
+def check_hydra_option(group: str, value: str) -> None:
+    """Refuse ``hydra/<group>=<value>`` when no such Hydra plugin is installed, naming the line that installs it.
+
+    Raises
+    ------
+    UserError
+        With the installed options and, for a plugin bionav knows, its ``pip install`` line.
+    """
+    from bionav.config import hydra_group_options
+    from bionav.errors import UserError
+
+    available = hydra_group_options(group)
+    if value in available or not available:
+        return
+    install = HYDRA_PLUGIN_INSTALL.get(group, {}).get(value)
+    fix = (f"Install it with `{install}`, or pick an installed one" if install
+           else "Pick an installed one, or install the Hydra plugin that provides it")
+    raise UserError(f"{group}={value} is not installed (installed: {', '.join(available)}). {fix} "
+                    f"(`python -m bionav --hydra-help` lists Hydra's groups).")

@@ -33,8 +33,8 @@ from typing import IO, TYPE_CHECKING, Any, Callable, Iterable, Sequence
 if TYPE_CHECKING:  # numpy is imported where an array is hashed: start-up paths (TAB completion) stay without it
     import numpy as np
 
-__all__ = ["cache_key", "check_cache_dir", "default_cache_dir", "not_a_regular_file", "read_json_file", "user_path",
-           "write_atomic", "write_csv_atomic", "write_json_atomic"]
+__all__ = ["OwnedFolder", "cache_key", "check_cache_dir", "default_cache_dir", "not_a_regular_file", "read_json_file",
+           "user_path", "write_atomic", "write_csv_atomic", "write_json_atomic"]
 
 
 def default_cache_dir() -> Path:
@@ -49,6 +49,74 @@ def default_cache_dir() -> Path:
     if env is None:
         return Path.home() / ".cache" / "bionav"
     return check_cache_dir(env)
+
+
+#: the folders of bionav's compiled (numba) kernels: numba caches them in their ``__pycache__`` by default
+_KERNEL_DIRS = ("evaluation", "homing", "homing/warping", "robot", "world")
+
+
+def _writable_dir(path: str | os.PathLike) -> bool:
+    """True if ``path`` is (or can be made) a folder where files can be created, as numba checks it."""
+    import tempfile
+
+    try:
+        os.makedirs(path, exist_ok=True)
+        tempfile.TemporaryFile(dir=path).close()
+        return True
+    except (OSError, ValueError):
+        return False
+
+
+def ensure_numba_cache() -> str | None:
+    """Give numba a place to cache bionav's kernels where it would find none; the folder set, or ``None``.
+
+    numba caches compiled kernels in ``NUMBA_CACHE_DIR``, else beside the
+    sources (``__pycache__``), else in ``~/.cache/numba``; where none of these
+    can be written (a read-only install and a home folder that is not
+    writable) it stops at the first import with a ``RuntimeError``. Then
+    ``NUMBA_CACHE_DIR`` is set to ``<bionav cache>/numba`` (:func:`default_cache_dir`)
+    or, if that cannot be written either, to a folder in the system's temporary
+    folder. Called once when :mod:`bionav` is imported (before numba reads its
+    settings); a usable setting of the user's is kept.
+    """
+    import tempfile
+
+    own = os.environ.get("NUMBA_CACHE_DIR")
+    if own and _writable_dir(own):
+        return None
+    package = Path(__file__).resolve().parent
+    if all(_writable_dir(package / d / "__pycache__") for d in _KERNEL_DIRS):
+        return None
+    try:
+        user_wide = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "numba"
+    except RuntimeError:  # no home folder at all
+        user_wide = None
+    if user_wide is not None and _writable_dir(user_wide):
+        return None
+    candidates = [Path(tempfile.gettempdir()) / f"bionav-numba-{os.getuid() if hasattr(os, 'getuid') else 0}"]
+    try:
+        candidates.insert(0, default_cache_dir() / "numba")
+    except Exception:  # BIONAV_CACHE unusable (reported where the cache is used) or no home folder
+        pass
+    for folder in candidates:
+        if _writable_dir(folder):
+            os.environ["NUMBA_CACHE_DIR"] = str(folder)
+            numba_config = sys.modules.get("numba.core.config")
+            if numba_config is not None:  # numba imported before bionav: tell it directly
+                numba_config.CACHE_DIR = str(folder)
+            return str(folder)
+    return None
+
+
+def numba_cached(kernel: Any) -> bool:
+    """True when numba has compiled code of ``kernel`` (a dispatcher) in this process or in its on-disk cache.
+
+    A cheap look (no compiling): before a long loop, whether its first call will compile first.
+    """
+    if getattr(kernel, "signatures", None):
+        return True
+    index = getattr(getattr(getattr(kernel, "_cache", None), "_cache_file", None), "_index_path", None)
+    return bool(index) and os.path.exists(index)
 
 
 def check_cache_dir(value: str | os.PathLike) -> Path:
@@ -179,6 +247,9 @@ def read_json_file(path: str | Path, *, what: str, fix: str, max_bytes: int = 25
         return json.loads(text, parse_int=_bounded_int)
     except ValueError as exc:
         raise UserError(f"{what} {path} is not valid JSON ({exc}). {fix}") from None
+    except RecursionError:  # "[[[[...": deeper than any data file bionav reads
+        raise UserError(f"{what} {path} nests lists or objects thousands of levels deep; no data file of bionav "
+                        f"does. {fix}") from None
 
 
 def cache_key(payload: Any, *arrays: np.ndarray) -> str:
@@ -291,3 +362,80 @@ def write_csv_atomic(path: str | Path, header: Sequence[Any], rows: Iterable[Seq
     writer.writerow(header)
     writer.writerows(rows)
     return write_atomic(path, text.getvalue())
+
+
+#: the record of what bionav wrote into an output folder it shares with the user's own files
+OWNED_MANIFEST = ".bionav-files.json"
+
+
+class OwnedFolder:
+    """An output folder (``--out``) that bionav shares with the user: it overwrites only what it wrote.
+
+    bionav records the SHA-256 of every file it writes there in
+    :data:`OWNED_MANIFEST`; a file of the same name that is not in that record,
+    or whose content changed since (the user edited it), is the user's and is
+    never overwritten (:meth:`check` refuses, naming it and the fix).
+
+    Parameters
+    ----------
+    folder : path-like
+        The output folder (created by the caller).
+    option : str
+        How the user names it, for messages (``"--out"``).
+    """
+
+    def __init__(self, folder: str | Path, *, option: str = "--out") -> None:
+        self.folder, self.option = Path(folder), option
+        try:
+            data = json.loads((self.folder / OWNED_MANIFEST).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            data = {}
+        self.written: dict[str, str] = {str(k): str(v) for k, v in data.items()} if isinstance(data, dict) else {}
+
+    @staticmethod
+    def _digest(path: Path) -> str | None:
+        try:
+            with open(path, "rb") as f:
+                return hashlib.file_digest(f, "sha256").hexdigest()
+        except OSError:
+            return None
+
+    def foreign(self, names: Iterable[str]) -> list[str]:
+        """The ``names`` that exist in the folder and were not written there by bionav (as they are now)."""
+        out = []
+        for name in names:
+            path = self.folder / name
+            if path.is_symlink() or path.exists():
+                if not path.is_file() or path.is_symlink() or self.written.get(name) != self._digest(path):
+                    out.append(name)
+        return sorted(set(out))
+
+    def check(self, names: Iterable[str]) -> None:
+        """Raise :class:`~bionav.errors.UserError` if any of ``names`` is a file bionav did not write."""
+        from bionav.errors import UserError
+
+        mine = self.foreign(names)
+        if mine:
+            shown = ", ".join(mine[:5]) + (f" and {len(mine) - 5} more" if len(mine) > 5 else "")
+            raise UserError(
+                f"{self.option} {self.folder} holds {shown}, which bionav did not write (or which was changed since), "
+                f"and this command would write files of the same name there. Nothing was overwritten: move "
+                f"{'them' if len(mine) > 1 else 'it'} elsewhere, or give another {self.option}.")
+
+    def claim(self, name: str) -> None:
+        """Record ``name`` (written by bionav just now) as bionav's; call :meth:`save` after the last one."""
+        digest = self._digest(self.folder / name)
+        if digest is not None:
+            self.written[name] = digest
+
+    def write(self, name: str, data: str | bytes) -> Path:
+        """Write ``name`` atomically (after :meth:`check`) and record it as bionav's."""
+        self.check([name])
+        path = write_atomic(self.folder / name, data)
+        self.claim(name)
+        self.save()
+        return path
+
+    def save(self) -> None:
+        """Write the record of bionav's files (atomically)."""
+        write_json_atomic(self.folder / OWNED_MANIFEST, dict(sorted(self.written.items())))

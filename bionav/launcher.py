@@ -53,7 +53,7 @@ class BionavSlurmQueueConf(SlurmQueueConf):
 def queued_job_ids() -> set[str] | None:
     """Ids of the jobs in the SLURM queue (array tasks as ``<array>_<task>``); None if squeue fails."""
     try:
-        proc = subprocess.run(["squeue", "-h", "-r", "-o", "%i"], capture_output=True, text=True, timeout=60)
+        proc = subprocess.run(["squeue", "-h", "-r", "-o", "%i"], capture_output=True, text=True, errors="replace", timeout=60)
     except (OSError, subprocess.TimeoutExpired):
         return None
     if proc.returncode != 0:
@@ -70,7 +70,8 @@ def slurm_state(job: Any) -> str:
     if state != "UNKNOWN":
         return state
     try:  # without accounting slurmctld still knows finished jobs for MinJobAge seconds
-        proc = subprocess.run(["scontrol", "show", "job", "-o", str(job.job_id)], capture_output=True, text=True, timeout=60)
+        proc = subprocess.run(["scontrol", "show", "job", "-o", str(job.job_id)], capture_output=True, text=True,
+                              errors="replace", timeout=60)
     except (OSError, subprocess.TimeoutExpired):
         return state
     for field in proc.stdout.split():

@@ -3,7 +3,9 @@
 A second run into a directory whose lock is held by a live process is refused
 (:class:`bionav.errors.UserError`); a lock left behind by a crashed run
 (SIGKILL, power cut) is recognised as stale -- its process is gone, or its
-pid now belongs to another process -- and taken over.
+pid now belongs to another process -- and taken over. The run it guarded is
+then marked ``"interrupted"`` in its metrics.json (it said ``"running"`` for
+good otherwise; :func:`settle_stale`, :func:`settle_stale_runs`).
 """
 
 from __future__ import annotations
@@ -17,6 +19,9 @@ from pathlib import Path
 from bionav.errors import UserError
 
 LOCK_FILE = ".bionav.lock"
+METRICS_FILE = "metrics.json"
+#: the status of a run whose process died without finishing its record
+INTERRUPTED = "interrupted"
 
 
 def _process_start(pid: int) -> str | None:
@@ -87,10 +92,61 @@ def _refusal(run_dir: Path, info: dict, *, what: str = "run directory", fix: str
 
 
 def check_free(run_dir: str | Path) -> None:
-    """Raise :class:`UserError` if a live run holds ``run_dir`` (checked before Hydra writes there)."""
+    """Raise :class:`UserError` if a live run holds ``run_dir`` (checked before Hydra writes there).
+
+    A dead run's lock is settled on the way (:func:`settle_stale`).
+    """
     info = lock_owner(run_dir)
     if info is not None and not (info.get("host") == socket.gethostname() and info.get("pid") == os.getpid()):
         raise _refusal(Path(run_dir), info)
+    if info is None:
+        settle_stale(run_dir)
+
+
+def settle_stale(run_dir: str | Path) -> bool:
+    """Mark the run in ``run_dir`` interrupted if its process died while it said ``"running"``; True if marked.
+
+    A run holds its lock from before its metrics.json says ``"running"`` until
+    after the final status is written, so ``"running"`` with no live lock means
+    the process was killed (SIGKILL, out of memory, a power cut). The metrics
+    keep every value recorded, with ``"status": "interrupted"`` and an ``error``
+    saying so; the stale lock is removed. A lock of a live process, or of
+    another host, is left alone (False).
+    """
+    from bionav.files import write_json_atomic
+
+    run_dir = Path(run_dir)
+    if lock_owner(run_dir) is not None:
+        return False
+    info = _read(run_dir / LOCK_FILE) or {}
+    metrics = _read(run_dir / METRICS_FILE)
+    marked = False
+    if isinstance(metrics, dict) and metrics.get("status") == "running":
+        pid = info.get("pid", metrics.get("pid", "?"))
+        metrics.update(status=INTERRUPTED, error=(
+            f"the run's process (pid {pid}) ended without finishing its record (killed, e.g. SIGKILL, out of "
+            f"memory or a power cut); what it logged is kept in run.mcap (`python -m bionav.logs recover` repairs "
+            f"a cut log)"))
+        try:
+            write_json_atomic(run_dir / METRICS_FILE, metrics)
+            marked = True
+        except OSError:  # a read-only copy of a run: reported as it is
+            return False
+    if info:
+        try:
+            (run_dir / LOCK_FILE).unlink()
+        except OSError:
+            pass
+    return marked
+
+
+def settle_stale_runs(root: str | Path) -> int:
+    """:func:`settle_stale` for every run below ``root`` that says ``"running"``; the number marked."""
+    root = Path(root)
+    if not root.is_dir():
+        return 0
+    dirs = {p.parent for p in root.rglob(METRICS_FILE)} | {p.parent for p in root.rglob(LOCK_FILE)}
+    return sum(settle_stale(d) for d in sorted(dirs) if d != root or (d / METRICS_FILE).exists())
 
 
 class RunLock:
@@ -127,7 +183,8 @@ class RunLock:
                     owner = lock_owner(self.path.parent)
                     if owner is not None:
                         raise _refusal(self.path.parent, owner, **self._words) from None
-                    try:  # stale: the owner crashed
+                    settle_stale(self.path.parent)  # stale: the owner crashed; its run is marked interrupted
+                    try:
                         self.path.unlink()
                     except FileNotFoundError:
                         pass

@@ -28,7 +28,7 @@ hook, e.g. ``min < max``). Every error is one :class:`~bionav.errors.UserError`
 naming the key as the user types it, the bad value and what is allowed.
 Plugin configs (:func:`bionav.config.plugin_config`), the ``db`` node
 (:func:`bionav.db.loading.as_database_config`), the experiment node
-(:func:`bionav.experiments.configs.experiment_config`) and the other typed
+(:func:`bionav.experiments.settings.experiment_config`) and the other typed
 groups all go through it; the command line runs all of them before a run
 directory is created, and nothing downstream re-checks or re-casts a value.
 A class that also accepts instances from Python code (``HomingMethod(config,

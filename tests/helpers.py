@@ -13,6 +13,15 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 
 
+#: seconds a refused command may take: Python, Hydra and the config composition only (a loaded 2-core machine)
+REFUSAL_S = 120
+
+
+def run_tiny(tiny: Path, *args: str, cwd: Path, env: dict | None = None):
+    """``python -m bionav homing=mfdid db=folder db.path=<tiny> args``: a grid-homing run of seconds."""
+    return run_bionav("homing=mfdid", "db=folder", f"db.path={tiny}", *args, cwd=cwd, env=env)
+
+
 def run_bionav(*args: str, cwd: Path, env: dict | None = None, module: str = "bionav", timeout: float = 600):
     """Run ``python -m <module> args`` and return the CompletedProcess (text mode), with ``.seconds`` (wall time)."""
     full_env = dict(os.environ)

@@ -209,13 +209,18 @@ def _check_args(parser, args) -> None:
 
 def _run_for_cpu(parser, args, argv: list[str]) -> int:
     """Re-run this command in a fresh process whose numba compiles for ``--cpu-name`` (exit status forwarded)."""
-    from bionav.bench.cpu import KNOWN_TARGETS, host_cpu, missing_host_features, target_environment
+    from bionav.bench.cpu import KNOWN_TARGETS, host_cpu, missing_host_features, target_environment, unrecognized
 
     try:
         env_vars = target_environment(args.cpu_name, args.cpu_features)
     except ValueError as exc:
         parser.error(f"--cpu-name {args.cpu_name}: {exc}; or give its features with --cpu-features "
                      f"(known names: {', '.join(KNOWN_TARGETS)})")
+    unknown = unrecognized(args.cpu_name, env_vars["NUMBA_CPU_FEATURES"])
+    if unknown:
+        parser.error(f"--cpu-name {args.cpu_name}: LLVM does not know {', '.join(unknown)} for this machine's "
+                     f"target ({host_cpu()[0]}), so numba would compile for a generic CPU or abort; give a CPU name "
+                     f"LLVM knows (e.g. {', '.join(KNOWN_TARGETS)}) and features such as +sse2,+avx2")
     missing = missing_host_features(env_vars["NUMBA_CPU_FEATURES"])
     if missing:
         parser.error(f"--cpu-name {args.cpu_name}: this machine's CPU ({host_cpu()[0]}) lacks "

@@ -88,6 +88,34 @@ def missing_host_features(features: str) -> list[str]:
     return sorted(f for f in enabled_features(features) if not host.get(f, False))
 
 
+def unrecognized(name: str, features: str) -> list[str]:
+    """The CPU name and features LLVM does not know for this machine's target (sorted; empty if all known).
+
+    LLVM only warns about them on stderr ("'x' is not a recognized processor for this target")
+    and then compiles for a generic CPU, which can abort the process later ("LLVM ERROR: 64-bit
+    code requested on a subtarget that doesn't support it"); so the name and the features are
+    tried here on a target machine, with LLVM's stderr captured, before numba sees them.
+    """
+    import os
+    import re
+    import tempfile
+
+    import llvmlite.binding as ll
+
+    ll.initialize_native_target()
+    with tempfile.TemporaryFile() as err:
+        saved = os.dup(2)
+        try:
+            os.dup2(err.fileno(), 2)
+            ll.Target.from_default_triple().create_target_machine(cpu=name, features=features)
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        err.seek(0)
+        text = err.read().decode("utf-8", "replace")
+    return sorted(set(re.findall(r"'([^']*)' is not a recognized (?:processor|feature)", text)))
+
+
 def target_environment(name: str, features: str | None = None, *, cache_root: Path | None = None) -> dict:
     """Environment variables that make numba compile for CPU ``name``.
 

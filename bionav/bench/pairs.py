@@ -102,7 +102,7 @@ def _reference_round(command: list[str], folder: Path, batch: int) -> dict[str, 
     """Run the reference command once; its CPU ms per home vector by variant."""
     shown = " ".join(command)
     try:
-        proc = subprocess.run([*command, str(folder), str(batch)], capture_output=True, text=True, timeout=3600)
+        proc = subprocess.run([*command, str(folder), str(batch)], capture_output=True, text=True, errors="replace", timeout=3600)
     except FileNotFoundError:
         raise UserError(f"--reference {shown!r}: no such program {command[0]!r}; give the path of the reference "
                         "driver (docs/performance.md)") from None

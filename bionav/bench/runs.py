@@ -93,7 +93,8 @@ def _run(args: list[str], *, cwd: Path, env: dict) -> tuple[float, float]:
     goes into the message: the temporary directory is removed afterwards.
     """
     c0, t0 = _children_cpu(), time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "bionav", *args], cwd=cwd, env=env, capture_output=True, text=True)
+    proc = subprocess.run([sys.executable, "-m", "bionav", *args], cwd=cwd, env=env, capture_output=True, text=True,
+                          errors="replace")
     wall, cpu = time.perf_counter() - t0, _children_cpu() - c0
     if proc.returncode != 0:
         lines = [line for line in proc.stderr.splitlines() if line.strip() and not line.startswith("[")]

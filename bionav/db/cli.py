@@ -1,7 +1,7 @@
 """``python -m bionav.db``: look at a database, or export it as a folder.
 
     python -m bionav.db show <db> [--out DIR] [overrides ...]
-    python -m bionav.db export <db> DIR [--bits 8|16] [--force] [overrides ...]
+    python -m bionav.db export <db> DIR [--bits 8|16] [--force | --resume] [overrides ...]
     python -m bionav.db camera <db> [--out DIR] [--cells N] [overrides ...]
 
 Overrides are Hydra overrides of the composed config, e.g. ``db.seed=1``,
@@ -44,6 +44,8 @@ def _parser(names: list[str]) -> argparse.ArgumentParser:
     export.add_argument("--bits", type=int, choices=(8, 16), default=None,
                         help="PNG bit depth (default: 8 if lossless, else 16)")
     export.add_argument("--force", action="store_true", help="overwrite images already in DIR")
+    export.add_argument("--resume", action="store_true",
+                        help="continue an interrupted export of the same database into DIR (images written are kept)")
     export.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. db.seed=1")
     camera = sub.add_parser("camera", help="write raw mirror frames and unfolded panoramas of a stand-in",
                             description="Write <db>_camera.png: raw catadioptric frames of a few capture cells "
@@ -69,6 +71,12 @@ def run(argv: list[str]) -> int:
         parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     args.overrides = list(args.overrides) + extra
     composed = compose_database(args.db, args.overrides)
+    if args.command == "export" and args.resume:  # nothing to continue: said before the database loads
+        from bionav.db.export import SIDECAR
+
+        if not (user_path(args.dir) / SIDECAR).is_file():
+            raise UserError(f"--resume: {args.dir} holds no export of bionav to continue (no {SIDECAR}); export "
+                            "without --resume (into an empty folder, or with --force).")
     if args.command == "camera":
         return _camera(args, composed)
     db = load_database(composed.db, data_dir=composed.data_dir, cache_dir=composed.cache_dir)
@@ -90,7 +98,8 @@ def run(argv: list[str]) -> int:
         from bionav.db.export import export_database
 
         with _one_writer(user_path(args.dir)):
-            overrides = export_database(db, user_path(args.dir), bits=args.bits, overwrite=args.force)
+            overrides = export_database(db, user_path(args.dir), bits=args.bits, overwrite=args.force,
+                                        resume=args.resume)
         print(f"wrote {len(db)} images of {db.name} to {args.dir}")
         print("read back with: python -m bionav " + " ".join(overrides))
     return 0
@@ -140,6 +149,8 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as exc:
         print(f"bionav.db: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("bionav.db: error: interrupted; the files written so far are kept.", file=sys.stderr)
+    except KeyboardInterrupt:  # Ctrl-C, SIGTERM, SIGHUP (bionav.cli_main.run_main)
+        how = (" Continue the export with the same command plus --resume."
+               if (argv or sys.argv[1:])[:1] == ["export"] else "")
+        print(f"bionav.db: error: interrupted; the files written so far are kept.{how}", file=sys.stderr)
         return 130

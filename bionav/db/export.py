@@ -9,9 +9,10 @@ import numpy as np
 
 from bionav.db.conventions import from_canonical
 from bionav.db.database import ImageDatabase
-from bionav.db.imageio import write_image
+from bionav.db.imageio import encode_image
 from bionav.db.naming import VARDY_PATTERN
 from bionav.errors import UserError
+from bionav.files import cache_key, write_atomic
 
 log = logging.getLogger(__name__)
 
@@ -25,7 +26,7 @@ def exact_in_8bit(images: np.ndarray) -> bool:
 
 
 def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None,
-                    overwrite: bool = False) -> list[str]:
+                    overwrite: bool = False, resume: bool = False) -> list[str]:
     """Write ``db`` as ``<x>_<y>.png`` files that ``db=folder`` reads back.
 
     The images are written in the Bielefeld convention (azimuth clockwise with
@@ -46,6 +47,11 @@ def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None
         and 16 otherwise.
     overwrite : bool
         Allow writing into a folder that already holds ``<x>_<y>.*`` images.
+    resume : bool
+        Continue an interrupted export of the same database into ``out_dir``
+        (its sidecar says which database and how): images already written are
+        kept (each is written atomically, so none is half-written), the rest
+        are written.
 
     Returns
     -------
@@ -55,22 +61,47 @@ def export_database(db: ImageDatabase, out_dir: Path, *, bits: int | None = None
         db.horizon_row=... db.rad_per_row=...``.
     """
     out_dir = Path(out_dir)
-    _prepare_folder(out_dir, overwrite=overwrite)
+    if bits is None:
+        bits = 8 if exact_in_8bit(db.images) else 16
+    digest = cache_key({"bits": bits, "positions": np.asarray(db.positions).tolist()}, db.images)
+    done = _resumable(out_dir, digest) if resume else None
+    if done is None:
+        _prepare_folder(out_dir, overwrite=overwrite)
     if np.any(np.asarray(db.headings) != 0):
         log.warning("database %s has rotated views; the export writes them as they are and "
                     "reads back with heading 0", db.name)
-    if bits is None:
-        bits = 8 if exact_in_8bit(db.images) else 16
+    overrides = _reload_overrides(db, out_dir)
     disk = from_canonical(db.images, azimuth="clockwise", x_axis_column=0.0)
     try:
+        _write_sidecar(db, out_dir, overrides, bits=bits, digest=digest, complete=False)
         for (x, y), image in zip(db.positions, disk):
-            write_image(out_dir / f"{int(x)}_{int(y)}.png", image, bits=bits)
+            name = f"{int(x)}_{int(y)}.png"
+            if done is None or name not in done:
+                write_atomic(out_dir / name, lambda f, image=image: f.write(encode_image(image, bits=bits)))
+        _write_sidecar(db, out_dir, overrides, bits=bits, digest=digest, complete=True)
     except OSError as exc:
         raise UserError(f"cannot write the exported images to {out_dir}: {exc}; check the folder's "
                         "permissions and free space.") from None
-    overrides = _reload_overrides(db, out_dir)
-    _write_sidecar(db, out_dir, overrides, bits=bits)
     return overrides
+
+
+def _resumable(out_dir: Path, digest: str) -> set[str] | None:
+    """The images an interrupted export of this database left in ``out_dir`` (``--resume``)."""
+    import yaml
+
+    sidecar = out_dir / SIDECAR
+    try:
+        info = yaml.safe_load(sidecar.read_text(encoding="utf-8")) if sidecar.is_file() else None
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        info = None
+    if not isinstance(info, dict) or "digest" not in info:
+        raise UserError(f"--resume: {out_dir} holds no export of bionav to continue (no {SIDECAR} with its digest); "
+                        "export without --resume (into an empty folder, or with --force).")
+    if info.get("digest") != digest:
+        raise UserError(f"--resume: {out_dir} holds the export of another database or another bit depth "
+                        f"({info.get('name')}, {info.get('bits')} bit); give the same database, overrides and --bits "
+                        "as the export you continue, or export into another folder.")
+    return {p.name for p in out_dir.iterdir() if VARDY_PATTERN.match(p.name)}
 
 
 def _prepare_folder(out_dir: Path, *, overwrite: bool) -> None:
@@ -84,7 +115,8 @@ def _prepare_folder(out_dir: Path, *, overwrite: bool) -> None:
     if existing and not overwrite:
         raise UserError(
             f"{out_dir} already holds database images ({', '.join(existing[:3])}"
-            f"{' ...' if len(existing) > 3 else ''}); export into an empty folder or pass --force to overwrite."
+            f"{' ...' if len(existing) > 3 else ''}); continue an interrupted export of the same database with "
+            f"--resume, export into an empty folder, or pass --force to overwrite."
         )
     for name in existing:
         (out_dir / name).unlink()
@@ -104,8 +136,10 @@ def _reload_overrides(db: ImageDatabase, out_dir: Path) -> list[str]:
     ]
 
 
-def _write_sidecar(db: ImageDatabase, out_dir: Path, overrides: list[str], *, bits: int) -> None:
-    """``bionav-export.yaml``: what the folder loader cannot infer from the files, and how to load them."""
+def _write_sidecar(db: ImageDatabase, out_dir: Path, overrides: list[str], *, bits: int, digest: str,
+                   complete: bool) -> None:
+    """``bionav-export.yaml``: what the folder loader cannot infer from the files, how to load them, and
+    whether the export is complete (``complete: false`` while it runs; ``--resume`` continues it)."""
     g = db.geometry
     sidecar = [
         f"# {len(db)} images of database {db.name!r} exported by python -m bionav.db export",
@@ -119,5 +153,7 @@ def _write_sidecar(db: ImageDatabase, out_dir: Path, overrides: list[str], *, bi
         f"height: {g.height}",
         f"horizon_row: {float(g.horizon_row)!r}",
         f"rad_per_row: {float(g.rad_per_row)!r}",
+        f"digest: {digest}",
+        f"complete: {'true' if complete else 'false'}",
     ]
-    (out_dir / SIDECAR).write_text("\n".join(sidecar) + "\n")
+    write_atomic(out_dir / SIDECAR, "\n".join(sidecar) + "\n")

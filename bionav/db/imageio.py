@@ -151,7 +151,13 @@ def read_image(path: Path) -> np.ndarray:
     ImageReadError
         The file is empty, truncated or not decodable (the message says which).
     """
+    from bionav.datafile import MAX_BYTES
+
     try:
+        size = Path(path).stat().st_size
+        if size > MAX_BYTES["image"]:  # refused before it is read (a 1 GiB image would not fit anyway)
+            raise ImageReadError(f"it is {size / 2**20:.0f} MiB, more than the {MAX_BYTES['image'] // 2**20} MiB "
+                                 "an image may have")
         data = Path(path).read_bytes()
     except OSError as exc:
         raise ImageReadError(f"the file cannot be read ({exc.strerror or exc})") from None
@@ -165,6 +171,14 @@ def read_image(path: Path) -> np.ndarray:
     return to_grey_float(image, maxval=maxval)
 
 
+def _levels(image: np.ndarray, bits: int) -> np.ndarray:
+    if bits not in (8, 16):
+        raise ValueError(f"bits must be 8 or 16, not {bits}")
+    top = 255 if bits == 8 else 65535
+    dtype = np.uint8 if bits == 8 else np.uint16
+    return np.rint(np.clip(np.asarray(image, dtype=np.float64), 0.0, 1.0) * top).astype(dtype)
+
+
 def write_image(path: Path, image: np.ndarray, *, bits: int = 8) -> None:
     """Write a float grey image in ``[0, 1]`` as an 8- or 16-bit file (format from the suffix).
 
@@ -172,10 +186,13 @@ def write_image(path: Path, image: np.ndarray, *, bits: int = 8) -> None:
     ``round(v * 65535)``), so a value ``k / 255`` written with ``bits=8`` reads
     back exactly.
     """
-    if bits not in (8, 16):
-        raise ValueError(f"bits must be 8 or 16, not {bits}")
-    top = 255 if bits == 8 else 65535
-    dtype = np.uint8 if bits == 8 else np.uint16
-    levels = np.rint(np.clip(np.asarray(image, dtype=np.float64), 0.0, 1.0) * top).astype(dtype)
-    if not cv2.imwrite(str(path), levels):
+    if not cv2.imwrite(str(path), _levels(image, bits)):
         raise OSError(f"OpenCV could not write {path}")
+
+
+def encode_image(image: np.ndarray, *, bits: int = 8, suffix: str = ".png") -> bytes:
+    """The bytes of :func:`write_image`'s file (for atomic writes, :func:`bionav.files.write_atomic`)."""
+    ok, data = cv2.imencode(suffix, _levels(image, bits))
+    if not ok:
+        raise OSError(f"OpenCV could not encode a {suffix} image")
+    return data.tobytes()

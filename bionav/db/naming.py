@@ -211,10 +211,10 @@ def read_moeller_db(path: Path) -> dict:
         (as written), ``rad_per_row`` (radians, see the module docstring) and
         ``horizon`` (row).
     """
-    try:
-        text = path.read_text(encoding="latin-1")
-    except OSError as exc:
-        raise UserError(f"cannot read the Möller metadata file {path}: {exc.strerror or exc}.") from None
+    from bionav.datafile import read_user_text
+
+    text = read_user_text(path, what="the Möller metadata file", kind="metadata", encoding="latin-1",
+                          fix="Fix the file, or remove it and set db.grid_shape, db.horizon_row and db.rad_per_row.")
     tokens = text.split()
     try:
         values = [float(t) for t in tokens]
@@ -311,6 +311,10 @@ def _scan_csv(folder: Path, files: list[Path]) -> Scan:
             f"{folder} holds several CSV files ({', '.join(p.name for p in csvs)}); name the one with "
             "the grid positions positions.csv."
         )
+    from bionav.datafile import checked_path
+
+    checked_path(table, what="the positions file", fix="Write rows x,y[,filename] (a few bytes per cell).",
+                 kind="table")
     try:
         with open(table, newline="", encoding="utf-8-sig") as fh:
             rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]

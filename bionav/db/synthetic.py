@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 from pathlib import Path
 from typing import Callable, Iterable
 
@@ -49,6 +50,8 @@ from bionav.db.standins import (  # noqa: F401  (the stand-ins' table: its home 
 from bionav.errors import UserError
 from bionav.files import cache_key, default_cache_dir, write_atomic
 from bionav.geometry import PanoramaGeometry
+
+log = logging.getLogger(__name__)
 
 #: Bump when the database pipeline (noise, quantisation, layout) changes.
 DATABASE_VERSION = 1
@@ -255,6 +258,8 @@ def _cached_or_rendered(path: Path, key: str, params: dict, world, positions, ge
     """The 8-bit images from the cache file ``path``, or rendered and written there; and whether cached."""
     images_u8 = read_cached_images(path, key)
     cached = images_u8 is not None
+    if not cached:
+        _prepare_renderer(spec, world)
     if not cached and realism == "camera":
         from bionav.db.camera import camera_images
 
@@ -272,6 +277,16 @@ def _cached_or_rendered(path: Path, key: str, params: dict, world, positions, ge
         except OSError:
             pass  # a read-only cache is not fatal: the database is still returned
     return images_u8, cached
+
+
+def _prepare_renderer(spec, world) -> None:
+    """Say what the first render waits for, and compile before the progress bar starts (its ETA is then honest)."""
+    from bionav.world.render import prepare_renderer, renderer_compiled
+
+    if not renderer_compiled():
+        log.info("rendering %s (%d views) for the first time: compiling the renderer first (numba, once per "
+                 "installation and cached; about half a minute on 2 idle cores) ...", spec.name, spec.n_images)
+    prepare_renderer(world.scene)
 
 
 def _float_images(images_u8: np.ndarray) -> np.ndarray:

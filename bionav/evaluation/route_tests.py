@@ -140,12 +140,13 @@ def _closed_loop_heading(f: SnapshotFollower, render, pos, heading: float, k_las
 
 
 def closed_loop(f: SnapshotFollower, render, *, start_offset_m: float, agent_step_m: float, max_steps_factor: float,
-                success_radius_m: float, give_up_m: float, lookahead: int):
+                success_radius_m: float, give_up_m: float, lookahead: int, progress=None):
     """Simulated agent from the start displaced ``start_offset_m`` to the left; ``(path (T, 2), completed, mean distance)``.
 
     Steps of ``agent_step_m``; completed within ``success_radius_m`` of the route's end, given up
     beyond ``give_up_m`` from the route or after ``max_steps_factor`` x route length / step; the
-    mean distance of the path from the route, metres.
+    mean distance of the path from the route, metres. ``progress(iterable, total=...)`` shows the
+    steps (at most the step budget; the bar ends when the agent does).
     """
     s = f.s
     pos = s.xy[0] + start_offset_m * lateral_normals(s.heading[:1])[0]
@@ -156,7 +157,7 @@ def closed_loop(f: SnapshotFollower, render, *, start_offset_m: float, agent_ste
     k_last = 0
     heading = float(s.heading[0])
     completed = False
-    for _ in range(max_steps):
+    for _ in (progress or (lambda it, **_: it))(range(max_steps), total=max_steps):
         heading, k_last = _closed_loop_heading(f, render, pos, heading, k_last, lookahead)
         pos = pos + agent_step_m * np.array([math.cos(heading), math.sin(heading)])
         path.append(pos.copy())

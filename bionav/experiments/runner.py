@@ -17,6 +17,7 @@ from omegaconf import DictConfig, OmegaConf
 from bionav import __version__
 from bionav.errors import UserError
 from bionav.experiments.context import RunContext
+from bionav.experiments.warmup import start_warmup, stop_warmup
 from bionav.files import write_json_atomic
 from bionav.logs.writer import McapLog
 from bionav.runlock import RunLock
@@ -171,7 +172,25 @@ def run_experiment(cfg: DictConfig, run_dir: Path, *, show_progress: bool = True
             metrics = read_metrics(run_dir) or {}
             metrics["resumed"] = True
             return metrics
+        if resume:
+            _keep_attempt(run_dir)
         return _run_locked(cfg, run_dir, show_progress=show_progress)
+
+
+def _keep_attempt(run_dir: Path) -> None:
+    """A resumed run that did not finish: its earlier attempt's metrics.json and run.mcap are kept, renamed
+    ``metrics.attempt-<n>.json`` and ``run.attempt-<n>.mcap``, before the run starts again (nothing recorded
+    is lost)."""
+    if not (run_dir / METRICS_FILE).exists() and not (run_dir / LOG_FILE).exists():
+        return
+    n = 1
+    while (run_dir / f"metrics.attempt-{n}.json").exists() or (run_dir / f"run.attempt-{n}.mcap").exists():
+        n += 1
+    for name, kept in ((METRICS_FILE, f"metrics.attempt-{n}.json"), (LOG_FILE, f"run.attempt-{n}.mcap")):
+        if (run_dir / name).exists():
+            os.replace(run_dir / name, run_dir / kept)
+    log.info("resume: the earlier attempt in %s is kept as metrics.attempt-%d.json and run.attempt-%d.mcap",
+             run_dir, n, n)
 
 
 def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[str, Any]:
@@ -202,7 +221,12 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
             nodes=check_group_nodes(cfg, cls),
         )
         experiment = cls(config)
-        result = experiment.run(ctx)
+        # compiles the homing kernels the run needs later in a second process, beside the run
+        warmup = start_warmup(cfg, used_groups=tuple(cls.used_plugin_groups(cfg.get("experiment"))))
+        try:
+            result = experiment.run(ctx)
+        finally:
+            stop_warmup(warmup)
         metrics.update(result or {})
         metrics["status"] = "completed"
     except BaseException as exc:
@@ -213,6 +237,8 @@ def _run_locked(cfg: DictConfig, run_dir: Path, *, show_progress: bool) -> dict[
             log.error("%s interrupted after %.1f s", name, metrics["wall_time_s"])
             raise KeyboardInterrupt from None
         full = disk_full_error(exc, run_dir)
+        if isinstance(exc, UserError):  # nothing logged yet: a refusal at start (the command line removes the run)
+            exc.refused_at_start = mcap is None or mcap.n_messages == 0
         metrics["status"] = "failed"
         metrics["error"] = str(full or exc) if isinstance(full or exc, UserError) else f"{type(exc).__name__}: {exc}"
         if full is None and not isinstance(exc, (UserError, KeyboardInterrupt)):

@@ -92,4 +92,13 @@ def finish_merge(task_dirs: Sequence[Path], out: Path, metrics: dict[str, Any]) 
             overrides = [o for o in (yaml.safe_load(ov_file.read_text()) or [])
                          if not str(o).lstrip("+~").startswith(f"{BLOCK_KEY}=")]
             ov_file.write_text(yaml.safe_dump(overrides))
+        cfg_file = out / ".hydra" / "config.yaml"  # the merged run's configuration is the unsplit run's
+        if cfg_file.is_file():
+            from omegaconf import OmegaConf, open_dict
+
+            cfg = OmegaConf.load(cfg_file)
+            if OmegaConf.select(cfg, BLOCK_KEY, default=None) is not None:
+                with open_dict(cfg):
+                    cfg.experiment.block = None
+                cfg_file.write_text(OmegaConf.to_yaml(cfg))
     write_json_atomic(out / METRICS_FILE, json_safe(metrics))

@@ -11,6 +11,14 @@ use them.
 * :func:`edge_filter` (Sobel magnitude), :func:`vertical_difference` (the
   scale planes' vertical edge filter), :func:`equalize_histogram`.
 * :func:`horizon_strip` -- the rows around the horizon averaged to one row.
+
+scikit-image has each of these jobs; bionav does not use it (measured 2026-11-28 on 170 panoramas of
+561 x 81, CPU time, scikit-image 0.26): ``skimage.filters.sobel`` gives the same magnitude (within
+1e-7) only after the panorama is padded to wrap around, at 2.1 times the CPU time;
+``skimage.exposure.equalize_hist`` maps by another formula than OpenCV's ``equalizeHist`` (up to 0.014
+apart) at 4 times the time; ``skimage.filters.butterworth`` pads the image edges, so it does not wrap
+the 360-degree azimuth; ``skimage.transform.resize_local_mean`` equals ``cv2.INTER_AREA`` at 6 times
+the time.
 """
 
 from __future__ import annotations

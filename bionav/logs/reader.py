@@ -67,3 +67,24 @@ def read_metadata(path: str | Path) -> dict[str, dict[str, str]]:
     with _open(path) as f:
         reader = make_reader(f)
         return {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+
+
+def read_recorded_messages(path: str | Path, topics: Iterable[str]) -> list[tuple[str, dict]]:
+    """``(topic, message)`` of every complete JSON message of ``topics``, in file order, also from a log that a
+    crash cut off (SIGKILL, a full disk): the messages before the damage; none from a file that is not a log.
+
+    For continuing a run from what an earlier attempt logged (``bionav.resume=true``).
+    """
+    from mcap.exceptions import McapError
+    from mcap.reader import NonSeekingReader
+
+    wanted = set(topics)
+    out: list[tuple[str, dict]] = []
+    try:
+        with _open(path) as f:
+            for _schema, channel, message in NonSeekingReader(f, validate_crcs=True).iter_messages():
+                if channel.topic in wanted and channel.message_encoding == "json":
+                    out.append((channel.topic, json.loads(message.data)))
+    except (UserError, McapError, ValueError, OSError, EOFError):
+        pass  # the damage: what came before it is kept
+    return out

@@ -31,17 +31,14 @@ MAGIC = b"\x89MCAP0\r\n"
 
 def check_mcap(path: str | Path) -> None:
     """Raise :class:`UserError` unless ``path`` is a file starting with the MCAP magic bytes."""
-    from bionav.files import not_a_regular_file
+    from bionav.datafile import checked_path
 
     path = Path(path)
     if path.is_dir():
         raise UserError(f"{path} is a directory, not a log file; pass the run.mcap inside it, "
                         f"e.g. {path / 'run.mcap'}.")
-    problem = not_a_regular_file(path)  # never open a FIFO or a device: reading it would block
-    if problem == "does not exist":
-        raise UserError(f"the log file {path} does not exist; pass the path of a run.mcap written by a bionav run.")
-    if problem is not None:
-        raise UserError(f"the log file {path} {problem}; pass the path of a run.mcap written by a bionav run.")
+    # never open a FIFO or a device (reading it would block), nor a file larger than any log of a run
+    checked_path(path, what="the log file", fix="Pass the path of a run.mcap written by a bionav run.", kind="log")
     try:
         with open(path, "rb") as f:
             head = f.read(len(MAGIC))

@@ -121,6 +121,11 @@ class McapLog:
                     except OSError:  # reported by the next write or close in the main thread
                         return
 
+    @property
+    def n_messages(self) -> int:
+        """Messages written so far (attachments and metadata not counted)."""
+        return sum(self._sequence.values())
+
     # -- channels -------------------------------------------------------------
     def _channel(self, topic: str, schema_name: str, schema: Mapping[str, Any] | None) -> int:
         if topic in self._channels:

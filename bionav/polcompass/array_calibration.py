@@ -57,8 +57,17 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.geometry import parabolic_peak_offset, wrap_axial
+from bionav.validation import Range
 
 SCHEMA = "bionav.pol_array_calibration/1"
+#: what each field of a calibration file may hold (JSON null: "not calibrated", where a fill is defined)
+FIELD_RANGES = {
+    "units": Range(ge=1, le=64), "photodiodes": Range(ge=1, le=16), "gain": Range(ge=1e-3, le=1e3),
+    "gain_log_sigma": Range(ge=0.0, le=10.0), "angle_offset_deg": Range(ge=-180.0, le=180.0),
+    "angle_sigma_deg": Range(ge=0.0, le=360.0), "azimuth_offset_deg": Range(ge=-180.0, le=180.0),
+    "azimuth_sigma_deg": Range(ge=0.0, le=360.0), "n_sessions": Range(ge=0, le=1_000_000),
+    "mount_tilt_deg": Range(ge=-45.0, le=45.0),
+}
 
 
 @dataclass(frozen=True)
@@ -495,49 +504,48 @@ class ArrayCalibration:
         return out
 
     @classmethod
-    def from_dict(cls, data: dict, *, source: str = "the calibration") -> "ArrayCalibration":
-        """Inverse of :meth:`to_dict`; a clear :class:`UserError` for another layout."""
+    def from_dict(cls, data: dict, *, source: str = "The calibration",
+                  fix: str = "Recalibrate with recordings.calibration=auto.") -> "ArrayCalibration":
+        """Inverse of :meth:`to_dict`; every field checked (:data:`FIELD_RANGES`, shapes, unit indices), a
+        :class:`UserError` naming ``source``, the field and its allowed values otherwise."""
+        from bionav.datafile import FileFields
+
         if not isinstance(data, dict) or data.get("schema") != SCHEMA:
             raise UserError(
                 f"{source} is not a POL-OP array calibration (it needs \"schema\": \"{SCHEMA}\"); write one with "
                 "experiment=pol_recordings recordings.calibration=auto (calibration.json in the run folder)."
             )
-        try:
-            k, p = int(data["units"]), int(data["photodiodes"])
+        f = FileFields(data, source=source, fix=fix)
+        k = f.number("units", valid=FIELD_RANGES["units"], integer=True)
+        p = f.number("photodiodes", valid=FIELD_RANGES["photodiodes"], integer=True)
+        rad = np.pi / 180.0
 
-            def arr(key, shape, scale=1.0, fill=np.nan):
-                a = np.array([[fill if v is None else v for v in row] for row in data[key]] if len(shape) == 2
-                             else [fill if v is None else v for v in data[key]], float)
-                if a.shape != shape:
-                    raise ValueError(f"{key} has shape {a.shape}, expected {shape}")
-                return a * scale
+        def arr(key, shape, fill):
+            return f.array(key, shape=shape, valid=FIELD_RANGES[key], none=fill)
 
-            rad = np.pi / 180.0
-            calibrated = np.zeros(k, bool)
-            calibrated[[int(u) for u in data["calibrated_units"]]] = True
-            out = cls(arr("gain", (k, p), fill=1.0), arr("gain_log_sigma", (k, p)),
-                      arr("angle_offset_deg", (k, p), rad, 0.0), arr("angle_sigma_deg", (k, p), rad),
-                      arr("azimuth_offset_deg", (k,), rad, 0.0), arr("azimuth_sigma_deg", (k,), rad),
-                      calibrated, np.asarray(data.get("n_sessions", [0] * k), int), list(data.get("sessions", [])),
-                      None if data.get("mount_tilt_deg") is None else arr("mount_tilt_deg", (2,), rad))
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise UserError(f"{source} is malformed ({exc}); recalibrate with recordings.calibration=auto.") from None
-        if np.any(out.gain <= 0) or not np.all(np.isfinite(out.gain)):
-            raise UserError(f"{source} has non-positive or missing gains; recalibrate with recordings.calibration=auto.")
-        return out
+        calibrated = np.zeros(k, bool)
+        calibrated[f.indices("calibrated_units", size=k)] = True
+        n_sessions = f.array("n_sessions", shape=(k,), valid=FIELD_RANGES["n_sessions"], integer=True, optional=True,
+                             default=np.zeros(k, np.int64))
+        if not isinstance(sessions := data.get("sessions", []), list) or not all(isinstance(v, str) for v in sessions):
+            f.fail("sessions", "is not a list of session names", "a list of strings")
+        tilt = None if data.get("mount_tilt_deg") is None else f.array(
+            "mount_tilt_deg", shape=(2,), valid=FIELD_RANGES["mount_tilt_deg"]) * rad
+        return cls(arr("gain", (k, p), 1.0), arr("gain_log_sigma", (k, p), np.nan),
+                   arr("angle_offset_deg", (k, p), 0.0) * rad, arr("angle_sigma_deg", (k, p), np.nan) * rad,
+                   arr("azimuth_offset_deg", (k,), 0.0) * rad, arr("azimuth_sigma_deg", (k,), np.nan) * rad,
+                   calibrated, n_sessions, list(sessions), tilt)
 
     @classmethod
     def load(cls, path) -> "ArrayCalibration":
-        """Read a calibration file written by :meth:`save`."""
-        p = Path(path)
-        try:
-            data = json.loads(p.read_text())
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise UserError(
-                f"Cannot read the POL-OP calibration {p} ({exc}); point recordings.calibration at a calibration.json "
-                "written by experiment=pol_recordings, or use recordings.calibration=auto or none."
-            ) from None
-        return cls.from_dict(data, source=f"The file {p}")
+        """Read a calibration file written by :meth:`save` (size-capped, every field checked)."""
+        from bionav.datafile import read_user_json
+        from bionav.files import user_path
+
+        fix = ("Point recordings.calibration at a calibration.json written by experiment=pol_recordings, or use "
+               "recordings.calibration=auto or none.")
+        data = read_user_json(path, what="The POL-OP calibration", fix=fix, kind="calibration")
+        return cls.from_dict(data, source=f"The POL-OP calibration {user_path(path)}", fix=fix)
 
     def save(self, path) -> None:
         """Write the calibration as JSON."""

@@ -28,6 +28,7 @@ import numpy as np
 
 from bionav.errors import UserError
 from bionav.geometry import wrap_axial
+from bionav.validation import Range
 
 
 @dataclass(frozen=True)
@@ -62,33 +63,50 @@ class UnitCalibration:
             "unit_angles": [float(v) for v in self.unit_angles],
         }
 
-    @classmethod
-    def from_dict(cls, data: dict) -> "UnitCalibration":
-        """Inverse of :meth:`to_dict`."""
-        try:
-            return cls(
-                np.asarray(data["center_v"], float),
-                np.asarray(data["volts_per_decade"], float),
-                np.asarray(data["unit_angles"], float),
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise UserError(
-                f"The calibration data is incomplete or malformed ({exc}); it needs the lists "
-                "center_v, volts_per_decade and unit_angles. Recalibrate with experiment.mode=rotation."
-            ) from None
+    #: the values a calibration may hold: volts within the 0-5 V rails, a gain that resolves a decade
+    #: within them (0 would divide by zero), polarizer angles in radians within a turn, 1..8 analog lines
+    CENTER_V = Range(ge=0.0, le=5.0)
+    VOLTS_PER_DECADE = Range(ge=0.01, le=50.0)
+    UNIT_ANGLE = Range(ge=-2.0 * np.pi, le=2.0 * np.pi)
+    MAX_UNITS = 8
 
     @classmethod
-    def load(cls, path, *, setting: str = "experiment.calibration_path") -> "UnitCalibration":
-        """Read a calibration written by :meth:`save`; ``setting`` names the option in error messages."""
-        from bionav.files import read_json_file
+    def from_dict(cls, data: dict, *, source: str = "The compass calibration",
+                  fix: str = "Recalibrate with experiment.mode=rotation.", units: int | None = None) -> "UnitCalibration":
+        """Inverse of :meth:`to_dict`, every field checked (finite, in range, one value per unit).
 
-        data = read_json_file(path, what="The compass calibration", fix=(
-            f"Point {setting} at a calibration.json written by a rotation run (experiment=pol_compass mode=rotation), "
-            "or drop it to calibrate from the scan."), max_bytes=16 * 2**20)
-        if not isinstance(data, dict):
-            raise UserError(f"The compass calibration {path} holds a JSON {type(data).__name__}, not an object; "
-                            "recalibrate with experiment.mode=rotation.")
-        return cls.from_dict(data)
+        Raises
+        ------
+        UserError
+            Naming ``source``, the field and its allowed values: a missing field, a ragged or
+            non-numeric list, NaN or infinity, a value outside :attr:`CENTER_V`,
+            :attr:`VOLTS_PER_DECADE` or :attr:`UNIT_ANGLE`, lists of different lengths.
+        """
+        from bionav.datafile import FileFields
+
+        fields = FileFields(data, source=source, fix=fix)
+        center = fields.array("center_v", shape=(None,), valid=cls.CENTER_V)
+        k = center.size
+        if not 1 <= k <= cls.MAX_UNITS or (units is not None and k != units):
+            fields.fail("center_v", f"has {k} values", f"one per unit of this compass ({units} units)" if units
+                        else f"one per unit, 1 to {cls.MAX_UNITS} units")
+        gain = fields.array("volts_per_decade", shape=(k,), valid=cls.VOLTS_PER_DECADE)
+        angles = fields.array("unit_angles", shape=(k,), valid=cls.UNIT_ANGLE)
+        return cls(center, gain, angles)
+
+    @classmethod
+    def load(cls, path, *, setting: str = "experiment.calibration_path", units: int | None = None) -> "UnitCalibration":
+        """Read a calibration written by :meth:`save`; ``setting`` names the option in error messages.
+
+        ``units``: the number of units the compass has (a calibration of another one is refused).
+        """
+        from bionav.datafile import read_user_json
+        from bionav.files import user_path
+
+        fix = (f"Point {setting} at a calibration.json written by a rotation run (experiment=pol_compass "
+               "mode=rotation), or drop it to calibrate from the scan.")
+        data = read_user_json(path, what="The compass calibration", fix=fix, kind="calibration")
+        return cls.from_dict(data, source=f"The compass calibration {user_path(path)}", fix=fix, units=units)
 
     def save(self, path) -> None:
         """Write the calibration as JSON."""

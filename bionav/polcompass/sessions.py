@@ -359,17 +359,21 @@ def simulate_session(data: SessionData, exp, rng) -> SessionData:
     return replace(data, counts=counts, valid=valid, evectors=ev, pol_op_valid=pol_ok)
 
 
-def prepared_sessions(rc) -> tuple[list, list]:
-    """Every session of ``recordings.path`` prepared for decoding, and ``(path, message)`` of the unusable ones."""
+def prepared_sessions(rc, progress=None) -> tuple[list, list]:
+    """Every session of ``recordings.path`` prepared for decoding, and ``(path, message)`` of the unusable ones.
+
+    ``progress(iterable, desc=..., total=...)`` (e.g. ``ctx.progress``) shows the preparation of the sessions.
+    """
     from bionav.polcompass.recordings import load_sessions
 
+    log.info("reading the POL-OP recordings in %s ...", rc.path)
     sessions, bad_files = load_sessions(rc.path)
     for _path, message in bad_files:
         log.warning("%s", message)
     if not sessions:
         raise UserError(" ".join(m for _p, m in bad_files) or f"No usable recordings in {rc.path}.")
     prepared = []
-    for session in sessions:
+    for session in (progress or (lambda it, **_: it))(sessions, desc="preparing sessions", total=len(sessions)):
         try:
             prepared.append(prepare_session(session, rc))
         except UserError as exc:  # e.g. a folder name without the recording time: skip that session, keep the rest

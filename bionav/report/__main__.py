@@ -24,10 +24,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     from bionav.report.sections import extra_sections
     from bionav.report.summary import write_summary
-    from bionav.runlock import RunLock
+    from bionav.runlock import RunLock, settle_stale_runs
 
     # one writer of summary.csv / summary.md per directory; a stale lock is taken over
     with RunLock(root, what="directory", fix="Wait for the other `python -m bionav.report` to finish."):
+        settle_stale_runs(root)  # runs whose process was killed say "interrupted", not "running"
         csv_path, md_path, rows = write_summary(root)
         if not rows:
             print(f"bionav.report: error: no runs (metrics.json) found below {root}.", file=sys.stderr)

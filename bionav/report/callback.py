@@ -16,7 +16,7 @@ log = logging.getLogger(__name__)
 LAST_SWEEP: dict[str, Any] = {}
 
 
-def write_sweep_summary(sweep_dir: Path) -> tuple[int, int, Path]:
+def write_sweep_summary(sweep_dir: Path, *, objective: str | None = None) -> tuple[int, int, Path]:
     """Write summary.csv and summary.md (with comparison sections) of ``sweep_dir``.
 
     Returns
@@ -26,7 +26,7 @@ def write_sweep_summary(sweep_dir: Path) -> tuple[int, int, Path]:
     from bionav.report.sections import extra_sections
     from bionav.report.summary import write_summary
 
-    csv_path, md_path, rows = write_summary(sweep_dir)
+    csv_path, md_path, rows = write_summary(sweep_dir, objective=objective)
     sections = extra_sections(sweep_dir, rows)  # comparisons, parameter-homing rankings
     if sections:
         md_path.write_text(md_path.read_text() + "\n" + "\n\n".join(sections) + "\n")
@@ -46,5 +46,5 @@ class SweepSummary(Callback):
         sweep_dir = Path(str(config.hydra.sweep.dir))
         if not sweep_dir.is_dir():
             return
-        write_sweep_summary(sweep_dir)
+        write_sweep_summary(sweep_dir, objective=OmegaConf.select(config, "objective.metric", default=None))
         LAST_SWEEP["fail_on_job_error"] = bool(OmegaConf.select(config, "bionav.fail_on_job_error", default=True))

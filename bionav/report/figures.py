@@ -56,6 +56,32 @@ def grid_cell_axes(ax, *, fontsize: float | None = None) -> None:
     ax.set_ylabel("y (grid cells)", fontsize=fontsize)
 
 
+#: the colour of values beyond a colour bar's upper end (distinct from every colour map bionav uses)
+OVER_COLOUR = "tab:cyan"
+
+
+def capped_colormap(name: str, *, over: str = OVER_COLOUR):
+    """Colour map ``name`` whose values above ``vmax`` are drawn in ``over`` (not in the top colour).
+
+    Use it with :func:`capped_colorbar`, e.g. for AAE maps capped at pi/2 (a random direction's expected
+    error) while errors reach pi: a method worse than chance is then cyan, not the top colour.
+    """
+    import matplotlib
+
+    return matplotlib.colormaps[name].with_extremes(over=over)
+
+
+def capped_colorbar(fig, image, *, ax, label: str, **kwargs):
+    """A colour bar for ``image`` (drawn with :func:`capped_colormap`) with an overflow triangle at the top.
+
+    The triangle shows the over colour and the label says what it means, e.g. ``AAE$_s$ (rad), cyan >
+    1.57``. Extra keyword arguments go to :meth:`matplotlib.figure.Figure.colorbar`.
+    """
+    vmax = image.get_clim()[1]
+    text = f"{label}, cyan > {vmax:.3g}"
+    return fig.colorbar(image, ax=ax, extend="max", label=text, **kwargs)
+
+
 def draw_border_line(ax, point, tangent, style: str, label: str, *, color: str = "tab:blue", lw: float = 1.3) -> None:
     """A straight class border through ``point`` along ``tangent`` (data units), drawn across the axes' view.
 

@@ -20,7 +20,7 @@ from types import MappingProxyType
 from typing import Any, Iterable, Mapping, Sequence
 
 from bionav.files import write_csv_atomic
-from bionav.report.figures import pyplot
+from bionav.report.figures import capped_colorbar, capped_colormap, pyplot
 from bionav.report.table import markdown_table
 
 ROWS_FILE = "param_sweep.jsonl"
@@ -203,7 +203,8 @@ def plot_per_snapshot(path: Path, ranked: Sequence[Mapping[str, Any]], *, db: st
             m = np.full((ny, nx), np.nan)
             m[pos[:, 1], pos[:, 0]] = [np.nan if v is None else v for v in row[key]]
             ax = axes[r, col]
-            images[r] = ax.imshow(m, origin="lower", cmap=cmap, vmin=0, vmax=vmax)
+            images[r] = ax.imshow(m, origin="lower", cmap=capped_colormap(cmap) if key == "aae_s" else cmap,
+                                  vmin=0, vmax=vmax)
             ax.set_xticks([])
             ax.set_yticks([])
             if r == 0:
@@ -212,8 +213,9 @@ def plot_per_snapshot(path: Path, ranked: Sequence[Mapping[str, Any]], *, db: st
                 ax.set_title(f"AAE*={row['aae']:.3f}", fontsize=8)
             if col == 0:
                 ax.set_ylabel(label)
-    for r in range(2):
-        fig.colorbar(images[r], ax=axes[r, :].tolist(), shrink=0.9)
+    fig.colorbar(images[0], ax=axes[0, :].tolist(), shrink=0.9, label="RR$_s$")
+    # AAE_s beyond pi/2 (worse than a guess) in the over colour, marked on the bar
+    capped_colorbar(fig, images[1], ax=axes[1, :].tolist(), label="AAE$_s$ (rad)", shrink=0.9)
     fig.suptitle(f"Parameter homing on {db}: RR$_s$ and AAE$_s$ per snapshot position (best {len(shown)})", fontsize=9)
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)

@@ -85,14 +85,20 @@ def collect_rows(root: Path) -> tuple[list[dict[str, Any]], list[str]]:
     return rows, override_keys
 
 
-def write_summary(root: Path) -> tuple[Path, Path, list[dict[str, Any]]]:
-    """Write ``summary.csv`` and ``summary.md`` into ``root``; return their paths and the rows."""
+def write_summary(root: Path, *, objective: str | None = None) -> tuple[Path, Path, list[dict[str, Any]]]:
+    """Write ``summary.csv``, ``summary.md`` and the figure of the metric over the swept values
+    (``summary.png``, :func:`bionav.report.sweep_figure.plot_sweep`) into ``root``; return the paths and rows."""
+    from bionav.report.sweep_figure import plot_sweep
+
     root = Path(root)
     rows, override_keys = collect_rows(root)
     columns = ordered_columns(rows, first=["job", *override_keys, "status"])
     csv_path, md_path = root / "summary.csv", root / "summary.md"
     write_csv_atomic(csv_path, columns, ([row.get(c, "") for c in columns] for row in rows))
     n_failed = sum(1 for r in rows if r.get("status") != "completed")
+    figure = plot_sweep(root, rows, override_keys, objective=objective) if rows else None
     text = [f"# Summary of {root}", "", f"{len(rows)} runs, {n_failed} failed.", "", markdown_table(rows, columns), ""]
+    if figure is not None:
+        text += [f"![the metric over the swept values]({figure.name})", ""]
     md_path.write_text("\n".join(text))
     return csv_path, md_path, rows

@@ -60,10 +60,28 @@ def ordered_columns(rows: Iterable[Mapping[str, Any]], first: Sequence[str] = ()
     return cols
 
 
+#: what a metric is called in the thesis (3.2) and the docs, with its unit, by its metrics.json key
+LABELS = {
+    "aae": "AAE* (rad)",
+    "mae": "MAE* (rad)",
+    "rr": "RR* (fraction of agents home)",
+    "compass_aae": "compass AAE* (rad)",
+    "n_images": "images",
+    "n_pairs": "snapshot/current-view pairs",
+    "ms_per_home_vector": "time per home vector (ms)",
+    "keypoints_per_image": "SIFT keys per image",
+    "wall_time_s": "wall time (s)",
+}
+
+
 def format_metrics(metrics: Mapping[str, Any]) -> str:
-    """The results table a single run prints (Markdown, one metric per row)."""
+    """The results table a single run prints (Markdown, one metric per row).
+
+    Columns: the metric as the thesis and the docs name it, with its unit
+    (:data:`LABELS`: ``AAE* (rad)``, ``MAE* (rad)``, ``RR* (fraction of agents home)``, ...), its value,
+    and its key in metrics.json.
+    """
     flat = flatten(metrics)
-    rows = [{"metric": k, "value": flat[k]} for k in ordered_columns([flat]) if k != "wall_time_s"]
-    if "wall_time_s" in flat:
-        rows.append({"metric": "wall_time_s", "value": flat["wall_time_s"]})
-    return markdown_table(rows, ["metric", "value"])
+    keys = [k for k in ordered_columns([flat]) if k != "wall_time_s"] + (["wall_time_s"] if "wall_time_s" in flat else [])
+    rows = [{"metric": LABELS.get(k, k), "value": flat[k], "metrics.json": k} for k in keys]
+    return markdown_table(rows, ["metric", "value", "metrics.json"])

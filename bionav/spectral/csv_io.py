@@ -51,13 +51,12 @@ def read_samples_csv(path) -> SampleSet:
     """
     path = Path(path)
     fix = "Fix the file, or use data=sim_natural / data=sim_artificial for a simulated set."
-    if not path.is_file():
+    if not path.exists():
         raise UserError(f"Sample CSV {str(path)!r} does not exist. Point data.path at a CSV file with columns "
                         f"class,UV,B,G,R,IR[,kind,time]. {fix}")
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UserError(f"Cannot read sample CSV {str(path)!r}: {exc}. {fix}") from None
+    from bionav.datafile import read_user_text
+
+    text = read_user_text(path, what="The sample CSV", fix=fix, kind="table")
     lines = [(i + 1, line) for i, line in enumerate(text.splitlines()) if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
         raise UserError(f"Sample CSV {str(path)!r} is empty; it needs a header line class,UV,B,G,R,IR and data lines. {fix}")

@@ -77,17 +77,11 @@ def _launcher_overrides(name: str | None, extra: list[str]) -> list[str]:
     return [f"hydra/launcher={name}", *extra]
 
 
-def _interrupt(signum, frame) -> None:  # noqa: ARG001
-    raise KeyboardInterrupt
-
-
 def main(argv: list[str] | None = None) -> int:
-    import signal
+    from bionav.cli_main import end_on_termination_signals
 
     args = build_parser().parse_args(argv)
-    for sig in ("SIGTERM", "SIGHUP"):  # `kill` and a closed terminal end the command as Ctrl-C does (unless ignored:
-        if hasattr(signal, sig) and signal.getsignal(getattr(signal, sig)) != signal.SIG_IGN:  # nohup)
-            signal.signal(getattr(signal, sig), _interrupt)
+    end_on_termination_signals()  # `kill` and a closed terminal end the command as Ctrl-C does
     try:
         return run(args)
     except UserError as exc:
@@ -147,17 +141,49 @@ def run(args) -> int:
     return _run_in(args, out, items, preset, started, load_start)
 
 
-def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> int:
-    from bionav.machine import usable_cpus
-    from bionav.thesis.diagnoses import load_diagnoses
-    from bionav.thesis.items import Context
-    from bionav.thesis.outcome import Outcome
-    from bionav.thesis.reference import load_reference
-    from bionav.thesis.report import Section, markdown_to_html, report_markdown, verdict_counts, write_csv
-    from bionav.thesis.runs import Runner, tool_env
+#: the files of the report itself (the items add their figures and tables, named after the item)
+REPORT_FILES = ("report.md", "report.html", "items.csv")
+#: where the items' files are made before they are moved into --out (bionav's own files only)
+STAGING = ".bionav-staging"
 
-    ref_all = load_reference()
+
+def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> int:
+    from bionav.files import OwnedFolder
+
+    owned = OwnedFolder(out)
+    if not args.dry_run:  # the user's files in --out are never overwritten: refused before any run
+        owned.check([*REPORT_FILES, *(p.name for p in out.iterdir() if any(p.name.startswith(it.id) for it in items))])
+        from bionav.runlock import settle_stale_runs
+
+        for sub in ("runs", "sweeps"):  # runs whose process was killed (with this command, alone) say "interrupted"
+            settle_stale_runs(out / sub)
     specs = {it.id: it.runs(preset) for it in items}
+    results = _results(args, out, specs)
+    if args.dry_run:
+        return 0
+    import shutil
+
+    staging = out / STAGING
+    shutil.rmtree(staging, ignore_errors=True)
+    staging.mkdir()
+    sections = _sections(items, specs, results, staging, preset)
+    wall = time.time() - started
+    _write_report(args, sections, results, staging, out, preset, wall, load_start)
+    _publish(staging, out, owned)
+    from bionav.thesis.report import verdict_counts
+
+    counts = verdict_counts(sections)
+    print(f"bionav.thesis: {len(sections)} items in {wall:.0f} s: " +
+          ", ".join(f"{v} {counts.get(v, 0)}" for v in ("holds", "partly", "does not hold", "not produced")))
+    print(f"report: {out / 'report.md'} ({out / 'report.html'}, {out / 'items.csv'})")
+    return 0
+
+
+def _results(args, out: Path, specs: dict) -> dict:
+    """Run (or, with --report-only, find) every run the items need; their results by key."""
+    from bionav.machine import usable_cpus
+    from bionav.thesis.runs import Runner, RunResult, index_runs, read_json, tool_env
+
     launcher = _launcher_overrides(args.launcher, args.launcher_arg)
     if args.jobs is not None:
         jobs = args.jobs
@@ -165,30 +191,36 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         jobs = 4096 if "slurm" in (args.launcher or "") else 1
     else:
         jobs = usable_cpus()
-    from bionav.thesis.plan import task_cpu_s
-
-    runner = Runner(out=out, launcher=launcher, dry_run=args.dry_run, echo=lambda s: print(s, flush=True),
-                    env=tool_env(), jobs=jobs, cost=lambda spec: task_cpu_s(spec).cpu_s)
     all_specs = [s for ss in specs.values() for s in ss]
-    if args.report_only:
-        from bionav.thesis.runs import RunResult, index_runs, read_json
+    if not args.report_only:
+        from bionav.thesis.plan import task_cpu_s
 
-        index = index_runs(out)
-        results = {}
-        for s in all_specs:
-            d = index.get(s.key)
-            results[s.key] = RunResult(s, d, None if d is None else read_json(d / "metrics.json") if not s.multirun
-                                       else {"status": "completed"}, None if d else "not run (--report-only)", reused=True)
-    else:
-        results = runner.run_all(all_specs)
-    if args.dry_run:
-        return 0
+        runner = Runner(out=out, launcher=launcher, dry_run=args.dry_run, echo=lambda s: print(s, flush=True),
+                        env=tool_env(), jobs=jobs, cost=lambda spec: task_cpu_s(spec).cpu_s)
+        return runner.run_all(all_specs)
+    index = index_runs(out)
+    results = {}
+    for s in all_specs:
+        d = index.get(s.key)
+        results[s.key] = RunResult(s, d, None if d is None else read_json(d / "metrics.json") if not s.multirun
+                                   else {"status": "completed"}, None if d else "not run (--report-only)", reused=True)
+    return results
 
+
+def _sections(items, specs: dict, results: dict, staging: Path, preset) -> list:
+    """Evaluate every item (its figures and tables go to ``staging``); one report section per item."""
+    from bionav.thesis.diagnoses import load_diagnoses
+    from bionav.thesis.items import Context
+    from bionav.thesis.outcome import Outcome
+    from bionav.thesis.reference import load_reference
+    from bionav.thesis.report import Section
+
+    ref_all = load_reference()
     sections = []
     diagnoses = load_diagnoses()
     for it in items:
         ref = ref_all.get(it.id, {})
-        ctx = Context(preset=preset, out=out, ref=ref, results=results, ref_id=it.id)
+        ctx = Context(preset=preset, out=staging, ref=ref, results=results, ref_id=it.id)
         try:
             outcome = it.evaluate(ctx, specs[it.id])
         except Exception as exc:  # a report section must never take the whole report down
@@ -196,7 +228,7 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         item_runs = [results[s.key] for s in specs[it.id]]
         if item_runs and not any(r.ok for r in item_runs):
             for name in (*outcome.figures, *outcome.tables):  # empty figures and all-n/a tables are not left behind
-                (out / name).unlink(missing_ok=True)
+                (staging / name).unlink(missing_ok=True)
             outcome = outcome.without_runs(len({r.spec.key for r in item_runs}))
         claims = list(ref.get("claims", []))
         if it.id.startswith("tableB"):
@@ -204,20 +236,37 @@ def _run_in(args, out: Path, items, preset, started: float, load_start: str) -> 
         sections.append(Section(it.id, it.label, ref.get("title", it.label), ref.get("source", ""), it.rule,
                                 outcome, [results[s.key] for s in {s.key: s for s in specs[it.id]}.values()], claims,
                                 diagnoses.get(it.id)))
-    wall = time.time() - started
+    return sections
+
+
+def _write_report(args, sections, results, staging: Path, out: Path, preset, wall: float, load_start: str) -> None:
+    """report.md, report.html and items.csv into ``staging`` (run paths relative to ``out``)."""
+    from bionav.thesis.report import markdown_to_html, report_markdown, write_csv
+
     command = "python -m bionav.thesis " + " ".join(argv_for_display(args))
     cpu = sum(r.cpu_seconds or 0.0 for r in results.values())
     machine = f"{os.cpu_count()} CPUs, 1-minute load average {load_start} at the start and {_loadavg()} at the end"
     md = report_markdown(sections, preset=preset, out=out, wall_s=wall, command=command, cpu_s=cpu or None,
                          machine=machine)
-    (out / "report.md").write_text(md)
-    (out / "report.html").write_text(markdown_to_html(md, out))
-    write_csv(out / "items.csv", sections)
-    counts = verdict_counts(sections)
-    print(f"bionav.thesis: {len(sections)} items in {wall:.0f} s: " +
-          ", ".join(f"{v} {counts.get(v, 0)}" for v in ("holds", "partly", "does not hold", "not produced")))
-    print(f"report: {out / 'report.md'} ({out / 'report.html'}, {out / 'items.csv'})")
-    return 0
+    (staging / "report.md").write_text(md)
+    (staging / "report.html").write_text(markdown_to_html(md, staging))
+    write_csv(staging / "items.csv", sections)
+
+
+def _publish(staging: Path, out: Path, owned) -> None:
+    """Move the staged files into ``out``; a file there that bionav did not write is kept (and named)."""
+    import shutil
+
+    names = sorted(p.name for p in staging.iterdir())
+    kept = owned.foreign(names)
+    for name in names:
+        if name not in kept:
+            os.replace(staging / name, out / name)
+            owned.claim(name)
+    owned.save()
+    if kept:
+        owned.check(kept)  # one message naming them; the new files stay in STAGING
+    shutil.rmtree(staging, ignore_errors=True)
 
 
 def _plan(args, items, preset) -> int:

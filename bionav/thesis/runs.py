@@ -31,7 +31,8 @@ from bionav.machine import usable_cpus
 
 log = logging.getLogger(__name__)
 
-#: override keys that do not change a run's results (ignored when matching runs)
+#: override keys that do not change a run's results (ignored when matching runs; the config keys among them
+#: are :data:`bionav.runrecord.NEUTRAL_KEYS`)
 NEUTRAL_KEYS = ("hydra", "hydra/launcher", "bionav.resume", "workers")
 #: file marking a finished multirun (all jobs completed)
 SWEEP_DONE = ".thesis_sweep_done"
@@ -190,12 +191,45 @@ def index_runs(root: Path) -> dict[str, Path]:
             continue
         if not isinstance(overrides, list):  # not written by Hydra: not a run of ours
             continue
+        if not recorded_as_composed(run_dir, tuple(str(o) for o in overrides)):
+            continue  # its record is not what these overrides give (changed defaults, a rewritten record)
         found.setdefault(canonical_key([str(o) for o in overrides]), run_dir)
     for marker in root.rglob(SWEEP_DONE):
         info = read_json(marker)
         if info and "key" in info:
             found.setdefault(str(info["key"]), marker.parent)
     return found
+
+
+@lru_cache(maxsize=4096)
+def _composed(overrides: tuple[str, ...]) -> dict | None:
+    """The configuration ``python -m bionav <overrides>`` composes today (None: it does not compose)."""
+    from bionav.config import compose, register_configs
+    from bionav.runrecord import plain_config
+
+    register_configs()
+    try:
+        return plain_config(compose([o for o in overrides if not o.startswith("hydra")]))
+    except Exception:  # an override of an older bionav: nothing to reuse
+        return None
+
+
+def recorded_as_composed(run_dir: Path, overrides: tuple[str, ...]) -> bool:
+    """True when ``run_dir`` recorded the configuration its overrides compose to today.
+
+    The reuse of completed runs applies the comparison of ``bionav.resume=true``
+    (:func:`bionav.runrecord.config_differences`, neutral keys ignored), so a run is
+    reused only for the configuration it was made with.
+    """
+    from bionav.errors import UserError
+    from bionav.runrecord import config_differences, recorded_config
+
+    try:
+        recorded = recorded_config(run_dir)
+    except UserError:
+        return False
+    composed = _composed(overrides)
+    return recorded is not None and composed is not None and not config_differences(composed, recorded)
 
 
 def sweep_jobs(sweep_dir: Path) -> list[tuple[Path, dict | None]]:
@@ -394,7 +428,7 @@ class Runner:
         _move_aside(run_dir)
         run_dir.parent.mkdir(parents=True, exist_ok=True)
         cmd = [sys.executable, "-m", "bionav.experiments.merge", str(run_dir), *(str(p.dir) for p in parts)]
-        proc = subprocess.run(cmd, capture_output=True, text=True, env=self.env)
+        proc = subprocess.run(cmd, capture_output=True, text=True, errors="replace", env=self.env)
         metrics = read_json(run_dir / "metrics.json")
         if proc.returncode != 0 or not metrics or metrics.get("status") != "completed":
             return RunResult(spec, None, None, f"merging its {len(parts)} tasks failed: "

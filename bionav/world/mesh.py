@@ -239,6 +239,10 @@ def load_mesh(path) -> TriangleMesh:
     problem = not_a_regular_file(p)  # a FIFO or a device would block the reader or never end
     if problem is not None:
         raise UserError(f"mesh file {p} {problem}; give db.path=FILE pointing at a {', '.join(MESH_SUFFIXES)} file.")
+    from bionav.datafile import checked_path
+
+    checked_path(p, what="mesh file", kind="mesh", fix=f"Give db.path=FILE pointing at a {', '.join(MESH_SUFFIXES)} "
+                 "file of a world (decimate a larger reconstruction, e.g. with MeshLab).")
     suffix = p.suffix.lower()
     if suffix == ".mat":
         return _load_mat(p)

@@ -179,6 +179,23 @@ def render_ray_grid(scene: Scene | CompiledScene, *, position: Sequence[float], 
     return out
 
 
+def renderer_compiled() -> bool:
+    """True when the render kernel's compiled code is at hand (this process, or numba's on-disk cache)."""
+    from bionav.files import numba_cached
+
+    return numba_cached(render_kernel)
+
+
+def prepare_renderer(scene: Scene | CompiledScene) -> None:
+    """Compile (or load from numba's cache) the render kernel for ``scene`` before a long render.
+
+    One ray is rendered: the same argument types as every view of the scene, so the views that follow
+    run at their own speed and a progress bar's rate (and ETA) is the render's, not the compiler's.
+    """
+    render_ray_grid(scene, position=(0.0, 0.0, 0.0), azimuths=np.zeros(1), elevations=np.zeros(1),
+                    pixel_angle=1e-3)
+
+
 def render_depth(scene: Scene | CompiledScene, *, position: Sequence[float], heading: float = 0.0,
                  geometry: PanoramaGeometry, threads: int | None = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Distance to the nearest surface for every pixel of a canonical panorama.

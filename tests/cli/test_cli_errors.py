@@ -55,13 +55,21 @@ def test_unwritable_output_dir(tmp_path):
 
 
 def test_failed_run_writes_failed_metrics(tmp_path):
+    """A run refused at start into a folder the user made keeps its record there (metrics.json says failed);
+    into a new folder it leaves none behind (issue 45)."""
     run_dir = tmp_path / "run"
+    run_dir.mkdir()
     proc = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path / 'nowhere'}", f"hydra.run.dir={run_dir}",
                       cwd=tmp_path)
     assert_fails_cleanly(proc, "nowhere does not exist")
     metrics = json.loads((run_dir / "metrics.json").read_text())
     assert metrics["status"] == "failed" and "nowhere does not exist" in metrics["error"]
     assert (run_dir / "run.mcap").stat().st_size > 0
+    fresh = tmp_path / "fresh"
+    proc = run_bionav("experiment=pol_recordings", f"recordings.path={tmp_path / 'nowhere'}", f"hydra.run.dir={fresh}",
+                      cwd=tmp_path)
+    assert_fails_cleanly(proc, "nowhere does not exist", "no run directory was left behind")
+    assert not fresh.exists()
 
 
 def test_an_unknown_experiment_is_refused_before_the_run(tmp_path):

@@ -12,19 +12,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from helpers import assert_fails_cleanly, run_bionav, run_into_closed_pipe, write_tiny_folder
-
-#: a refusal comes before any work: Python, Hydra and the config composition only (a loaded 2-core machine)
-REFUSAL_S = 120
-
-
-@pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    return write_tiny_folder(tmp_path_factory.mktemp("db") / "tiny")
-
-
-def run_tiny(tiny, *args, cwd, env=None):
-    return run_bionav("homing=mfdid", "db=folder", f"db.path={tiny}", *args, cwd=cwd, env=env)
+from helpers import REFUSAL_S, assert_fails_cleanly, run_bionav, run_into_closed_pipe, run_tiny
 
 
 @pytest.fixture(scope="module")

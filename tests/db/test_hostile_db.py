@@ -64,6 +64,10 @@ def test_stray_file_outside_declared_grid_can_be_skipped(tmp_path):
 def test_one_image_database_is_a_user_error_not_nan(tmp_path):
     folder = make_folder(tmp_path / "db", [(0, 0)])
     proc = run_folder(tmp_path, folder)
+    assert_fails_cleanly(proc, "has 1 usable image(s)", "at least 2", "no run directory was left behind")
+    assert not (tmp_path / "run").exists()  # refused at start (issue 45)
+    (tmp_path / "run").mkdir()  # into a folder the user made, the failure is recorded there
+    proc = run_folder(tmp_path, folder)
     assert_fails_cleanly(proc, "has 1 usable image(s)", "at least 2")
     metrics = strict_metrics(tmp_path / "run")
     assert metrics["status"] == "failed" and "at least 2" in metrics["error"]

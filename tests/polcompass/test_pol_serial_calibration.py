@@ -71,7 +71,7 @@ def test_bad_calibration_options_are_clear_errors(tmp_path):
         PolCompassSerial(PolCompassSerialConfig(calibration=str(two)))
     broken = tmp_path / "broken.json"
     broken.write_text(json.dumps({"center_v": [2.5]}))
-    with pytest.raises(UserError, match="center_v, volts_per_decade and unit_angles"):
+    with pytest.raises(UserError, match="broken.json: field 'volts_per_decade' is missing"):
         PolCompassSerial(PolCompassSerialConfig(calibration=str(broken)))
 
 

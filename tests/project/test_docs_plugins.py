@@ -3,6 +3,8 @@
 import re
 from pathlib import Path
 
+import pytest
+
 DOC = Path(__file__).resolve().parents[2] / "docs" / "plugins.md"
 
 
@@ -34,8 +36,8 @@ def test_plugin_docs_snippets_run():
     from bionav.config import plugin_node_class
     from bionav.testing import assert_homing_plugin
 
-    assert_homing_plugin(namespace["DarkCentroidHoming"])
-    for cls in ("DarkCentroidHoming", "RowMax", "NoisyCounter", "StraightController", "BrightSide", "NearestView"):
+    assert_homing_plugin(namespace["HorizonWarpHoming"])
+    for cls in ("HorizonWarpHoming", "RowMax", "NoisyCompass", "StraightController", "BrightSide", "NearestView"):
         plugin_node_class("x", namespace[cls].Config)  # Hydra can store every Config
 
 
@@ -47,9 +49,11 @@ def test_plugin_docs_example_rejects_bad_values():
     from bionav.errors import UserError
     from bionav.geometry import PanoramaGeometry
 
-    cls = namespace["DarkCentroidHoming"]
+    cls = namespace["HorizonWarpHoming"]
     with pytest.raises(UserError, match="homing.band_deg"):
         cls(cls.Config(band_deg=0.0), geometry=PanoramaGeometry.square_pixels(64, 16))
+    with pytest.raises(UserError, match=r"homing.directions=2: .*>= 4 and <= 720"):
+        cls(cls.Config(directions=2), geometry=PanoramaGeometry.square_pixels(64, 16))
 
 
 def test_render_pillar_panorama_is_exported():
@@ -101,3 +105,72 @@ def test_plugin_docs_complete_pyproject_names_the_documented_plugins():
                 assert attr in namespace, f"{group} {name} = {target}: no such class in the snippets"
                 # the short registration line of each section names the same target
                 assert f'{name} = "{target}"' in DOC.read_text().split("## A complete")[0], target
+
+
+def _install_docs_plugins(site):
+    """The page's homing method and sensor as an installed distribution (entry points as the page registers them)."""
+    from helpers import install_plugin_dist
+
+    snippets = _snippets()
+    homing = next(s for s in snippets if "class HorizonWarpHoming" in s)
+    sensor = next(s for s in snippets if "class NoisyCompass" in s)
+    return install_plugin_dist(site, "my-bionav-plugins", {
+        "bionav.homing": {"horizon_warp": "my_homing:HorizonWarpHoming"},
+        "bionav.sensors": {"noisy_compass": "my_sensors:NoisyCompass"}}, {"my_homing": homing, "my_sensors": sensor})
+
+
+def test_the_docs_homing_example_refuses_a_bad_range_before_the_run(tmp_path):
+    """`homing=horizon_warp homing.directions=2`: its `bounded` range refuses the value before Hydra makes a run
+    directory, one message naming the key and the range (issue 39: the check used to come after the start)."""
+    from helpers import assert_fails_cleanly, pythonpath_with, run_bionav
+
+    site = _install_docs_plugins(tmp_path / "site")
+    proc = run_bionav("homing=horizon_warp", "homing.directions=2", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path,
+                      env=pythonpath_with(site))
+    assert_fails_cleanly(proc, "homing.directions=2", ">= 4 and <= 720", code=2)
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.slow
+def test_the_docs_homing_example_homes_better_than_chance_on_the_default_database(tmp_path):
+    """`python -m bionav homing=horizon_warp` as the page shows it (issue 45: the earlier example scored AAE* 2.28)."""
+    import json
+
+    from helpers import pythonpath_with, run_bionav
+
+    from bionav.files import default_cache_dir
+
+    site = _install_docs_plugins(tmp_path / "site")
+    env = {**pythonpath_with(site), "BIONAV_CACHE": str(default_cache_dir())}  # the shared render of sim_original
+    proc = run_bionav("homing=horizon_warp", f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path, env=env)
+    assert proc.returncode == 0, proc.stderr
+    metrics = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    # a guess scores AAE* pi/2 and RR* about 0.02 here; the page states AAE* 0.47 rad, RR* 0.81
+    assert metrics["aae"] < 0.7 and metrics["rr"] > 0.6, metrics
+
+
+@pytest.mark.slow
+def test_the_docs_sensor_example_runs_in_the_named_experiment(tmp_path):
+    """`experiment=pol_compass mode=rotation sensor=noisy_compass` as the page shows it: completed, and its
+    heading errors grow with the board noise; a sensor with other readings is refused before the session."""
+    import json
+
+    from helpers import assert_fails_cleanly, pythonpath_with, run_bionav
+
+    site = _install_docs_plugins(tmp_path / "site")
+    env = pythonpath_with(site)
+    rmse = {}
+    for noise in (0, 8):
+        run_dir = tmp_path / f"noise{noise}"
+        proc = run_bionav("experiment=pol_compass", "mode=rotation", "sensor=noisy_compass",
+                          f"sensor.extra_noise_counts={noise}", f"hydra.run.dir={run_dir}", cwd=tmp_path, env=env)
+        assert proc.returncode == 0, proc.stderr
+        metrics = json.loads((run_dir / "metrics.json").read_text())
+        assert metrics["status"] == "completed"
+        rmse[noise] = metrics["heading_rmse_deg"]
+    assert rmse[0] < 3.0 < rmse[8], rmse
+    proc = run_bionav("experiment=pol_compass", "mode=rotation", "sensor=spectral5_sim",
+                      f"hydra.run.dir={tmp_path / 'wrong'}", cwd=tmp_path)
+    assert_fails_cleanly(proc, "sensor=spectral5_sim", "experiment=pol_compass reads bionav.PolCompassReading",
+                         code=2)
+    assert not (tmp_path / "wrong").exists()

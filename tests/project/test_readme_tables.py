@@ -43,3 +43,21 @@ def test_readme_names_every_entry_point_group():
     text = README.read_text()
     for group in (*GROUPS.values(), CONFIG_GROUP, SCHEMA_GROUP):
         assert f"`{group}`" in text, group
+
+
+def test_readme_dependencies_are_the_installed_ones():
+    """README's "Dependencies and why" names every required dependency of pyproject.toml and no other
+    (issue 45: it listed scikit-image, which nothing used); a library it says is not used is not imported."""
+    import tomllib
+
+    project = tomllib.loads((README.parent / "pyproject.toml").read_text())["project"]
+    required = [re.split(r"[<>=!~ \[]", d, maxsplit=1)[0] for d in project["dependencies"]]
+    section = README.read_text().split("### Dependencies and why", 1)[1].split("\n### ", 1)[0]
+    named, _, not_used = section.partition("is not used")
+    missing = [d for d in required if d.lower() not in named.lower()]
+    assert missing == [], f"README does not name {missing}"
+    for extra in ("parallel", "slurm", "tune"):
+        assert f"bionav[{extra}]" in section and extra in project["optional-dependencies"]
+    assert "scikit-image" in named.rsplit(".", 1)[-1] and "scikit-image" not in required  # said: not used
+    sources = "\n".join(p.read_text(encoding="utf-8") for p in (README.parent / "bionav").rglob("*.py"))
+    assert not re.search(r"^\s*(import skimage|from skimage)", sources, flags=re.MULTILINE)

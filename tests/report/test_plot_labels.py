@@ -50,7 +50,34 @@ def test_per_snapshot_maps_have_whole_cell_ticks_and_named_axes(tmp_path, figure
     for ax in [*maps.axes[:2], field.axes[0]]:  # maps: two heatmaps, then their colour bars
         assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (grid cells)", "y (grid cells)")
         _whole_cell_ticks(ax)
-    assert [c.get_ylabel() for c in maps.axes[2:]] == ["AAE$_s$ (rad)", "RR$_s$"]
+    # AAE_s is capped at pi/2: its colour bar says what the overflow colour means (issue 45)
+    assert [c.get_ylabel() for c in maps.axes[2:]] == ["AAE$_s$ (rad), cyan > 1.57", "RR$_s$"]
+
+
+def test_home_vector_field_legend_names_every_colour_and_marker(tmp_path, figures):
+    """Issue 45: the red (failed) arrows, the crosses of cells without a direction, the agents' paths and the
+    snapshot star each have a legend entry, and the AAE map draws errors above pi/2 in the named over colour."""
+    from matplotlib.colors import to_rgba
+
+    from bionav.experiments.grid_homing.plots import plot_home_vector_field, plot_per_snapshot_maps
+
+    pos = np.array([[0, 0], [1, 0], [0, 1], [1, 1]])
+    plot_home_vector_field(tmp_path / "h.png", positions=pos, angles=np.array([np.nan, 0.5, 1.0, 2.0]),
+                           snapshot=pos[0], grid_shape=(2, 2), title="t", success=np.array([False, True, False, True]),
+                           paths=[np.array([[1.0, 0.0], [0.5, 0.0]])])
+    plot_per_snapshot_maps(tmp_path / "p.png", positions=pos, grid_shape=(2, 2), aae_s=np.array([0.1, 2.5, 0.3, 3.0]),
+                           rr_s=np.array([1.0, 0.0, 0.5, 0.0]), title="t")
+    field, maps = figures()
+    legend = next(ax.get_legend() for ax in field.axes if ax.get_legend() is not None)
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert labels == ["home vector (its return agent reached the snapshot)", "home vector (its return agent failed)",
+                      "no direction given", "return agents' paths", "snapshot position"]
+    colours = [to_rgba(h.get_color()) for h in legend.legend_handles[:2]]
+    arrows = field.axes[0].collections[0].get_facecolors()
+    assert {tuple(c) for c in arrows} == {tuple(colours[0]), tuple(colours[1])}  # blue and red, both named
+    image = maps.axes[0].get_images()[0]
+    assert to_rgba(image.get_cmap().get_over()) == to_rgba("tab:cyan")
+    assert maps.axes[2].get_ylabel() == "AAE$_s$ (rad), cyan > 1.57"
 
 
 def test_world_routes_legend_names_every_line_and_the_title_matches(tmp_path, figures):
@@ -137,3 +164,37 @@ def test_cleaning_legends_stand_beside_or_below_the_maps(tmp_path, figures):
         assert _legend_clear_of_axes(fig, ax)
     labels = [t.get_text() for t in traj.axes[0].get_legend().get_texts()]
     assert labels[:3] == ["obstacle outlines", "target area", "ideal meander"] and len(labels) == 3 + 2  # 2 runs
+
+
+def test_sweep_figure_draws_the_metric_over_the_swept_values(tmp_path):
+    """summary.png of a sweep (issue 45): one panel per metric (AAE*, RR*), x the first swept key, one series per
+    value of the others, failed jobs left out and counted."""
+    from bionav.report.sweep_figure import plot_sweep
+
+    rows = [{"job": "0", "homing": "sift", "db": "a", "status": "completed", "aae": 0.5, "rr": 0.9},
+            {"job": "1", "homing": "mfdid", "db": "a", "status": "completed", "aae": 0.8, "rr": 0.6},
+            {"job": "2", "homing": "sift", "db": "b", "status": "completed", "aae": 0.4, "rr": 0.95},
+            {"job": "3", "homing": "mfdid", "db": "b", "status": "failed", "error": "x"}]
+    captured = {}
+    import matplotlib.figure
+
+    original = matplotlib.figure.Figure.savefig
+
+    def keep(fig, *args, **kwargs):
+        captured["fig"] = fig
+        return original(fig, *args, **kwargs)
+
+    matplotlib.figure.Figure.savefig = keep
+    try:
+        path = plot_sweep(tmp_path, rows, ["homing", "db"])
+    finally:
+        matplotlib.figure.Figure.savefig = original
+    assert path == tmp_path / "summary.png" and path.stat().st_size > 0
+    fig = captured["fig"]
+    aae_ax, rr_ax = fig.axes[:2]
+    assert aae_ax.get_xlabel() == "homing" and aae_ax.get_ylabel() == "AAE* (rad)"
+    assert rr_ax.get_ylabel() == "RR* (fraction of agents home)"
+    series = {line.get_label(): list(line.get_ydata()) for line in aae_ax.get_lines()}
+    assert series == {"db=a": [0.5, 0.8], "db=b": [0.4]}  # x positions: sift 0, mfdid 1; the failed job not drawn
+    assert "1 failed (not drawn)" in fig._suptitle.get_text()
+    assert plot_sweep(tmp_path, rows[:1], ["homing"]) is None  # nothing varies

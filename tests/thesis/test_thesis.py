@@ -75,12 +75,24 @@ def test_product_blocks_cover_every_run_exactly_once():
 
 
 def test_index_finds_completed_runs_only(tmp_path):
-    for name, status, overrides in (("r1", "completed", ["db=sim_uni", "homing=sift"]),
-                                    ("r2", "failed", ["db=sim_hall1"])):
+    """Completed runs whose recorded configuration is what their overrides compose to (issue 45: a record that
+    describes another run, or none, is not reused)."""
+    from omegaconf import OmegaConf
+
+    from bionav.config import compose, register_configs
+
+    register_configs()
+    for name, status, overrides, edit in (("r1", "completed", ["db=sim_uni", "homing=sift"], None),
+                                          ("r2", "failed", ["db=sim_hall1"], None),
+                                          ("r3", "completed", ["db=sim_hall2"], "seed: 0"),
+                                          ("r4", "completed", ["db=sim_day"], "no record")):
         d = tmp_path / "runs" / name
         (d / ".hydra").mkdir(parents=True)
         (d / ".hydra" / "overrides.yaml").write_text(yaml.safe_dump(overrides))
         (d / "metrics.json").write_text(json.dumps({"status": status}))
+        if edit != "no record":
+            text = OmegaConf.to_yaml(compose(overrides))
+            (d / ".hydra" / "config.yaml").write_text(text.replace(edit, "seed: 7") if edit else text)
     index = index_runs(tmp_path)
     assert index == {canonical_key(["homing=sift", "db=sim_uni"]): tmp_path / "runs" / "r1"}
 

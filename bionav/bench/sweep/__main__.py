@@ -15,7 +15,7 @@ def _sweep(launcher_args: list[str], overrides: list[str], sweep_dir: Path) -> f
     t0 = time.perf_counter()
     proc = subprocess.run(
         [sys.executable, "-m", "bionav", "-m", *overrides, *launcher_args, f"hydra.sweep.dir={sweep_dir}"],
-        capture_output=True, text=True,
+        capture_output=True, text=True, errors="replace",
     )
     elapsed = time.perf_counter() - t0
     if proc.returncode != 0:

@@ -14,6 +14,7 @@ import numpy as np
 from bionav.errors import UserError
 from bionav.evaluation.measures import quality_measures
 from bionav.experiments.grid_homing.plots import plot_per_snapshot_maps
+from bionav.experiments.grid_homing.resume import nan_floats
 from bionav.experiments.grid_homing.run import HOME_VECTOR_SCHEMA, write_per_snapshot_csv
 from bionav.experiments.runner import LOG_FILE
 from bionav.experiments.tasks import check_blocks, finish_merge, merge_target, read_task
@@ -23,10 +24,6 @@ from bionav.logs.writer import McapLog
 _HV_TOPIC = "/grid_homing/home_vectors"
 #: metrics every task of one run shares
 _TASK_SHARED = ("experiment", "homing", "db", "n_images")
-
-
-def _floats(values: Sequence[Any]) -> np.ndarray:
-    return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
 
 
 def merge(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
@@ -70,7 +67,7 @@ def merge(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
             rows[index] = (d, msg)
     check_blocks(metas)
     order = sorted(rows)
-    ae = np.stack([_floats(rows[i][1]["ae"]) for i in order])
+    ae = np.stack([nan_floats(rows[i][1]["ae"]) for i in order])
     success = np.stack([np.asarray(rows[i][1]["success"], dtype=bool) for i in order])
     compass = [rows[i][1].get("compass_error") for i in order]
     q = quality_measures(ae, success)
@@ -83,7 +80,7 @@ def merge(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
                    ms_per_home_vector=float(np.dot(ms, n_pairs) / max(1, sum(n_pairs))))
     metrics.update({k: v for k, v in metas[0].items() if k.endswith("_per_image")})
     if all(c is not None for c in compass):
-        metrics["compass_aae"] = float(np.nanmean(np.abs(np.concatenate([_floats(c) for c in compass]))))
+        metrics["compass_aae"] = float(np.nanmean(np.abs(np.concatenate([nan_floats(c) for c in compass]))))
     metrics.update(status="completed", tasks=len(metas),
                    wall_time_s=round(sum(float(m.get("wall_time_s", 0.0)) for m in metas), 3))
 

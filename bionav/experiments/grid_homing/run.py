@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from omegaconf import OmegaConf
 
 from bionav.errors import UserError
 from bionav.evaluation.agent import evaluate_agents
@@ -22,6 +23,7 @@ from bionav.evaluation.pairs import home_vector_matrix
 from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
 from bionav.experiments.grid_homing.config import GridHomingConfig
 from bionav.experiments.grid_homing.plots import plot_fields
+from bionav.experiments.grid_homing.resume import ROWS_TOPIC, resumed_rows, with_resumed_rows
 from bionav.experiments.tasks import block_of
 from bionav.files import write_csv_atomic
 
@@ -82,7 +84,7 @@ def _row_loggers(ctx, db):
         """Each snapshot's home vectors as soon as they are computed (a crash loses no finished row)."""
         ae_row = angular_errors(angles[None], ideal_home_angles(db.positions[[si]], db.positions))[0]
         ctx.log.write(
-            "/grid_homing/snapshot_rows",
+            ROWS_TOPIC,
             {"snapshot": db.positions[si], "angles": _finite_or_none(angles), "ae": _finite_or_none(ae_row),
              "compass_error": _finite_or_none(compass)},
             schema_name="bionav.HomeVectorRow",
@@ -144,10 +146,16 @@ def run(exp: GridHomingConfig, ctx) -> dict[str, Any]:
         snapshots = block_of(exp.block, range(len(db)) if snapshots is None else snapshots)
 
     log_row, log_partial = _row_loggers(ctx, db)
+    wanted = list(range(len(db))) if snapshots is None else [int(v) for v in snapshots]
+    done = resumed_rows(ctx, db, wanted, resume=bool(OmegaConf.select(cfg, "bionav.resume", default=False)))
+    for si in (si for si in wanted if si in done):  # the new log holds every row, the earlier attempt's too
+        log_row(si, *done[si])
     hv = home_vector_matrix(
-        method, db, snapshot_index=snapshots, workers=int(cfg.workers), progress=ctx.progress,
-        cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial, device=str(cfg.get("device") or "cpu"),
+        method, db, snapshot_index=[si for si in wanted if si not in done], workers=int(cfg.workers),
+        progress=ctx.progress, cache=prepared_cache(cfg), on_row=log_row, on_partial=log_partial,
+        device=str(cfg.get("device") or "cpu"),
     )
+    hv = with_resumed_rows(hv, done, wanted)
     s_pos = db.positions[hv.snapshot_index]
     ae = angular_errors(hv.angles, ideal_home_angles(s_pos, db.positions))
     n_plots = min(exp.n_quiver_plots, len(hv.snapshot_index))
@@ -170,6 +178,8 @@ def run(exp: GridHomingConfig, ctx) -> dict[str, Any]:
         "n_pairs": hv.n_pairs,
         "ms_per_home_vector": hv.ms_per_home_vector,
     }
+    if done:  # rows of the earlier attempt: their pairs count, the time per home vector is this attempt's
+        metrics.update(n_pairs=hv.n_pairs + len(done) * (len(db) - 1), resumed_rows=len(done))
     if exp.block is not None:
         metrics["block"] = [int(v) for v in exp.block]
     metrics.update({f"{k}_per_image": v for k, v in hv.prepared_stats.items()})

@@ -75,7 +75,7 @@ def _calibration(exp, volts, pans, tilts, *, unit_angles, out_dir, fixed=None):
     else:  # "file" (experiment.calibration's declared choices)
         if not exp.calibration_path:
             raise UserError("experiment.calibration=file needs experiment.calibration_path=<calibration.json of a rotation run>.")
-        cal = UnitCalibration.load(exp.calibration_path)
+        cal = UnitCalibration.load(exp.calibration_path, units=len(unit_angles))
     if out_dir is not None:
         cal.save(out_dir / "calibration.json")
     return cal, how

@@ -62,6 +62,8 @@ from bionav.experiments.pol_compass.session import (
 )
 from bionav.validation import typed_config
 
+#: the readings experiment=pol_compass reads: the compass' counts per line, recorded POL-OP arrays, a replayed log
+SENSOR_READINGS = ("bionav.PolCompassReading", "bionav.PolOpArrayReading", "bionav.ReplayedReading")
 
 # ---------------------------------------------------------------------------
 # glue
@@ -185,13 +187,25 @@ def _recorded_array(node: dict) -> bool:
     return False
 
 
+def _check_reading_kind(sensor_class, name) -> None:
+    """Refuse a sensor whose readings experiment=pol_compass cannot read (before the session, not after a rotation)."""
+    kind = getattr(sensor_class, "schema_name", None)
+    if kind not in SENSOR_READINGS:
+        raise UserError(f"sensor={name} gives {kind} readings, but experiment=pol_compass reads "
+                        f"{' or '.join(SENSOR_READINGS[:2])} (counts per POL-OP line or unit); choose sensor="
+                        "polcompass_sim, polcompass_serial, recording or replay, or a plugin giving such readings "
+                        "(docs/plugins.md, 'Sensors').")
+
+
 def run(exp: PolCompassConfig, ctx) -> dict[str, Any]:
     """Run ``experiment=pol_compass`` with the checked ``exp`` (the rest of the config in ``ctx.cfg``)."""
-    from bionav.polcompass import CompassScene
+    from bionav.polcompass import CompassScene, UnitCalibration
 
     cfg = ctx.cfg
     if cfg.get("sensor") is None or not cfg.sensor.get("name"):
         raise UserError("experiment=pol_compass needs a compass: sensor=polcompass_sim, polcompass_serial or replay.")
+    if exp.calibration == "file" and exp.calibration_path:  # a bad file is refused before the session, not after it
+        UnitCalibration.load(exp.calibration_path, units=len(exp.unit_angles_deg))
     nodes = {
         "sensor": _node_dict(cfg.sensor),
         "pantilt": _node_dict(cfg.get("pantilt")) if cfg.get("pantilt") and cfg.pantilt.get("name") else None,
@@ -205,6 +219,7 @@ def run(exp: PolCompassConfig, ctx) -> dict[str, Any]:
         nodes["pantilt"] = None  # the recorded robot turned itself; its yaw is the reference
 
     classes = {role: registry.load_plugin("sensor", node["name"]) for role, node in nodes.items() if node is not None}
+    _check_reading_kind(classes.get("sensor"), (nodes["sensor"] or {}).get("name"))
     simulated = any(getattr(c, "simulated", False) for c in classes.values())
     fake_devices = exp.fake_devices
     needs_scene = simulated or fake_devices or exp.mode == "partial_sky"

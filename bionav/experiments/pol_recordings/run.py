@@ -412,7 +412,11 @@ def run(exp: PolRecordingsConfig, ctx) -> dict[str, Any]:
             "(e.g. recordings.path=../shared/data/celestial-compass)."
         )
     chosen, decoders = _decoders(cfg, ctx, exp)
-    prepared, bad_files = prepared_sessions(rc)
+    if rc.calibration not in ("none", "auto"):  # a bad calibration file is refused before the recordings load
+        from bionav.polcompass.array_calibration import ArrayCalibration
+
+        ArrayCalibration.load(rc.calibration)
+    prepared, bad_files = prepared_sessions(rc, progress=ctx.progress)
     calibration_for = _calibration_for(prepared, rc, ctx, decoders[chosen])
     tally = _score_all(ctx, exp, rc, prepared, calibration_for, decoders, chosen)
     if not tally.session_rows:

@@ -52,6 +52,7 @@ along each route, heading-error maps).
 
 from __future__ import annotations
 
+import logging
 import zlib
 from typing import Any
 
@@ -65,6 +66,8 @@ from bionav.experiments.route_homing.config import RouteHomingConfig
 from bionav.experiments.route_homing import shared
 from bionav.plugins.signatures.zernike import Zernike
 
+log = logging.getLogger(__name__)
+
 
 def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     """Run ``experiment=route_homing`` (``protocol=bionav``) with the checked ``exp`` (the rest in ``ctx.cfg``)."""
@@ -76,6 +79,7 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     rows = []
     per_route = {}
     for name in routes:
+        log.info("route %s: loading its world and route views (rendered once, then cached) ...", name)
         setup = shared.route_setup(cfg, name)
         homing = make_homing(cfg, ctx, setup.geometry) if "homing" in exp.methods else None
         zernike = Zernike({"order": exp.zernike_order}) if "zernike" in exp.methods else None
@@ -99,7 +103,8 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
                 path, completed, dist = closed_loop(
                     f, render, start_offset_m=exp.start_offset_m, agent_step_m=exp.agent_step_m,
                     max_steps_factor=exp.max_steps_factor, success_radius_m=exp.success_radius_m,
-                    give_up_m=exp.give_up_m, lookahead=exp.lookahead)
+                    give_up_m=exp.give_up_m, lookahead=exp.lookahead, progress=lambda it, n=name, m=method, **kw:
+                    ctx.progress(it, desc=f"{n} {m} closed loop (steps)", **kw))
                 row.update({"completed": bool(completed), "route_distance_m": dist, "steps": len(path) - 1})
                 res["path"] = path
                 ctx.log.write(shared.PATH_TOPIC, {"route": name, "method": method, "xy": path.tolist(),

@@ -53,12 +53,15 @@ def read_topics(path) -> dict[str, list[dict]]:
     from mcap.exceptions import McapError
     from mcap.reader import NonSeekingReader
 
+    from bionav.logs.recover import check_mcap
+
     p = Path(path)
     if not p.is_file():
         raise UserError(
             f"The log to replay, {p}, does not exist. Set sensor.path=/pantilt.path= to the run.mcap of a "
             "recorded run (it lies in that run's output directory)."
         )
+    check_mcap(p)  # not a FIFO or a device, within the size of a log, an MCAP file
     out: dict[str, list[dict]] = {}
     try:
         with p.open("rb") as f:
