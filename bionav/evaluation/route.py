@@ -175,13 +175,15 @@ class StepResult:
 
 def protocol_step(choose_heading: Callable[[np.ndarray, float], float], position: np.ndarray, heading: float, *,
                   route_xy: np.ndarray, route_heading: np.ndarray, nest_xy: np.ndarray, step_m: float,
-                  putback_m: float, goal_m: float, jitter_m: float = 0.0,
+                  putback_m: float, goal_m: float, jitter_m: float = 0.0, heading_noise: float = 0.0,
                   rng: np.random.Generator | None = None) -> StepResult:
     """One step of the route-following test of Ardin et al. 2016 (doi:10.1371/journal.pcbi.1004683).
 
     ``heading = choose_heading(position, heading)`` (the agent's scan and choice; NaN keeps
-    the heading), a step of ``step_m`` along it, isotropic Gaussian position noise of
-    ``jitter_m`` per axis; the nest is reached within ``goal_m`` of ``nest_xy``; otherwise,
+    the heading), Gaussian heading noise of std ``heading_noise`` radians added to it (the
+    agent walks a little off the heading it chose; not in the paper), a step of ``step_m``
+    along it, isotropic Gaussian position noise of ``jitter_m`` per axis (drawn after the
+    heading noise); the nest is reached within ``goal_m`` of ``nest_xy``; otherwise,
     farther than ``putback_m`` from the route polyline (strictly), the agent is put on the
     *nearest* route view, facing ``route_heading`` there (an error).
 
@@ -200,6 +202,8 @@ def protocol_step(choose_heading: Callable[[np.ndarray, float], float], position
     nest_xy : ndarray, shape (2,)
     step_m, putback_m, goal_m, jitter_m : float
         Metres; ``jitter_m > 0`` needs ``rng``.
+    heading_noise : float
+        Radians (std); ``> 0`` needs ``rng``.
 
     Returns
     -------
@@ -208,6 +212,10 @@ def protocol_step(choose_heading: Callable[[np.ndarray, float], float], position
     new = choose_heading(position, heading)
     if np.isfinite(new):
         heading = float(new)
+    if heading_noise > 0:
+        if rng is None:
+            raise ValueError("heading_noise > 0 needs an rng")
+        heading = float(heading + rng.normal(0.0, heading_noise))
     pos = np.asarray(position, np.float64) + step_m * np.array([math.cos(heading), math.sin(heading)])
     if jitter_m > 0:
         if rng is None:
@@ -224,11 +232,13 @@ def protocol_step(choose_heading: Callable[[np.ndarray, float], float], position
 
 def follow_route(choose_heading: Callable[[np.ndarray, float], float], *, route_xy: np.ndarray,
                  route_heading: np.ndarray, nest_xy: np.ndarray, step_m: float, putback_m: float,
-                 goal_m: float, max_steps: int, jitter_m: float = 0.0, rng: np.random.Generator | None = None,
+                 goal_m: float, max_steps: int, jitter_m: float = 0.0, heading_noise: float = 0.0,
+                 start_offset_m: float = 0.0, rng: np.random.Generator | None = None,
                  on_putback: Callable[[int], None] | None = None) -> RouteRun:
     """Walk an agent along a route with the put-back rule of Ardin et al. 2016 (doi:10.1371/journal.pcbi.1004683).
 
-    The agent starts on route view 0 facing ``route_heading[0]`` and takes
+    The agent starts on route view 0 (``start_offset_m`` to its left, across ``route_heading[0]``;
+    the paper starts on the view) facing ``route_heading[0]`` and takes
     :func:`protocol_step` after step until it reaches the nest or ``max_steps``
     steps are taken; every put-back is an error, and ``on_putback(index)``
     tells the agent where it was put.
@@ -248,18 +258,22 @@ def follow_route(choose_heading: Callable[[np.ndarray, float], float], *, route_
         Step budget.
     jitter_m : float
         Metres; needs ``rng`` when positive.
+    heading_noise : float
+        Radians, the std of the noise added to every chosen heading (:func:`protocol_step`); needs ``rng``.
+    start_offset_m : float
+        Metres, left positive.
     """
     route_xy = np.asarray(route_xy, np.float64)
-    if jitter_m > 0 and rng is None:
-        raise ValueError("jitter_m > 0 needs an rng")
-    pos = route_xy[0].copy()
+    if (jitter_m > 0 or heading_noise > 0) and rng is None:
+        raise ValueError("jitter_m > 0 or heading_noise > 0 needs an rng")
     heading = float(route_heading[0])
+    pos = route_xy[0] + float(start_offset_m) * lateral_normals(np.array([heading]))[0]
     path = [pos.copy()]
     steps, reached, putbacks = 0, False, []
     for steps in range(1, int(max_steps) + 1):
         r = protocol_step(choose_heading, pos, heading, route_xy=route_xy, route_heading=route_heading,
                           nest_xy=nest_xy, step_m=step_m, putback_m=putback_m, goal_m=goal_m, jitter_m=jitter_m,
-                          rng=rng)
+                          heading_noise=heading_noise, rng=rng)
         path.append(r.stepped_to.copy())
         pos, heading = r.position, r.heading
         if r.reached_nest:
@@ -330,9 +344,8 @@ def scan_views(panorama: np.ndarray, *, column_deg: float, scan_half_deg: float 
     if scan < 1 or pix < 1 or abs(scan * column_deg - scan_step_deg) > 1e-9 or abs(pix * column_deg - pixel_deg) > 1e-9:
         raise ValueError(f"scan step {scan_step_deg} deg and pixel {pixel_deg} deg must be whole multiples "
                          f"of the panorama's {column_deg} deg columns")
-    n_scan = int(round(scan_half_deg / scan_step_deg))
     n_pix = int(round(fov_deg / pixel_deg))
-    k = np.arange(-n_scan, n_scan + 1)
+    k = np.arange(-int(round(scan_half_deg / scan_step_deg)), int(round(scan_half_deg / scan_step_deg)) + 1)
     # pixel j of the view at offset k*scan: azimuth k*scan + (n_pix - 1)/2*pix - j*pix (in columns)
     half = (n_pix - 1) * pix / 2.0
     if abs(half - round(half)) > 1e-9:
@@ -340,7 +353,20 @@ def scan_views(panorama: np.ndarray, *, column_deg: float, scan_half_deg: float 
     cols = (k[:, None] * scan + int(round(half)) - np.arange(n_pix)[None] * pix) % w
     views = 1.0 - pano[:, cols].transpose(1, 0, 2)  # (S, H, n_pix), inverted
     views = equalize_histogram(views)
-    return resize_images(views, size), np.deg2rad(k * scan * column_deg)
+    return resize_images(views, size), scan_offsets(scan_half_deg=scan_half_deg, scan_step_deg=scan * column_deg)
+
+
+def scan_offsets(*, scan_half_deg: float, scan_step_deg: float) -> np.ndarray:
+    """The headings of a scan relative to the current one: ``-scan_half_deg .. +scan_half_deg`` in ``scan_step_deg``.
+
+    Returns
+    -------
+    ndarray, shape (S,)
+        Radians, counter-clockwise positive, ``S = 2 * round(scan_half_deg / scan_step_deg) + 1``
+        (the offsets of :func:`scan_views`).
+    """
+    n = int(round(scan_half_deg / scan_step_deg))
+    return np.deg2rad(np.arange(-n, n + 1) * float(scan_step_deg))
 
 
 def lateral_normals(headings: np.ndarray) -> np.ndarray:

@@ -46,18 +46,30 @@ class FamiliarityFollower:
         ``index``); the ``bionav.route_agents`` plugins.
     views : callable ``(xy, heading) -> (views (S, h, w), offsets (S,))``
         The scan at a pose (:func:`bionav.evaluation.route.scan_views` cuts it from a panorama).
+    offsets : ndarray, shape (S,), optional
+        The scan's offsets in radians (:func:`bionav.evaluation.route.scan_offsets`), needed
+        only for an agent with ``needs_views = False`` (``random_choice``): it gets ``S``
+        empty views of shape ``(S, 0)`` and nothing is rendered.
 
     Calling it returns ``heading + offsets[s]`` for the least unfamiliar view ``s``
     (ties: the one nearest straight ahead), or NaN (keep the heading) when no view has a
     finite unfamiliarity.
     """
 
-    def __init__(self, agent: Any, views: ScanViews) -> None:
+    def __init__(self, agent: Any, views: ScanViews, *, offsets: np.ndarray | None = None) -> None:
         self.agent = agent
         self.views = views
+        self.blind = not getattr(agent, "needs_views", True)
+        if self.blind and offsets is None:
+            raise ValueError("an agent that needs no views needs the scan offsets")
+        self.offsets = None if offsets is None else np.asarray(offsets, np.float64)
 
     def __call__(self, xy: np.ndarray, heading: float) -> float:
-        v, off = self.views(xy, heading)
+        if self.blind:
+            off = self.offsets
+            v = np.zeros((len(off), 0), np.float32)
+        else:
+            v, off = self.views(xy, heading)
         s = least_unfamiliar(self.agent.unfamiliarity(v), off)
         if s < 0:
             return float("nan")
@@ -136,11 +148,23 @@ def home_direction(homing: Any, prepared_target: Any, target_heading: float, ren
 class HomingFollower:
     """Heading chooser of a homing method following a route by homing to the view ahead.
 
-    Each call: the best route view by windowed RIDF (:func:`windowed_match`, window from the
-    last match), then the home direction to the view ``lookahead`` after it
-    (:func:`home_direction`); the turn from the current heading is limited to
-    ``+-max_turn`` radians (the familiarity agents' scan range). A put-back
-    (:meth:`reset`) moves the last match to the route view the agent was put on.
+    Each call:
+
+    1. **progress**: the best route view ``k`` by windowed RIDF (:func:`windowed_match`, from the
+       last match);
+    2. **target**: the view ``j = k + lookahead`` and the home direction to it (:func:`home_direction`);
+    3. **a passed view** (``passed="skip"``): a home direction more than 90 degrees from the
+       route direction at ``j`` means the agent is already past ``j`` (homing to it would turn
+       it round); it homes to ``j + 1`` instead, and so on, at most ``max_skip`` views further
+       (``passed="keep"`` homes to ``j`` whatever the direction);
+    4. **route direction** (``route_weight = w``): the heading is the direction of
+       ``(1 - w) * u_home + w * u_route``, unit vectors along the home direction and the route
+       direction stored with the target view (the compass heading of travel when it was stored);
+       ``w = 0`` homes, ``w = 1`` ignores the home vector;
+    5. the turn from the current heading is limited to ``+-max_turn`` radians (the familiarity
+       agents' scan range).
+
+    A put-back (:meth:`reset`) moves the last match to the route view the agent was put on.
 
     Parameters
     ----------
@@ -156,27 +180,64 @@ class HomingFollower:
         Metres.
     max_turn : float
         Radians.
+    passed : {"keep", "skip"}
+        What to do with a target view the agent has passed (step 3).
+    max_skip : int, optional
+        Views skipped at most per call (default ``lookahead``, at least 1).
+    route_weight : float
+        ``w`` in ``[0, 1]`` (step 4).
+    route_directions : ndarray, shape (K,), optional
+        Route direction at each view, radians CCW from ``+x`` (default ``snapshot_headings``).
     """
 
     def __init__(self, homing: Any, *, snapshots: np.ndarray, snapshot_headings: np.ndarray, render: Render,
-                 window: int, lookahead: int, test_step_m: float, max_turn: float) -> None:
+                 window: int, lookahead: int, test_step_m: float, max_turn: float, passed: str = "keep",
+                 max_skip: int | None = None, route_weight: float = 0.0,
+                 route_directions: np.ndarray | None = None) -> None:
+        if passed not in ("keep", "skip"):
+            raise ValueError(f"passed={passed!r}: use 'keep' or 'skip'")
+        if not 0.0 <= route_weight <= 1.0:
+            raise ValueError(f"route_weight={route_weight} outside [0, 1]")
         self.homing = homing
         self.snapshots = np.asarray(snapshots)
         self.headings = np.asarray(snapshot_headings, np.float64)
+        self.route_directions = self.headings if route_directions is None else np.asarray(route_directions, np.float64)
         self.prepared = [homing.prepare(img) for img in self.snapshots]
         self.render = render
         self.window, self.lookahead = int(window), int(lookahead)
         self.test_step_m, self.max_turn = float(test_step_m), float(max_turn)
+        self.passed, self.route_weight = passed, float(route_weight)
+        self.max_skip = max(1, self.lookahead) if max_skip is None else int(max_skip)
         self.last = 0
 
-    def __call__(self, xy: np.ndarray, heading: float) -> float:
+    def _home(self, xy: np.ndarray, j: int) -> float:
+        return home_direction(self.homing, self.prepared[j], float(self.headings[j]), self.render, xy,
+                              test_step_m=self.test_step_m)
+
+    def target_direction(self, xy: np.ndarray) -> tuple[float, int]:
+        """The home direction from ``xy`` (radians CCW from ``+x``, NaN if none) and the view it homes to."""
+        n = len(self.snapshots)
         _h, self.last = windowed_match(self.render(xy, 0.0), self.snapshots, self.headings, last=self.last,
                                        window=self.window)
-        target = min(self.last + self.lookahead, len(self.snapshots) - 1)
-        h = home_direction(self.homing, self.prepared[target], float(self.headings[target]), self.render, xy,
-                           test_step_m=self.test_step_m)
+        j = min(self.last + self.lookahead, n - 1)
+        h = self._home(xy, j)
+        if self.passed == "skip":
+            first = j
+            while (np.isfinite(h) and j < n - 1 and j - first < self.max_skip
+                   and abs(wrap_angle(h - self.route_directions[j])) > math.pi / 2):
+                j += 1
+                h = self._home(xy, j)
+        return h, j
+
+    def __call__(self, xy: np.ndarray, heading: float) -> float:
+        h, j = self.target_direction(xy)
         if not np.isfinite(h):
             return float("nan")
+        w = self.route_weight
+        if w > 0:
+            r = float(self.route_directions[j])
+            y, x = (1 - w) * math.sin(h) + w * math.sin(r), (1 - w) * math.cos(h) + w * math.cos(r)
+            h = math.atan2(y, x) if math.hypot(x, y) > 1e-9 else r  # opposite and equal: the route decides
         return heading + float(np.clip(wrap_angle(h - heading), -self.max_turn, self.max_turn))
 
     def reset(self, index: int) -> None:

@@ -251,6 +251,10 @@ def test_ardin2016_cli_small(tmp_path):
     (["experiment.agents=[infomax]", "+experiment.agent_params.infomax.learning_rate=-1"],
      "experiment.agent_params.infomax.learning_rate"),
     (["experiment.scan_step_deg=3"], "experiment.scan_step_deg"),
+    (["+experiment.sweep.wind_speed=[0,1]"], "experiment.sweep: unknown axis 'wind_speed'"),
+    (["+experiment.sweep.position_jitter_m=[0,-0.01]"], "experiment.sweep.position_jitter_m: bad level -0.01"),
+    (["+experiment.sweep.training_stride=[1,2.5]"], "experiment.sweep.training_stride: bad level 2.5"),
+    (["+experiment.sweep.camera_height_m=[0.01,-1]"], "experiment.sweep.camera_height_m: bad level -1"),
 ])
 @pytest.mark.slow
 def test_ardin2016_bad_input_one_message_before_work(tmp_path, args, needle):

@@ -1,7 +1,7 @@
-"""``experiment=route_homing experiment.protocol=ardin2016``: the published route-following test.
+"""``experiment=route_homing experiment.protocol=ardin2016``: the published route-following test, and beyond it.
 
 The test of Ardin, Peng, Mangan, Lagogiannis & Webb 2016 (PLoS Comput. Biol.
-12(2), e1004683, doi:10.1371/journal.pcbi.1004683) on the routes of the Seville
+12(2), e1004683, doi:10.1371/journal.pcbi.1004683) on the routes of a mesh
 world, for every agent of ``experiment.agents`` (``bionav.route_agents``
 plugins and homing methods), route and seed: the agent starts on the first
 route view facing along the route, and each step
@@ -11,9 +11,19 @@ around its heading, walks ``agent_step_m`` along the least unfamiliar view
 method homes to the view ahead instead,
 :class:`~bionav.evaluation.route_followers.HomingFollower`), and farther than
 ``putback_m`` from the route it is put back on the nearest route view (an
-error). Writes ``route_following.csv`` (one row per route, agent and seed),
-metrics.json (:func:`ardin_metrics`), run.mcap (every path) and
-``plots/world_routes.png`` (docs/worlds.md).
+error). Each agent, route and seed is one unit of work
+(:mod:`bionav.experiments.route_homing.units`), run on ``workers`` processes.
+
+``experiment.sweep`` adds robustness conditions no paper reports (position and
+heading noise, start offsets, sparser training views, eye height, routes
+learned together): every level of every axis is a condition run like the run
+itself (:mod:`bionav.experiments.route_homing.robustness`).
+
+Writes ``route_following.csv`` (one row per route, agent, seed and condition),
+``errors_per_route.csv`` and ``plots/errors_per_route.png`` (the published
+figure's boxplots, for the run as configured), metrics.json
+(:func:`ardin_metrics`), run.mcap (every path), ``plots/world_routes.png``, and
+with a sweep ``robustness.csv`` and ``plots/robustness_<axis>.png`` (docs/worlds.md).
 
 Conventions: positions in metres (world frame of the mesh), headings radians
 CCW from world ``+x``, views as :func:`bionav.evaluation.route.scan_views`.
@@ -21,35 +31,35 @@ CCW from world ``+x``, views as :func:`bionav.evaluation.route.scan_views`.
 
 from __future__ import annotations
 
-import math
 import time
-import zlib
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
-from bionav.evaluation.route_setup import RouteSetup, route_renderer, scan_renderer, travel_headings
+from bionav.experiments.route_homing import robustness
 from bionav.experiments.route_homing.config import RouteHomingConfig
 from bionav.experiments.route_homing.shared import (
     PATH_SCHEMA,
     PATH_TOPIC,
     check_step_budget,
+    is_bag,
     route_setup,
     routes_file,
     routes_to_follow,
-    with_protocol_step,
+    with_protocol_defaults,
     write_rows,
 )
+from bionav.experiments.route_homing.units import Unit, frozen, run_unit, with_condition
 
 #: the routes when ``experiment.routes`` is empty: Route1 of Ant1 .. Ant15, as the paper
 ARDIN_ROUTES = tuple(f"Ant{a}_Route1" for a in range(1, 16))
 ARDIN_CSV = "route_following.csv"
-ARDIN_KEYS = ["route", "agent", "seed", "position_jitter_m", "errors", "error_free", "reached_nest", "steps",
-              "n_views", "cpu_s"]
-
-
+PER_ROUTE_CSV = "errors_per_route.csv"
+ARDIN_KEYS = ["route", "agent", "seed", "axis", "level", "position_jitter_m", "heading_noise_deg", "start_offset_m",
+              "training_stride", "camera_height_m", "routes_learned_together", "errors", "error_free", "reached_nest",
+              "steps", "n_views", "cpu_s", "views_cpu_s"]
 def _agent_kinds(agents: list[str]) -> dict[str, str]:
     """``{agent: "route_agent" | "homing"}``; an unknown name is a UserError listing both groups."""
     from bionav import registry
@@ -85,136 +95,154 @@ def _check_agent_params(exp: RouteHomingConfig, kinds: dict[str, str]) -> None:
             plugin_config("route_agent", {"name": name, **params}, key=f"experiment.agent_params.{name}")
 
 
-def _route_agent(name: str, exp: RouteHomingConfig, rng: np.random.Generator):
+def _homing_nodes(name: str, cfg: DictConfig, exp: RouteHomingConfig) -> tuple[str, str]:
+    """The ``homing`` and ``signature`` nodes of homing agent ``name`` (:func:`units.frozen`), checked here."""
     from bionav.config import plugin_config
 
     params = dict(exp.agent_params.get(name) or {})
-    cls, config = plugin_config("route_agent", {"name": name, **params}, key=f"experiment.agent_params.{name}")
-    return cls(config, rng=rng)
-
-
-def _homing_agent(name: str, cfg: DictConfig, ctx, exp: RouteHomingConfig, geometry):
-    from omegaconf import open_dict
-
-    from bionav.experiments.common import make_homing
-
-    params = dict(exp.agent_params.get(name) or {})
     if str(cfg.homing.name) == name and not params:
-        return make_homing(cfg, ctx, geometry)
-    local = cfg.copy()
-    with open_dict(local):
-        local.homing = OmegaConf.create({"name": name, **params})
-    return make_homing(local, ctx, geometry)
+        node = OmegaConf.to_container(cfg.homing, resolve=True)
+    else:
+        node = {"name": name, **params}
+    plugin_config("homing", node, key=f"experiment.agent_params.{name}" if params else "homing")
+    signature = OmegaConf.to_container(cfg.signature, resolve=True) if cfg.get("signature") else None
+    return frozen(node), frozen(signature)
 
 
-def _scan_renderer(setup: RouteSetup, exp: RouteHomingConfig, rng: np.random.Generator, *, half_deg=None):
-    """The agents' preprocessed scan views (:func:`bionav.evaluation.route_setup.scan_renderer`) of ``exp``'s scan."""
-    return scan_renderer(setup, rng, scan_step_deg=exp.scan_step_deg, supersample=exp.supersample,
-                         scan_half_deg=exp.scan_half_deg if half_deg is None else half_deg, view_size=exp.view_size)
+def _units(exp: RouteHomingConfig, cfg: DictConfig, routes: list[str], kinds: dict[str, str]) -> list[Unit]:
+    """Every unit of the run: the run as configured, then each sweep level that differs from it."""
+    db = OmegaConf.to_container(cfg.db, resolve=True)
+    if db.get("source") != "route":
+        raise UserError(f"experiment=route_homing needs a route database (db=seville_route), not db={db.get('name')}.")
+    homing = {a: _homing_nodes(a, cfg, exp) for a, k in kinds.items() if k == "homing"}
+    units = []
+    for axis, level in robustness.conditions(exp, db):
+        cexp, cdb = with_condition(exp, db, axis, level)
+        for i, route in enumerate(routes):
+            learned = tuple(routes[(i + k) % len(routes)] for k in range(min(cexp.routes_learned_together, len(routes))))
+            for seed in exp.seeds:
+                for agent in exp.agents:
+                    if kinds[agent] == "homing" and axis == "routes_learned_together":
+                        continue  # a homing follower learns its own route's views only
+                    units.append(Unit(cexp, frozen(cdb), str(cfg.cache_dir), route, learned, int(seed), agent,
+                                      kinds[agent], homing.get(agent), axis, float(level) if axis else None,
+                                      keep_path=not axis and seed == exp.seeds[0]))
+    return units
 
 
-def _rng(seed: int, *parts: str) -> np.random.Generator:
-    return np.random.default_rng(np.random.SeedSequence([int(seed), *(zlib.crc32(p.encode()) for p in parts)]))
+def _group_rows(units: list[Unit]) -> list[dict]:
+    return [run_unit(u) for u in units]
 
 
-def _follower(agent_name: str, kind: str, cfg: DictConfig, ctx, exp: RouteHomingConfig, setup: RouteSetup,
-              route_heading: np.ndarray, seed: int, training: dict):
-    """The heading chooser of one agent on one route and seed (``training`` caches the route's training views)."""
-    from bionav.evaluation.route_followers import FamiliarityFollower, HomingFollower
+def _run_units(units: list[Unit], ctx, workers: int) -> Iterator[dict]:
+    """The rows of ``units`` in order: here, or on a pool of ``workers`` processes by route, seed and condition."""
+    if workers <= 1:
+        yield from (run_unit(u) for u in units)
+        return
+    from bionav.experiments.common import worker_pool
 
-    rng = _rng(seed, setup.name, agent_name)
-    if kind == "route_agent":
-        if "views" not in training:  # the same training views for every agent of this route and seed
-            one = _scan_renderer(setup, exp, _rng(seed, setup.name, "training"), half_deg=0.0)
-            training["views"] = np.concatenate([one(p, float(h))[0] for p, h in zip(setup.xy, route_heading)])
-        agent = _route_agent(agent_name, exp, rng)
-        agent.train(training["views"])
-        return FamiliarityFollower(agent, _scan_renderer(setup, exp, rng))
-    homing = _homing_agent(agent_name, cfg, ctx, exp, setup.geometry)
-    return HomingFollower(homing, snapshots=setup.db.images, snapshot_headings=setup.heading,
-                          render=route_renderer(setup, rng), window=exp.window, lookahead=exp.lookahead,
-                          test_step_m=exp.test_step_m, max_turn=math.radians(exp.scan_half_deg))
+    groups: list[list[Unit]] = []
+    for u in units:  # the agents of one route, seed and condition share their training views: one task
+        if groups and (groups[-1][0].route, groups[-1][0].seed, groups[-1][0].db, groups[-1][0].exp) == \
+                (u.route, u.seed, u.db, u.exp):
+            groups[-1].append(u)
+        else:
+            groups.append([u])
+    with worker_pool(workers) as pool:
+        for rows in pool.imap(_group_rows, groups, chunksize=1):
+            yield from rows
 
 
 def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
-    """``experiment.protocol=ardin2016``: the published route-following test for every agent, route and seed."""
-    from bionav.evaluation.route import follow_route
+    """``experiment.protocol=ardin2016``: the published route-following test for every agent, route, seed and condition."""
+    from bionav.machine import usable_cpus
 
     cfg = ctx.cfg
-    exp = with_protocol_step(exp)
+    exp = with_protocol_defaults(exp)
     routes = routes_to_follow(cfg, exp, list(ARDIN_ROUTES))
     kinds = _agent_kinds(exp.agents)
     _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, routes_file(cfg))
-    rows, paths, setups = [], {}, []
-    timing = {a: [0.0, 0.0] for a in exp.agents}
-    for name in ctx.progress(routes, desc="ardin2016 routes"):
-        setup = route_setup(cfg, name, exp)
-        name = setup.name
-        setups.append(setup)
-        length = float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum())
-        max_steps = int(math.ceil(exp.max_steps_factor * length / exp.agent_step_m))
-        route_heading = setup.heading if exp.training_heading == "recorded" else travel_headings(setup.xy)
-        for seed in exp.seeds:
-            training: dict = {}
-            for agent_name in exp.agents:
-                wall0, cpu0 = time.perf_counter(), time.process_time()
-                follower = _follower(agent_name, kinds[agent_name], cfg, ctx, exp, setup, route_heading, seed,
-                                     training)
-                res = follow_route(follower, route_xy=setup.xy, route_heading=route_heading,
-                                   nest_xy=setup.dense_xy[-1], step_m=exp.agent_step_m, putback_m=exp.putback_m,
-                                   goal_m=exp.putback_m, max_steps=max_steps, jitter_m=exp.position_jitter_m,
-                                   rng=_rng(seed, name, agent_name, "jitter"), on_putback=follower.reset)
-                wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
-                timing[agent_name][0] += wall
-                timing[agent_name][1] += cpu
-                rows.append({"route": name, "agent": agent_name, "seed": int(seed),
-                             "position_jitter_m": exp.position_jitter_m, "errors": int(res.errors),
-                             "error_free": int(res.errors == 0), "reached_nest": int(res.reached_nest),
-                             "steps": int(res.steps), "n_views": len(setup.xy), "cpu_s": cpu})
-                if seed == exp.seeds[0]:
-                    paths[(name, agent_name)] = res.path
-                ctx.log.write(PATH_TOPIC, {"route": name, "method": agent_name, "xy": res.path.tolist(),
-                                           "completed": bool(res.reached_nest)},
-                              schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
-    routes = [s.name for s in setups]  # db=bag: the drive's own name
+    if is_bag(cfg):  # the drive read once here (its length checked); its own name in the rows and figures
+        routes = [route_setup(cfg, routes[0], exp).name]
+    units = _units(exp, cfg, routes, kinds)
+    workers = max(1, min(int(cfg.get("workers") or 1), usable_cpus(), len(units)))
+    rows, paths = [], {}
+    wall0 = time.perf_counter()
+    desc = f"ardin2016: {len(routes)} routes x {len(exp.agents)} agents x {len(exp.seeds)} seeds" + \
+        (f" x {len(units) // max(1, len(routes) * len(exp.agents) * len(exp.seeds))} conditions" if exp.sweep else "")
+    for unit, row in zip(units, ctx.progress(_run_units(units, ctx, workers), desc=desc, total=len(units))):
+        path = row.pop("path")
+        ctx.log.write(PATH_TOPIC, {"route": row["route"], "method": row["agent"], "xy": path.tolist(),
+                                   "completed": bool(row["reached_nest"])},
+                      schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
+        if unit.keep_path:
+            paths[(row["route"], row["agent"])] = path
+        rows.append(row)
     write_rows(ctx.dir / ARDIN_CSV, rows, ARDIN_KEYS)
+    base = [r for r in rows if not r["axis"]]
+    table = per_route_table(base, routes=routes, agents=exp.agents, seeds=exp.seeds)
+    write_rows(ctx.dir / PER_ROUTE_CSV, table, ["route", "seed", *exp.agents])
     if exp.plots:
-        from bionav.experiments.route_homing.plots import plot_world_routes
+        from bionav.experiments.route_homing.plots import plot_errors_per_route, plot_world_routes
+        from bionav.experiments.route_homing.units import route_of
 
+        setups = [route_of(frozen(OmegaConf.to_container(cfg.db, resolve=True)), str(cfg.cache_dir), r) for r in routes]
         plot_world_routes(ctx.plots / "world_routes.png", setups[0].world, setups, paths)
-    return ardin_metrics(rows, routes=routes, agents=exp.agents, seeds=exp.seeds, timing=timing,
-                         extra={"db": str(cfg.db.name), "protocol": "ardin2016",
-                                "position_jitter_m": exp.position_jitter_m, "step_m": exp.agent_step_m})
+        plot_errors_per_route(ctx.plots / "errors_per_route.png", table, list(exp.agents),
+                              title=f"{len(routes)} routes x {len(exp.seeds)} seed(s), protocol of Ardin et al. 2016",
+                              labels={a: f"{a} (homing)" for a, k in kinds.items() if k == "homing"})
+    metrics = ardin_metrics(base, routes=routes, agents=exp.agents, seeds=exp.seeds,
+                            extra={"db": str(cfg.db.name), "protocol": "ardin2016", "workers": workers,
+                                   "position_jitter_m": exp.position_jitter_m, "step_m": exp.agent_step_m,
+                                   "wall_s": time.perf_counter() - wall0})
+    if exp.sweep:
+        metrics.update(robustness.write(ctx, rows, exp=exp, agents=list(exp.agents)))
+    return metrics
+
+
+def per_route_table(rows: list[dict], *, routes: list[str], agents: list[str], seeds: list[int]) -> list[dict]:
+    """One row per route and seed with each agent's errors (integers): the data of ``plots/errors_per_route.png``."""
+    errors = {(r["route"], r["seed"], r["agent"]): int(r["errors"]) for r in rows}
+    return [{"route": route, "seed": int(seed), **{a: errors[(route, int(seed), a)] for a in agents}}
+            for route in routes for seed in seeds]
+
+
+def _count(value: float) -> float | int:
+    """A statistic of counts as an int when it is whole (a median of 0 prints as 0, not 0.0000)."""
+    return int(value) if float(value).is_integer() else float(value)
 
 
 def ardin_metrics(rows: list[dict], *, routes: list[str], agents: list[str], seeds: list[int],
-                  timing: dict | None = None, extra: dict | None = None) -> dict[str, Any]:
+                  extra: dict | None = None) -> dict[str, Any]:
     """Flat metrics of the ardin2016 rows (one per route, agent and seed).
 
     Per agent ``a``: ``errors_per_route_<a>`` (median over routes x seeds), ``errors_per_route_q25_<a>``,
     ``errors_per_route_q75_<a>``, ``errors_per_route_mean_<a>``; ``error_free_routes_<a>`` (error-free
     routes out of ``n_routes``, mean over seeds); ``reached_nest_<a>`` (fraction of runs);
-    ``errors_by_route_<a>`` and ``reached_nest_by_route_<a>`` (``{route: [per seed]}``); ``wall_s_<a>``, ``cpu_s_<a>``.
+    ``errors_by_route_<a>`` and ``reached_nest_by_route_<a>`` (``{route: [per seed]}``); ``wall_s_<a>``,
+    ``cpu_s_<a>`` (summed over the runs) and ``cpu_s_per_route_<a>`` (their mean). Counts and
+    statistics of counts that are whole are ints.
     """
     m: dict[str, Any] = dict(extra or {})
     m.update({"routes": routes, "n_routes": len(routes), "agents": agents, "seeds": seeds})
     for a in agents:
         mine = [r for r in rows if r["agent"] == a]
         err = np.array([r["errors"] for r in mine], np.float64)
-        m[f"errors_per_route_{a}"] = float(np.median(err))
-        m[f"errors_per_route_q25_{a}"] = float(np.percentile(err, 25))
-        m[f"errors_per_route_q75_{a}"] = float(np.percentile(err, 75))
+        m[f"errors_per_route_{a}"] = _count(np.median(err))
+        m[f"errors_per_route_q25_{a}"] = _count(np.percentile(err, 25))
+        m[f"errors_per_route_q75_{a}"] = _count(np.percentile(err, 75))
         m[f"errors_per_route_mean_{a}"] = float(err.mean())
-        m[f"error_free_routes_{a}"] = float(np.mean([sum(r["errors"] == 0 for r in mine if r["seed"] == s)
-                                                     for s in seeds]))
+        m[f"error_free_routes_{a}"] = _count(np.mean([sum(r["errors"] == 0 for r in mine if r["seed"] == s)
+                                                      for s in seeds]))
         m[f"reached_nest_{a}"] = float(np.mean([r["reached_nest"] for r in mine]))
         m[f"errors_by_route_{a}"] = {rt: [r["errors"] for r in mine if r["route"] == rt] for rt in routes}
         m[f"reached_nest_by_route_{a}"] = {rt: [bool(r["reached_nest"]) for r in mine if r["route"] == rt]
                                            for rt in routes}
-        if timing is not None:
-            m[f"wall_s_{a}"], m[f"cpu_s_{a}"] = (float(v) for v in timing[a])
+        m[f"wall_s_{a}"] = float(sum(r.get("wall_s", 0.0) for r in mine))
+        m[f"cpu_s_{a}"] = float(sum(r["cpu_s"] for r in mine))
+        m[f"cpu_s_per_route_{a}"] = m[f"cpu_s_{a}"] / max(1, len(mine))
     return m
 
 
-__all__ = ["ARDIN_ROUTES", "ardin_metrics", "run"]
+__all__ = ["ARDIN_ROUTES", "ardin_metrics", "per_route_table", "run"]

@@ -14,6 +14,9 @@ from bionav.validation import Range, bounded
 
 ROUTE_METHODS = ("perfect_memory", "windowed", "zernike", "homing")
 ROUTE_PROTOCOLS = ("bionav", "ardin2016")
+#: ``experiment.sweep`` axes (``ardin2016``): the experiment key each varies (``camera_height_m`` is ``db.camera_height_m``)
+SWEEP_AXES = ("position_jitter_m", "heading_noise_deg", "start_offset_m", "training_stride", "camera_height_m",
+              "routes_learned_together")
 
 
 @dataclass
@@ -30,8 +33,9 @@ class RouteHomingConfig:
     test_step_m : test-step length of methods with test steps, metres.
     closed_loop : run the simulated agent from a displaced start.
     start_offset_m, agent_step_m, success_radius_m, give_up_m : the agent's start displacement (left
-        positive), step (null: the protocol's, 0.05 for ``bionav``, 0.1 for ``ardin2016``), success radius
-        around the route's end and give-up distance from the route, metres.
+        positive; null: the protocol's, 0.2 for ``bionav``, 0 for ``ardin2016``), step (null: the protocol's,
+        0.05 for ``bionav``, 0.1 for ``ardin2016``), success radius around the route's end and give-up
+        distance from the route, metres.
     max_steps_factor : step budget = factor x route length / agent step.
     zernike_order : highest Zernike-moment order of the ``zernike`` method.
     protocol : ``bionav`` (the tests above: open loop at lateral offsets, closed loop from a displaced
@@ -55,6 +59,22 @@ class RouteHomingConfig:
         view (``travel``) or the ant's recorded heading there (``recorded``); the put-back faces the same.
     supersample : ``ardin2016``: rays per 4-degree pixel along each axis (1: one ray at the pixel centre;
         2, 4: the mean of 2 x 2 or 4 x 4 rays, area pixels as the reference renderer's rasterised patches).
+    heading_noise_deg : ``ardin2016``: Gaussian noise (std, degrees) added to every heading an agent
+        chooses before it steps (not in the paper).
+    training_stride : ``ardin2016``: the agents learn every k-th route view (1: all, 0.1 m apart); the
+        put-back rule keeps the whole route.
+    routes_learned_together : ``ardin2016``: the familiarity agents learn the views of this many routes
+        (the followed one and the next ones of ``routes``, cyclically) and follow each (capacity).
+    passed, route_weight, follower_window : ``ardin2016`` homing followers: a target view the agent has
+        passed (its home direction more than 90 degrees off the route direction there) is kept or
+        skipped (``skip``: home to the next, at most ``lookahead`` views further); the heading blends
+        the home direction with the route direction stored with the target view (0: homing only,
+        1: the stored direction only); the windowed RIDF that tracks progress searches from one view
+        behind to ``follower_window`` ahead of the last match
+        (:class:`bionav.evaluation.route_followers.HomingFollower`).
+    sweep : ``ardin2016``: robustness axes ``{axis: [levels]}`` (axes :data:`SWEEP_AXES`); each level
+        is run with every other setting as given, and ``robustness.csv`` and ``plots/robustness_<axis>.png``
+        summarise them (docs/worlds.md).
     """
 
     name: str = "route_homing"
@@ -68,7 +88,7 @@ class RouteHomingConfig:
     lookahead: int = bounded(2, ge=1, le=1000)
     test_step_m: float = bounded(0.05, gt=0.0, le=1.0)
     closed_loop: bool = True
-    start_offset_m: float = bounded(0.2, ge=-5.0, le=5.0)
+    start_offset_m: Optional[float] = bounded(None, ge=-5.0, le=5.0)
     agent_step_m: Optional[float] = bounded(None, gt=0.0, le=1.0)
     success_radius_m: float = bounded(0.2, gt=0.0, le=5.0)
     give_up_m: float = bounded(1.0, gt=0.0, le=20.0)
@@ -86,9 +106,54 @@ class RouteHomingConfig:
     view_size: list[int] = bounded([36, 10], length=2, item=Range(ge=2, le=74))
     training_heading: str = bounded("travel", choices=("travel", "recorded"))
     supersample: int = bounded(4, choices=(1, 2, 4))
+    heading_noise_deg: float = bounded(0.0, ge=0.0, le=180.0)
+    training_stride: int = bounded(1, ge=1, le=100)
+    routes_learned_together: int = bounded(1, ge=1, le=1000)
+    passed: str = bounded("skip", choices=("keep", "skip"))
+    route_weight: float = bounded(0.5, ge=0.0, le=1.0)
+    follower_window: int = bounded(5, ge=1, le=10_000)
+    sweep: dict[str, Any] = field(default_factory=dict)
 
     def validate(self) -> None:
-        """``offsets_m`` includes 0, the route itself (called by :func:`bionav.validation.typed_config`)."""
+        """``offsets_m`` includes 0, the route itself; ``sweep`` names known axes with lists of levels in range.
+
+        Called by :func:`bionav.validation.typed_config`.
+        """
         if 0.0 not in self.offsets_m:
             raise UserError(f"experiment.offsets_m={self.offsets_m} must include 0 (the route itself), "
                             "e.g. experiment.offsets_m=[-0.2,0.0,0.2].")
+        for axis, levels in self.sweep.items():
+            if axis not in SWEEP_AXES:
+                raise UserError(f"experiment.sweep: unknown axis {axis!r}; the axes are {', '.join(SWEEP_AXES)} "
+                                "(e.g. +experiment.sweep.position_jitter_m=[0,0.01,0.02]).")
+            if not isinstance(levels, (list, tuple)) or not levels:
+                raise UserError(f"experiment.sweep.{axis} must be a non-empty list of levels, e.g. "
+                                f"+experiment.sweep.{axis}=[...].")
+            for level in levels:
+                sweep_level(self, axis, level)
+
+
+def sweep_level(exp: "RouteHomingConfig", axis: str, level: Any) -> Any:
+    """``level`` of sweep axis ``axis`` checked against the range of the key it sets (one message naming both)."""
+    import dataclasses
+
+    from bionav.validation import check_config, range_of
+
+    if axis == "camera_height_m":
+        from bionav.db.config import DatabaseConfig
+
+        rng = range_of(next(f for f in dataclasses.fields(DatabaseConfig) if f.name == "camera_height_m"))
+        if isinstance(level, bool) or not isinstance(level, (int, float)) or rng.problem(level):
+            raise UserError(f"experiment.sweep.camera_height_m: bad level {level!r}; db.camera_height_m takes "
+                            f"{rng.describe()}.")
+        return float(level)
+    kind = type(getattr(exp, axis))
+    if isinstance(level, bool) or not isinstance(level, (int, float)) or (kind is int and level != int(level)):
+        raise UserError(f"experiment.sweep.{axis}: bad level {level!r}; give numbers "
+                        f"({'whole numbers' if kind is int else 'metres or degrees as the key says'}).")
+    value = kind(level) if kind in (int, float) else float(level)
+    try:
+        check_config(dataclasses.replace(exp, sweep={}, **{axis: value}), prefix="experiment")
+    except UserError as exc:
+        raise UserError(f"experiment.sweep.{axis}: bad level {level!r} ({exc})") from None
+    return value

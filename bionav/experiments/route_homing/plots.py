@@ -90,3 +90,67 @@ def plot_error_maps(path, setup, results, offsets) -> None:
     fig.suptitle(f"{setup.name}: heading error")
     fig.savefig(path, dpi=110)  # constrained layout (save_figure's tight layout fights the shared colour bar)
     plt.close(fig)
+
+
+def plot_errors_per_route(path, table: list[dict], agents: list[str], *, title: str,
+                          labels: dict[str, str] | None = None) -> dict[str, np.ndarray]:
+    """Boxplots of the errors per route of each agent (Ardin et al. 2016, Fig. 4D), with every run as a dot.
+
+    ``table`` holds the rows of ``errors_per_route.csv`` (one per route and seed, one integer
+    column per agent); each box covers all of an agent's runs: median, quartiles and whiskers
+    to the extremes (the paper's "maximum and minimum"). Returns the values drawn per agent,
+    read back from the dots of the figure (what the tests compare with the CSV). ``labels``
+    names the agents on the axis (default: their names).
+    """
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(1.1 * len(agents) + 2.2, 3.8))
+    data = [np.array([int(r[a]) for r in table], np.int64) for a in agents]
+    ax.boxplot(data, whis=(0, 100), widths=0.55, medianprops={"color": "k", "lw": 2})
+    jitter = np.random.default_rng(0)  # only spreads the dots sideways
+    drawn = {}
+    for k, (a, d) in enumerate(zip(agents, data), start=1):
+        dots = ax.scatter(k + jitter.uniform(-0.18, 0.18, len(d)), d, s=9, alpha=0.6, zorder=3)
+        drawn[a] = np.asarray(dots.get_offsets())[:, 1].astype(np.int64)
+    names = [(labels or {}).get(a, a).replace("_", " ") for a in agents]
+    ax.set_xticks(range(1, len(agents) + 1), names, rotation=30, ha="right", fontsize=8)
+    ax.set_ylabel("errors per route (put-backs)")
+    ax.set_title(title, fontsize=9)
+    ax.set_ylim(bottom=-0.5)
+    save_figure(fig, path, dpi=110)
+    return drawn
+
+
+def plot_robustness(path, summary: list[dict], *, axis: str, unit: str,
+                    agents: list[str]) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Errors per route (median with interquartile band) and nest arrivals against one robustness axis, per agent.
+
+    ``summary`` holds rows of ``robustness.csv`` for this axis (``agent``, ``level``,
+    ``errors_median``, ``errors_q25``, ``errors_q75``, ``reached_nest``). Returns, per agent drawn,
+    the levels, medians and nest arrivals (%) read back from the figure's lines (what the tests
+    compare with the CSV).
+    """
+    plt = pyplot()
+    fig, (ax_e, ax_n) = plt.subplots(1, 2, figsize=(9.5, 3.6))
+    drawn = {}
+    for a in agents:
+        mine = sorted((r for r in summary if r["agent"] == a), key=lambda r: float(r["level"]))
+        if not mine:
+            continue
+        x = np.array([float(r["level"]) for r in mine])
+        med = np.array([float(r["errors_median"]) for r in mine])
+        line, = ax_e.plot(x, med, "o-", ms=4, label=a.replace("_", " "))
+        ax_e.fill_between(x, [float(r["errors_q25"]) for r in mine], [float(r["errors_q75"]) for r in mine],
+                          color=line.get_color(), alpha=0.15, lw=0)
+        nest, = ax_n.plot(x, [100.0 * float(r["reached_nest"]) for r in mine], "o-", ms=4, color=line.get_color())
+        drawn[a] = (np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float),
+                    np.asarray(nest.get_ydata(), float))
+    ax_e.set_xlabel(f"{axis} ({unit})" if unit else axis)
+    ax_n.set_xlabel(f"{axis} ({unit})" if unit else axis)
+    ax_e.set_ylabel("errors per route: median (IQR)")
+    ax_n.set_ylabel("routes reaching the nest (%)")
+    ax_n.set_ylim(-3, 103)
+    ax_e.set_ylim(bottom=-0.3)
+    ax_e.legend(fontsize=7, ncol=2)
+    fig.suptitle(f"Route following against {axis} (Seville routes, protocol of Ardin et al. 2016)", fontsize=9)
+    save_figure(fig, path, dpi=110)
+    return drawn

@@ -73,7 +73,7 @@ log = logging.getLogger(__name__)
 def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     """Run ``experiment=route_homing`` (``protocol=bionav``) with the checked ``exp`` (the rest in ``ctx.cfg``)."""
     cfg = ctx.cfg
-    exp = shared.with_protocol_step(exp)
+    exp = shared.with_protocol_defaults(exp)
     routes = shared.routes_to_follow(cfg, exp, [str(OmegaConf.select(cfg, "db.route", default=None))])
     if exp.closed_loop:  # open-loop runs take no agent steps
         shared.check_step_budget(routes, exp, shared.routes_file(cfg))

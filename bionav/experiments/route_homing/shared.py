@@ -21,8 +21,9 @@ from bionav.evaluation.route_setup import RouteSetup, setup_bag_route, setup_rou
 from bionav.experiments.route_homing.config import RouteHomingConfig
 from bionav.files import write_csv_atomic
 
-#: the agent's step of each protocol when ``experiment.agent_step_m`` is null, metres
-PROTOCOL_STEP_M = {"bionav": 0.05, "ardin2016": 0.1}
+#: what each protocol sets when the key is null: the agent's step and its start offset from the route, metres
+PROTOCOL_DEFAULTS = {"bionav": {"agent_step_m": 0.05, "start_offset_m": 0.2},
+                     "ardin2016": {"agent_step_m": 0.1, "start_offset_m": 0.0}}
 #: most steps one agent may take on one route (``max_steps_factor`` x length / step)
 MAX_STEPS_PER_ROUTE = 20_000
 #: the route name :func:`routes_to_follow` gives a bag's drive until it is read (then :attr:`RouteSetup.name`)
@@ -39,13 +40,12 @@ PATH_SCHEMA = {
 }
 
 
-def with_protocol_step(exp: RouteHomingConfig) -> RouteHomingConfig:
-    """``exp`` with ``agent_step_m`` defaulting to its protocol's (:data:`PROTOCOL_STEP_M`)."""
+def with_protocol_defaults(exp: RouteHomingConfig) -> RouteHomingConfig:
+    """``exp`` with ``agent_step_m`` and ``start_offset_m`` defaulting to its protocol's (:data:`PROTOCOL_DEFAULTS`)."""
     import dataclasses
 
-    if exp.agent_step_m is not None:
-        return exp
-    return dataclasses.replace(exp, agent_step_m=PROTOCOL_STEP_M[exp.protocol])
+    unset = {k: v for k, v in PROTOCOL_DEFAULTS[exp.protocol].items() if getattr(exp, k) is None}
+    return dataclasses.replace(exp, **unset) if unset else exp
 
 
 def is_bag(cfg: DictConfig) -> bool:

@@ -11,7 +11,9 @@ experiment.protocol=ardin2016`` walks it along the least unfamiliar heading
 * ``train(views)``: ``views`` shape ``(K, H, W)``, the route's views in order;
 * ``unfamiliarity(views)`` -> shape ``(S,)``: one value per candidate view;
 * ``choose(s)``: the agent walked along candidate ``s`` of the last call (sequence state);
-* ``reset(index)``: the agent was put back at route view ``index``.
+* ``reset(index)``: the agent was put back at route view ``index``;
+* ``needs_views`` (class attribute, default True): False for an agent that ignores what it sees
+  (``random_choice``), whose follower renders nothing and hands it ``S`` empty views.
 
 The algorithms are plain functions in :mod:`bionav.homing.familiarity`.
 """
@@ -27,6 +29,8 @@ class RouteAgent:
     """Base of the familiarity route agents (stateless choose/reset by default)."""
 
     Config: Any = None
+    #: False: the agent ignores the views (the follower passes ``(S, 0)`` empty views, rendering nothing)
+    needs_views: bool = True
 
     def __init__(self, config, *, rng: np.random.Generator) -> None:
         self.config = config
