@@ -112,8 +112,9 @@ def _homing_nodes(name: str, cfg: DictConfig, exp: RouteHomingConfig) -> tuple[s
 def _units(exp: RouteHomingConfig, cfg: DictConfig, routes: list[str], kinds: dict[str, str]) -> list[Unit]:
     """Every unit of the run: the run as configured, then each sweep level that differs from it."""
     db = OmegaConf.to_container(cfg.db, resolve=True)
-    if db.get("source") != "route":
-        raise UserError(f"experiment=route_homing needs a route database (db=seville_route), not db={db.get('name')}.")
+    if db.get("source") not in ("route", "bag"):
+        raise UserError(f"experiment=route_homing needs a route database (db=seville_route) or a robot's drive "
+                        f"(db=bag), not db={db.get('name')}.")
     homing = {a: _homing_nodes(a, cfg, exp) for a, k in kinds.items() if k == "homing"}
     units = []
     for axis, level in robustness.conditions(exp, db):

@@ -82,7 +82,8 @@ def route_setup(cfg: DictConfig, name: str, exp: RouteHomingConfig) -> RouteSetu
         check_route_length(setup.name, float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum()), exp)
         return setup
     if node.get("source") != "route":
-        raise UserError(f"experiment=route_homing needs a route database (db=seville_route), not db={node.get('name')}.")
+        raise UserError(f"experiment=route_homing needs a route database (db=seville_route) or a robot's drive "
+                        f"(db=bag), not db={node.get('name')}.")
     return setup_route(node, name, cache_dir=str(cfg.cache_dir))
 
 
