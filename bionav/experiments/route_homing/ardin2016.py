@@ -43,15 +43,15 @@ from bionav.experiments.route_homing.config import RouteHomingConfig
 from bionav.experiments.route_homing.shared import (
     PATH_SCHEMA,
     PATH_TOPIC,
+    check_route_length,
     check_step_budget,
     is_bag,
-    route_setup,
     routes_file,
     routes_to_follow,
     with_protocol_defaults,
     write_rows,
 )
-from bionav.experiments.route_homing.units import Unit, frozen, run_unit, with_condition
+from bionav.experiments.route_homing.units import Unit, frozen, route_of, run_unit, with_condition
 
 #: the routes when ``experiment.routes`` is empty: Route1 of Ant1 .. Ant15, as the paper
 ARDIN_ROUTES = tuple(f"Ant{a}_Route1" for a in range(1, 16))
@@ -164,8 +164,10 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     kinds = _agent_kinds(exp.agents)
     _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, routes_file(cfg))
-    if is_bag(cfg):  # the drive read once here (its length checked); its own name in the rows and figures
-        routes = [route_setup(cfg, routes[0], exp).name]
+    if is_bag(cfg):  # the drive read once per process (units.route_of), its length checked; its own name in the rows
+        setup = route_of(frozen(OmegaConf.to_container(cfg.db, resolve=True)), str(cfg.cache_dir), routes[0])
+        check_route_length(setup.name, float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum()), exp)
+        routes = [setup.name]
     units = _units(exp, cfg, routes, kinds)
     workers = max(1, min(int(cfg.get("workers") or 1), usable_cpus(), len(units)))
     rows, paths = [], {}
@@ -186,7 +188,6 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     write_rows(ctx.dir / PER_ROUTE_CSV, table, ["route", "seed", *exp.agents])
     if exp.plots:
         from bionav.experiments.route_homing.plots import plot_errors_per_route, plot_world_routes
-        from bionav.experiments.route_homing.units import route_of
 
         setups = [route_of(frozen(OmegaConf.to_container(cfg.db, resolve=True)), str(cfg.cache_dir), r) for r in routes]
         plot_world_routes(ctx.plots / "world_routes.png", setups[0].world, setups, paths)

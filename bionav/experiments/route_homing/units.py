@@ -89,13 +89,13 @@ def route_of(db: tuple, cache_dir: str, name: str):
     :func:`~bionav.evaluation.route_setup.setup_bag_route`), kept per process."""
     from bionav.evaluation.route_setup import setup_bag_route, setup_route
 
-    key = (db, name)
+    node = json.loads(db)
+    bag = node.get("source") == "bag"  # db=bag: the bag's one drive, whatever name it is asked by
+    key = (db, None if bag else name)
     if key not in _SETUPS:
         if len(_SETUPS) >= _CACHE_ITEMS:
             _SETUPS.pop(next(iter(_SETUPS)))
-        node = json.loads(db)  # db=bag: the bag's one drive, whatever its name
-        _SETUPS[key] = setup_bag_route(node) if node.get("source") == "bag" else setup_route(node, name,
-                                                                                             cache_dir=cache_dir)
+        _SETUPS[key] = setup_bag_route(node) if bag else setup_route(node, name, cache_dir=cache_dir)
     return _SETUPS[key]
 
 
