@@ -77,3 +77,26 @@ def test_vector_distances_equal_the_previous_kernel(width, n_alpha, rows):
     acc = np.empty((width + 4, width), np.uint16)
     diagonal_distances_u8(sq, cq2, sn, cn2, step, q, got, acc)
     np.testing.assert_array_equal(got, expected)
+
+
+@pytest.mark.parametrize("width,rows", [(64, 5), (96, 49), (130, 17)])
+def test_vector_distances_exact_at_the_largest_sums(width, rows):
+    """Values at +-the image quantum (|a - b| up to twice it, sums up to 65,535): the kernel's
+    ``2 sum max(a, b) - sum a - sum b`` wraps in 16 bits and must still equal ``sum |a - b|``."""
+    rng = np.random.default_rng(width + rows)
+    k, q = 2, distance_quantum(width)[0]
+    top = _image_quantum(rows)
+    sq = (top * rng.choice([-1, 1], size=(k, rows, width))).astype(np.int16)
+    c = (top * rng.choice([-1, 1], size=(k, rows, width))).astype(np.int16)
+    c[0] = -sq[0]  # a diagonal whose every term is 2 * top: the largest sum the quantum allows
+    cq2 = np.zeros((k, rows, 2 * width + 4), np.int16)
+    cq2[:, :, :2 * width] = np.concatenate([c, c], axis=2)
+    cq2[:, :, 2 * width:] = c[:, :, :4]
+    sn = np.abs(sq.astype(np.int32)).sum(axis=1)
+    cn2 = np.abs(cq2.astype(np.int32)).sum(axis=1)
+    expected = np.empty((k, width, 1, width), np.uint8)
+    _diagonal_distances_q(sq, cq2, sn, cn2, 1, q, expected)
+    got = np.empty_like(expected)
+    diagonal_distances_u8(sq, cq2, sn, cn2, 1, q, got, np.empty((width + 4, width), np.uint16))
+    np.testing.assert_array_equal(got, expected)
+    assert (expected[0, 0] == q).all()  # the opposite columns: NSAD 1 on diagonal 0
