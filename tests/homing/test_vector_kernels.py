@@ -100,3 +100,42 @@ def test_vector_distances_exact_at_the_largest_sums(width, rows):
     diagonal_distances_u8(sq, cq2, sn, cn2, 1, q, got, np.empty((width + 4, width), np.uint16))
     np.testing.assert_array_equal(got, expected)
     assert (expected[0, 0] == q).all()  # the opposite columns: NSAD 1 on diagonal 0
+
+
+#: (width, height, n_alpha, n_psi): the default, steps 2 and 1 (96 is no multiple of 40), an odd step (130 / 65)
+PAIR_SIZES = ((288, 50, 96, 96), (64, 12, 32, 16), (96, 20, 40, 30), (130, 17, 65, 26))
+VARIANTS = {"single": {}, "compass": {"compass_fraction": 0.3}, "fine": {"fine_search": True},
+            "double_fine": {"double_search": True, "fine_search": True},
+            "compass_double_fine": {"compass_fraction": 0.25, "double_search": True, "fine_search": True}}
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+@pytest.mark.parametrize("width,height,n_alpha,n_psi", PAIR_SIZES)
+def test_compiled_pair_equals_the_kernel_by_kernel_path(width, height, n_alpha, n_psi, symmetric):
+    """minwarping's one compiled call per pair (``pair.minwarp_pair_u8``) against the same kernels called
+    one by one from Python (``search._minwarping_steps``): the same hypothesis, score and count, exactly."""
+    from bionav.geometry import PanoramaGeometry
+    from bionav.homing.warping import minwarping, scale_plane_stack
+    from bionav.homing.warping import search as S
+
+    rng = np.random.default_rng(width + height)
+    geometry = PanoramaGeometry.square_pixels(width, height)
+    scales = default_scales() if symmetric else np.array([0.5, 0.75, 1.0, 1.4, 2.0])  # asymmetric: recomputed
+    for trial in range(2):
+        base = rng.random((height, width)).astype(np.float32)
+        other = np.roll(base, 5 * trial + 3, axis=1) + 0.3 * rng.random((height, width)).astype(np.float32)
+        snap, cur = (scale_plane_stack(img, geometry=geometry, scales=scales) for img in (base, other))
+        scl, tau, sym = S._scale_setup(snap["scales"], None)
+        assert sym == symmetric
+        windows = minwarp_windows(minwarp_template(width, scl, tau), max_level=S.WINDOW_LEVEL)
+        for name, opts in VARIANTS.items():
+            got = minwarping(snap, cur, n_alpha=n_alpha, n_psi=n_psi, **opts)
+            p_all = S._column_grid(n_psi, width)
+            double = opts.get("double_search", False)
+            grid = (S._column_grid(n_alpha, width), p_all, S._layout_step(width, n_alpha, p_all, double),
+                    n_alpha, n_psi)
+            want = S._minwarping_steps(snap, cur, grid, windows, opts.get("compass_fraction"),
+                                       opts.get("fine_search", False), double, sym, True)
+            assert (got.alpha, got.psi, got.score, got.home_angle) == (want.alpha, want.psi, want.score,
+                                                                      want.home_angle), (name, trial)
+            assert got.extras == want.extras

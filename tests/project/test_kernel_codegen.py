@@ -40,6 +40,8 @@ PACKED = {
     # bytes widened and added to words); the distance sums of 32 columns x 4 diagonals over all rows
     "minwarp_search_u8": ["vpminub", "vpmovzxbw", "vpaddw"],
     "diagonal_distances_u8": ["vpmaxsw", "vpaddw", "vpsubw", "vcvtdq2ps"],  # sum |a - b| as 2 sum max - sums
+    # one compiled call per pair: the kernels above linked in (byte minima, 16-bit sums, the normalisation)
+    "minwarp_pair_u8": ["vpminub", "vpmovzxbw", "vpmaxsw", "vcvtdq2ps"],
     "warping1d_scores": ["vfmadd231pd"],
 }
 #: int64 minima of the SIFT keys: compare and blend on AVX2, vpminsq (AVX-512 only) on AVX-512

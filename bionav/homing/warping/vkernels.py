@@ -51,10 +51,11 @@ GROUP = 3 * LANES
 TABLE_PAD = GROUP + LANES
 
 
-def padded_lanes(n: int) -> int:
+@njit(cache=True)
+def padded_lanes(n):
     """Lanes of an accumulator row of ``n`` alpha steps: ``n`` rounded up to a multiple of 32, at
     least 96 (the sums of up to 96 alpha steps stay in three vectors)."""
-    return max(GROUP, -(-int(n) // LANES) * LANES)
+    return max(GROUP, -(-n // LANES) * LANES)
 
 
 def search_scratch_size(n: int) -> int:
