@@ -194,14 +194,19 @@ def kenyon_activity(inputs: np.ndarray, connections, *, n_active: int,
     drive = kenyon_drive(inputs, connections)
     if thresholds is not None:
         centre, scale = thresholds
-        drive = (drive - centre) / scale
+        drive -= centre  # in place: the same values as (drive - centre) / scale, without two more arrays
+        drive /= scale
     n_kc = drive.shape[1]
     k = int(min(max(n_active, 1), n_kc))
     kth = np.partition(drive, n_kc - k, axis=1)[:, n_kc - k][:, None]  # the k-th largest drive of each view
-    above = drive > kth
-    tied = drive == kth
-    need = k - above.sum(axis=1, keepdims=True)
-    return above | (tied & (np.cumsum(tied, axis=1) <= need))
+    fire = drive >= kth
+    over = np.flatnonzero(fire.sum(axis=1) > k)  # rows where drives tie with the k-th: fire in index order
+    if len(over):
+        rows = drive[over]
+        above = rows > kth[over]
+        tied = rows == kth[over]
+        fire[over] = above | (tied & (np.cumsum(tied, axis=1) <= k - above.sum(axis=1, keepdims=True)))
+    return fire
 
 
 def mushroom_body_train(kc_to_en: np.ndarray, active: np.ndarray, *, depression: float) -> np.ndarray:
