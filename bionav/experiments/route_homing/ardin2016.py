@@ -31,6 +31,7 @@ CCW from world ``+x``, views as :func:`bionav.evaluation.route.scan_views`.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any, Iterator
 
@@ -52,6 +53,7 @@ from bionav.experiments.route_homing.shared import (
     write_rows,
 )
 from bionav.experiments.route_homing.units import Unit, frozen, route_of, run_unit, with_condition
+from bionav.experiments.route_homing.worlds import WORLD_AXIS, world_label, worlds_of
 
 #: the routes when ``experiment.routes`` is empty: Route1 of Ant1 .. Ant15, as the paper
 ARDIN_ROUTES = tuple(f"Ant{a}_Route1" for a in range(1, 16))
@@ -110,23 +112,28 @@ def _homing_nodes(name: str, cfg: DictConfig, exp: RouteHomingConfig) -> tuple[s
 
 
 def _units(exp: RouteHomingConfig, cfg: DictConfig, routes: list[str], kinds: dict[str, str]) -> list[Unit]:
-    """Every unit of the run: the run as configured, then each sweep level that differs from it."""
+    """Every unit of the run: the run as configured, then each sweep level that differs from it, then each world."""
     db = OmegaConf.to_container(cfg.db, resolve=True)
     if db.get("source") not in ("route", "bag"):
         raise UserError(f"experiment=route_homing needs a route database (db=seville_route) or a robot's drive "
                         f"(db=bag), not db={db.get('name')}.")
     homing = {a: _homing_nodes(a, cfg, exp) for a, k in kinds.items() if k == "homing"}
+    worlds = worlds_of(cfg, exp, default=list(exp.routes or ARDIN_ROUTES))
     units = []
     for axis, level in robustness.conditions(exp, db):
-        cexp, cdb = with_condition(exp, db, axis, level)
-        for i, route in enumerate(routes):
-            learned = tuple(routes[(i + k) % len(routes)] for k in range(min(cexp.routes_learned_together, len(routes))))
+        if axis == WORLD_AXIS:
+            (cdb, here), cexp = worlds[level], dataclasses.replace(exp, sweep={}, worlds={})
+        else:
+            (cexp, cdb), here = with_condition(exp, db, axis, level), routes
+        for i, route in enumerate(here):
+            learned = tuple(here[(i + k) % len(here)] for k in range(min(cexp.routes_learned_together, len(here))))
             for seed in exp.seeds:
                 for agent in exp.agents:
                     if kinds[agent] == "homing" and axis == "routes_learned_together":
                         continue  # a homing follower learns its own route's views only
                     units.append(Unit(cexp, frozen(cdb), str(cfg.cache_dir), route, learned, int(seed), agent,
-                                      kinds[agent], homing.get(agent), axis, float(level) if axis else None,
+                                      kinds[agent], homing.get(agent), axis,
+                                      level if axis == WORLD_AXIS else float(level) if axis else None,
                                       keep_path=not axis and seed == exp.seeds[0]))
     return units
 
@@ -164,8 +171,9 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     kinds = _agent_kinds(exp.agents)
     _check_agent_params(exp, kinds)
     check_step_budget(routes, exp, routes_file(cfg))
+    db = OmegaConf.to_container(cfg.db, resolve=True)
     if is_bag(cfg):  # the drive read once per process (units.route_of), its length checked; its own name in the rows
-        setup = route_of(frozen(OmegaConf.to_container(cfg.db, resolve=True)), str(cfg.cache_dir), routes[0])
+        setup = route_of(frozen(db), str(cfg.cache_dir), routes[0])
         check_route_length(setup.name, float(np.linalg.norm(np.diff(setup.dense_xy, axis=0), axis=1).sum()), exp)
         routes = [setup.name]
     units = _units(exp, cfg, routes, kinds)
@@ -173,7 +181,7 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     rows, paths = [], {}
     wall0 = time.perf_counter()
     desc = f"ardin2016: {len(routes)} routes x {len(exp.agents)} agents x {len(exp.seeds)} seeds" + \
-        (f" x {len(units) // max(1, len(routes) * len(exp.agents) * len(exp.seeds))} conditions" if exp.sweep else "")
+        (f" x {len(robustness.conditions(exp, db))} conditions" if exp.sweep or exp.worlds else "")
     for unit, row in zip(units, ctx.progress(_run_units(units, ctx, workers), desc=desc, total=len(units))):
         path = row.pop("path")
         ctx.log.write(PATH_TOPIC, {"route": row["route"], "method": row["agent"], "xy": path.tolist(),
@@ -189,7 +197,7 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
     if exp.plots:
         from bionav.experiments.route_homing.plots import plot_errors_per_route, plot_world_routes
 
-        setups = [route_of(frozen(OmegaConf.to_container(cfg.db, resolve=True)), str(cfg.cache_dir), r) for r in routes]
+        setups = [route_of(frozen(db), str(cfg.cache_dir), r) for r in routes]
         plot_world_routes(ctx.plots / "world_routes.png", setups[0].world, setups, paths)
         plot_errors_per_route(ctx.plots / "errors_per_route.png", table, list(exp.agents),
                               title=f"{len(routes)} routes x {len(exp.seeds)} seed(s), protocol of Ardin et al. 2016",
@@ -198,8 +206,9 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
                             extra={"db": str(cfg.db.name), "protocol": "ardin2016", "workers": workers,
                                    "position_jitter_m": exp.position_jitter_m, "step_m": exp.agent_step_m,
                                    "wall_s": time.perf_counter() - wall0})
-    if exp.sweep:
-        metrics.update(robustness.write(ctx, rows, exp=exp, agents=list(exp.agents)))
+    if exp.sweep or exp.worlds:
+        metrics.update(robustness.write(ctx, rows, exp=exp, agents=list(exp.agents),
+                                        base_world=world_label(db)))
     return metrics
 
 

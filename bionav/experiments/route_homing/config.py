@@ -75,6 +75,9 @@ class RouteHomingConfig:
     sweep : ``ardin2016``: robustness axes ``{axis: [levels]}`` (axes :data:`SWEEP_AXES`); each level
         is run with every other setting as given, and ``robustness.csv`` and ``plots/robustness_<axis>.png``
         summarise them (docs/worlds.md).
+    worlds : ``ardin2016``: second worlds ``{label: {db: preset, <db key>: value, routes: [...]}}``, each a
+        condition of the sweep's ``world`` axis (:mod:`bionav.experiments.route_homing.worlds`): a robot's drive
+        (``db: bag``) or a mesh world with routes (``db: seville_route``, ``path``, ``routes_path``, ``routes``).
     """
 
     name: str = "route_homing"
@@ -113,6 +116,7 @@ class RouteHomingConfig:
     route_weight: float = bounded(0.5, ge=0.0, le=1.0)
     follower_window: int = bounded(5, ge=1, le=10_000)
     sweep: dict[str, Any] = field(default_factory=dict)
+    worlds: dict[str, Any] = field(default_factory=dict)
 
     def validate(self) -> None:
         """``offsets_m`` includes 0, the route itself; ``sweep`` names known axes with lists of levels in range.
@@ -131,6 +135,13 @@ class RouteHomingConfig:
                                 f"+experiment.sweep.{axis}=[...].")
             for level in levels:
                 sweep_level(self, axis, level)
+        if self.worlds:
+            if self.protocol != "ardin2016":
+                raise UserError("experiment.worlds runs the published test in second worlds: add "
+                                "experiment.protocol=ardin2016.")
+            from bionav.experiments.route_homing.worlds import check_worlds
+
+            check_worlds(self.worlds)
 
 
 def sweep_level(exp: "RouteHomingConfig", axis: str, level: Any) -> Any:
