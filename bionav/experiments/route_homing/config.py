@@ -6,6 +6,7 @@ with zone. Checked by the runner before the run (:func:`bionav.experiments.setti
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
@@ -17,6 +18,8 @@ ROUTE_PROTOCOLS = ("bionav", "ardin2016")
 #: ``experiment.sweep`` axes (``ardin2016``): the experiment key each varies (``camera_height_m`` is ``db.camera_height_m``)
 SWEEP_AXES = ("position_jitter_m", "heading_noise_deg", "start_offset_m", "training_stride", "camera_height_m",
               "routes_learned_together")
+#: labels of ``experiment.worlds``
+_WORLD_LABEL = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
 @dataclass
@@ -139,9 +142,23 @@ class RouteHomingConfig:
             if self.protocol != "ardin2016":
                 raise UserError("experiment.worlds runs the published test in second worlds: add "
                                 "experiment.protocol=ardin2016.")
-            from bionav.experiments.route_homing.worlds import check_worlds
-
             check_worlds(self.worlds)
+
+
+def check_worlds(worlds: dict) -> None:
+    """``experiment.worlds``: labels that are plain names, each world a mapping (called by :meth:`RouteHomingConfig.validate`)."""
+    for label, entry in worlds.items():
+        if not isinstance(label, str) or not _WORLD_LABEL.match(label):
+            raise UserError(f"experiment.worlds: bad label {label!r}; use letters, digits, '_', '-' or '.', e.g. "
+                            "+experiment.worlds.pillars={db:bag,path:DRIVE,image_topic:/camera/image,pose_topic:/odom}.")
+        if not isinstance(entry, dict):
+            raise UserError(f"experiment.worlds.{label} must be a mapping of db keys (and routes), e.g. "
+                            f"+experiment.worlds.{label}={{db:bag,path:DRIVE,image_topic:/camera/image,pose_topic:/odom}}.")
+        routes = entry.get("routes")
+        if routes is not None and (not isinstance(routes, (list, tuple)) or not routes
+                                   or not all(isinstance(r, str) for r in routes)):
+            raise UserError(f"experiment.worlds.{label}.routes must be a non-empty list of route names, e.g. "
+                            "routes:[Ant1_Route1,Ant2_Route1].")
 
 
 def sweep_level(exp: "RouteHomingConfig", axis: str, level: Any) -> Any:

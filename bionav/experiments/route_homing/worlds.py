@@ -16,7 +16,6 @@ Seville world does (:func:`bionav.evaluation.route_setup.setup_route`).
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +26,6 @@ from bionav.errors import UserError
 from bionav.experiments.route_homing.config import RouteHomingConfig
 
 WORLD_AXIS = "world"
-_LABEL = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
 def world_label(db: dict) -> str:
@@ -38,22 +36,6 @@ def world_label(db: dict) -> str:
     if db.get("path"):
         return Path(str(db["path"])).stem or str(db.get("name"))
     return str(db.get("name"))
-
-
-def check_worlds(worlds: dict) -> None:
-    """``experiment.worlds``: labels that are plain names, each world a mapping (called by the config's validation)."""
-    for label, entry in worlds.items():
-        if not isinstance(label, str) or not _LABEL.match(label):
-            raise UserError(f"experiment.worlds: bad label {label!r}; use letters, digits, '_', '-' or '.', e.g. "
-                            "+experiment.worlds.pillars={db:bag,path:DRIVE,image_topic:/camera/image,pose_topic:/odom}.")
-        if not isinstance(entry, dict):
-            raise UserError(f"experiment.worlds.{label} must be a mapping of db keys (and routes), e.g. "
-                            f"+experiment.worlds.{label}={{db:bag,path:DRIVE,image_topic:/camera/image,pose_topic:/odom}}.")
-        routes = entry.get("routes")
-        if routes is not None and (not isinstance(routes, (list, tuple)) or not routes
-                                   or not all(isinstance(r, str) for r in routes)):
-            raise UserError(f"experiment.worlds.{label}.routes must be a non-empty list of route names, e.g. "
-                            "routes:[Ant1_Route1,Ant2_Route1].")
 
 
 def world_node(cfg: DictConfig, label: str, entry: dict) -> dict:
