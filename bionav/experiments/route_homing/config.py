@@ -81,6 +81,8 @@ class RouteHomingConfig:
     worlds : ``ardin2016``: second worlds ``{label: {db: preset, <db key>: value, routes: [...]}}``, each a
         condition of the sweep's ``world`` axis (:mod:`bionav.experiments.route_homing.worlds`): a robot's drive
         (``db: bag``) or a mesh world with routes (``db: seville_route``, ``path``, ``routes_path``, ``routes``).
+    block : ``ardin2016``: ``[i, n]``: this run is task i of n, every n-th group of units (one route, seed and
+        condition) from the i-th; ``python -m bionav.experiments.merge OUT TASK_DIR...`` joins the tasks.
     """
 
     name: str = "route_homing"
@@ -120,6 +122,7 @@ class RouteHomingConfig:
     follower_window: int = bounded(5, ge=1, le=10_000)
     sweep: dict[str, Any] = field(default_factory=dict)
     worlds: dict[str, Any] = field(default_factory=dict)
+    block: Optional[list[int]] = bounded(None, length=(2, 2), item=Range(ge=0, le=10**6))
 
     def validate(self) -> None:
         """``offsets_m`` includes 0, the route itself; ``sweep`` names known axes with lists of levels in range.
@@ -138,6 +141,9 @@ class RouteHomingConfig:
                                 f"+experiment.sweep.{axis}=[...].")
             for level in levels:
                 sweep_level(self, axis, level)
+        if self.block is not None and self.protocol != "ardin2016":
+            raise UserError("experiment.block splits the published test (experiment.protocol=ardin2016) into tasks; "
+                            "add experiment.protocol=ardin2016 or drop experiment.block.")
         if self.worlds:
             if self.protocol != "ardin2016":
                 raise UserError("experiment.worlds runs the published test in second worlds: add "
