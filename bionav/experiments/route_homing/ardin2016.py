@@ -221,11 +221,11 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
         return {**run_info, "block": [int(v) for v in exp.block], "n_units": len(units), "task_units": len(mine),
                 "routes": routes, "agents": list(exp.agents), "seeds": list(exp.seeds), "kinds": kinds,
                 "run_db": db, "cache_dir": str(cfg.cache_dir), "settings": {**dataclasses.asdict(exp), "block": None}}
-    return write_outputs(ctx.dir, rows, paths, exp=exp, db=db, cache_dir=str(cfg.cache_dir), routes=routes,
+    return write_ardin_outputs(ctx.dir, rows, paths, exp=exp, db=db, cache_dir=str(cfg.cache_dir), routes=routes,
                          kinds=kinds, run_info=run_info)
 
 
-def write_outputs(out: Path, rows: list[dict], paths: dict, *, exp: RouteHomingConfig, db: dict, cache_dir: str,
+def write_ardin_outputs(out: Path, rows: list[dict], paths: dict, *, exp: RouteHomingConfig, db: dict, cache_dir: str,
                   routes: list[str], kinds: dict[str, str], run_info: dict) -> dict[str, Any]:
     """The whole run's files in ``out`` from its rows (in unit order) and the paths of the run as configured (first
     seed): ``route_following.csv``, ``errors_per_route.csv``, the plots, ``robustness.csv``; the metrics."""
@@ -295,4 +295,4 @@ def ardin_metrics(rows: list[dict], *, routes: list[str], agents: list[str], see
     return m
 
 
-__all__ = ["ARDIN_ROUTES", "ardin_metrics", "per_route_table", "run", "unit_groups", "write_outputs"]
+__all__ = ["ARDIN_ROUTES", "ardin_metrics", "per_route_table", "run", "unit_groups", "write_ardin_outputs"]

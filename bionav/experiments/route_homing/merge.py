@@ -4,7 +4,7 @@
 (:class:`bionav.experiments.route_homing.RouteHoming`). Each task ran every n-th group of units (one route,
 seed and condition) and wrote their rows (with each unit's index in the whole run) and paths; the merge puts
 the rows back in unit order and writes the unsplit run's files
-(:func:`bionav.experiments.route_homing.ardin2016.write_outputs`). Every unit has its own random streams, so
+(:func:`bionav.experiments.route_homing.ardin2016.write_ardin_outputs`). Every unit has its own random streams, so
 the rows equal those of the unsplit run (CPU times aside).
 """
 
@@ -18,7 +18,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from bionav.errors import UserError
-from bionav.experiments.route_homing.ardin2016 import ARDIN_CSV, write_outputs
+from bionav.experiments.route_homing.ardin2016 import ARDIN_CSV, write_ardin_outputs
 from bionav.experiments.route_homing.config import RouteHomingConfig
 from bionav.experiments.route_homing.shared import PATH_SCHEMA, PATH_TOPIC
 from bionav.experiments.runner import LOG_FILE
@@ -98,7 +98,7 @@ def merge(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
             log.write(PATH_TOPIC, msg, schema_name="bionav.RoutePath", schema=PATH_SCHEMA)
     info = {k: meta[k] for k in ("db", "protocol", "position_jitter_m", "step_m")}
     info.update(workers=[m["workers"] for m in metas], wall_s=math.fsum(m["wall_s"] for m in metas))
-    metrics = write_outputs(out, rows, paths, exp=exp, db=meta["run_db"], cache_dir=meta["cache_dir"],
+    metrics = write_ardin_outputs(out, rows, paths, exp=exp, db=meta["run_db"], cache_dir=meta["cache_dir"],
                             routes=list(meta["routes"]), kinds=dict(meta["kinds"]), run_info=info)
     metrics.update(experiment=meta["experiment"], tasks=len(metas), status="completed",
                    wall_time_s=round(math.fsum(float(m.get("wall_time_s", 0.0)) for m in metas), 3))
