@@ -229,8 +229,16 @@ def mushroom_body_train(kc_to_en: np.ndarray, active: np.ndarray, *, depression:
 
 
 def mushroom_body_novelty(kc_to_en: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """Extrinsic-neuron output per view: ``sum`` of the weights of the active KCs, shape ``(K,)`` (lower = more familiar)."""
-    return np.asarray(active, np.float64) @ np.asarray(kc_to_en, np.float64)
+    """Extrinsic-neuron output per view: ``sum`` of the weights of the active KCs, shape ``(K,)`` (lower = more familiar).
+
+    With weights of 0 and 1 only (one-shot depression) the sum is the count of active KCs of weight 1, counted
+    as such (the same numbers, exact in either form).
+    """
+    w = np.asarray(kc_to_en, np.float64)
+    a = np.asarray(active)
+    if a.dtype == bool and np.all((w == 0.0) | (w == 1.0)):
+        return np.count_nonzero(a & (w == 1.0), axis=1).astype(np.float64)
+    return a.astype(np.float64) @ w
 
 
 __all__ = ["infomax_initial_weights", "infomax_train", "infomax_unfamiliarity", "kenyon_activity",
