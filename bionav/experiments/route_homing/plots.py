@@ -137,16 +137,18 @@ def plot_robustness(path, summary: list[dict], *, axis: str, unit: str, agents: 
     def x_of(r):
         return float(categories.index(str(r["level"]))) if categories else float(r["level"])
 
+    style = "o:" if categories else "o-"  # worlds are not a scale: dotted joins
+
     for a in agents:
         mine = sorted((r for r in summary if r["agent"] == a), key=x_of)
         if not mine:
             continue
         x = np.array([x_of(r) for r in mine])
         med = np.array([float(r["errors_median"]) for r in mine])
-        line, = ax_e.plot(x, med, "o-", ms=4, label=a.replace("_", " "))
+        line, = ax_e.plot(x, med, style, ms=4, label=a.replace("_", " "))
         ax_e.fill_between(x, [float(r["errors_q25"]) for r in mine], [float(r["errors_q75"]) for r in mine],
                           color=line.get_color(), alpha=0.15, lw=0)
-        nest, = ax_n.plot(x, [100.0 * float(r["reached_nest"]) for r in mine], "o-", ms=4, color=line.get_color())
+        nest, = ax_n.plot(x, [100.0 * float(r["reached_nest"]) for r in mine], style, ms=4, color=line.get_color())
         drawn[a] = (np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float),
                     np.asarray(nest.get_ydata(), float))
     ax_e.set_xlabel(f"{axis} ({unit})" if unit else axis)
