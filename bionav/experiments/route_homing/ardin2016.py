@@ -222,11 +222,11 @@ def run(exp: RouteHomingConfig, ctx) -> dict[str, Any]:
                 "routes": routes, "agents": list(exp.agents), "seeds": list(exp.seeds), "kinds": kinds,
                 "run_db": db, "cache_dir": str(cfg.cache_dir), "settings": {**dataclasses.asdict(exp), "block": None}}
     return write_ardin_outputs(ctx.dir, rows, paths, exp=exp, db=db, cache_dir=str(cfg.cache_dir), routes=routes,
-                         kinds=kinds, run_info=run_info)
+                               kinds=kinds, run_info=run_info)
 
 
 def write_ardin_outputs(out: Path, rows: list[dict], paths: dict, *, exp: RouteHomingConfig, db: dict, cache_dir: str,
-                  routes: list[str], kinds: dict[str, str], run_info: dict) -> dict[str, Any]:
+                        routes: list[str], kinds: dict[str, str], run_info: dict) -> dict[str, Any]:
     """The whole run's files in ``out`` from its rows (in unit order) and the paths of the run as configured (first
     seed): ``route_following.csv``, ``errors_per_route.csv``, the plots, ``robustness.csv``; the metrics."""
     from types import SimpleNamespace

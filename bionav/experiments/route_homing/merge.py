@@ -99,7 +99,7 @@ def merge(task_dirs: Sequence[Path], out: Path) -> dict[str, Any]:
     info = {k: meta[k] for k in ("db", "protocol", "position_jitter_m", "step_m")}
     info.update(workers=[m["workers"] for m in metas], wall_s=math.fsum(m["wall_s"] for m in metas))
     metrics = write_ardin_outputs(out, rows, paths, exp=exp, db=meta["run_db"], cache_dir=meta["cache_dir"],
-                            routes=list(meta["routes"]), kinds=dict(meta["kinds"]), run_info=info)
+                                  routes=list(meta["routes"]), kinds=dict(meta["kinds"]), run_info=info)
     metrics.update(experiment=meta["experiment"], tasks=len(metas), status="completed",
                    wall_time_s=round(math.fsum(float(m.get("wall_time_s", 0.0)) for m in metas), 3))
     finish_merge(task_dirs, out, metrics)
