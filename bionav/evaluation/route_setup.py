@@ -18,7 +18,7 @@ heading rendered at; camera noise and 8-bit quantisation as the databases'
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -58,6 +58,9 @@ class RouteSetup:
         The snapshots' geometry.
     noise : float
         Camera noise std before 8-bit quantisation (0 for a recorded world).
+    scans : dict
+        The noiseless scan panoramas rendered so far, by scan geometry and pose (:func:`scan_renderer`:
+        agents that stand where another stood, or on a training view, reuse its render; the noise is drawn anew).
     """
 
     name: str
@@ -69,6 +72,11 @@ class RouteSetup:
     height: float
     geometry: Any
     noise: float
+    scans: dict = field(default_factory=dict, repr=False)
+
+
+#: most noiseless scan panoramas kept per route (about 27 kB each at 2-degree columns)
+MAX_KEPT_SCANS = 768
 
 
 def check_route_views(name: str, dense_xy: np.ndarray, step_m: float) -> None:
@@ -196,13 +204,19 @@ def scan_renderer(setup: RouteSetup, rng: np.random.Generator, *, scan_step_deg:
                                        view_size=view_size)
     geometry, col, shift = scan_geometry(scan_step_deg=scan_step_deg, supersample=supersample)
 
+    def panorama(xy, heading):
+        key = (scan_step_deg, supersample, float(xy[0]), float(xy[1]), float(heading))
+        if key not in setup.scans:
+            z = _camera_z(setup, xy)
+            img = render_mesh_panorama(setup.world, position=(xy[0], xy[1], z), heading=heading + shift,
+                                       geometry=geometry).mean(axis=-1)
+            if len(setup.scans) >= MAX_KEPT_SCANS:
+                setup.scans.pop(next(iter(setup.scans)))
+            setup.scans[key] = box_panorama(img, supersample=supersample, column_deg=col) if supersample > 1 else img
+        return setup.scans[key]
+
     def views(xy, heading):
-        z = _camera_z(setup, xy)
-        img = render_mesh_panorama(setup.world, position=(xy[0], xy[1], z), heading=heading + shift, geometry=geometry)
-        img = img.mean(axis=-1)
-        if supersample > 1:
-            img = box_panorama(img, supersample=supersample, column_deg=col)
-        img = quantise(img, noise=setup.noise, rng=rng).astype(np.float32) / np.float32(255.0)
+        img = quantise(panorama(xy, heading), noise=setup.noise, rng=rng).astype(np.float32) / np.float32(255.0)
         return scan_views(img, column_deg=col, scan_half_deg=scan_half_deg, scan_step_deg=col, size=view_size)
 
     return views

@@ -172,3 +172,17 @@ def load_samples(data):
                   n_sky=int(_get("n_sky", 233)), sensor=sensor, n_average=int(_get("n_average", 10)))
     raise UserError(f"Unknown data set {name!r} for experiment=contrast_lda. Choose data=sim_natural, "
                     f"data=sim_artificial, or data=csv data.path=FILE.")
+
+
+def db_preset(name: str, *, key: str = "the cross_db family") -> dict:
+    """The ``bionav/conf/db/<name>.yaml`` preset from any config folder (``key``: where the name was given, for the
+    message naming a missing preset)."""
+    import yaml
+
+    from bionav.config import config_dirs
+
+    for _n, folder in config_dirs():
+        path = folder / "db" / f"{name}.yaml"
+        if path.is_file():
+            return yaml.safe_load(path.read_text()) or {}
+    raise UserError(f"{key} names the database {name!r}, which has no preset (bionav/conf/db/{name}.yaml).")

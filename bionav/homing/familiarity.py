@@ -194,14 +194,19 @@ def kenyon_activity(inputs: np.ndarray, connections, *, n_active: int,
     drive = kenyon_drive(inputs, connections)
     if thresholds is not None:
         centre, scale = thresholds
-        drive = (drive - centre) / scale
+        drive -= centre  # in place: the same values as (drive - centre) / scale, without two more arrays
+        drive /= scale
     n_kc = drive.shape[1]
     k = int(min(max(n_active, 1), n_kc))
     kth = np.partition(drive, n_kc - k, axis=1)[:, n_kc - k][:, None]  # the k-th largest drive of each view
-    above = drive > kth
-    tied = drive == kth
-    need = k - above.sum(axis=1, keepdims=True)
-    return above | (tied & (np.cumsum(tied, axis=1) <= need))
+    fire = drive >= kth
+    over = np.flatnonzero(fire.sum(axis=1) > k)  # rows where drives tie with the k-th: fire in index order
+    if len(over):
+        rows = drive[over]
+        above = rows > kth[over]
+        tied = rows == kth[over]
+        fire[over] = above | (tied & (np.cumsum(tied, axis=1) <= k - above.sum(axis=1, keepdims=True)))
+    return fire
 
 
 def mushroom_body_train(kc_to_en: np.ndarray, active: np.ndarray, *, depression: float) -> np.ndarray:
@@ -224,8 +229,16 @@ def mushroom_body_train(kc_to_en: np.ndarray, active: np.ndarray, *, depression:
 
 
 def mushroom_body_novelty(kc_to_en: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """Extrinsic-neuron output per view: ``sum`` of the weights of the active KCs, shape ``(K,)`` (lower = more familiar)."""
-    return np.asarray(active, np.float64) @ np.asarray(kc_to_en, np.float64)
+    """Extrinsic-neuron output per view: ``sum`` of the weights of the active KCs, shape ``(K,)`` (lower = more familiar).
+
+    With weights of 0 and 1 only (one-shot depression) the sum is the count of active KCs of weight 1, counted
+    as such (the same numbers, exact in either form).
+    """
+    w = np.asarray(kc_to_en, np.float64)
+    a = np.asarray(active)
+    if a.dtype == bool and np.all((w == 0.0) | (w == 1.0)):
+        return np.count_nonzero(a & (w == 1.0), axis=1).astype(np.float64)
+    return a.astype(np.float64) @ w
 
 
 __all__ = ["infomax_initial_weights", "infomax_train", "infomax_unfamiliarity", "kenyon_activity",

@@ -88,3 +88,55 @@ def test_route_options_that_do_not_fit_a_bag(tmp_path, drive):
     proc = run_bionav(*ROUTE, f"db.path={drive}", "experiment.routes=[Ant1_Route1]", f"hydra.run.dir={tmp_path / 'b'}",
                       cwd=tmp_path)
     assert_fails_cleanly(proc, "drop experiment.routes")
+
+
+@pytest.mark.slow
+def test_a_second_world_on_the_robustness_sweep(tmp_path, drive):
+    """experiment.worlds puts a second world on the sweep (axis ``world``): the agents follow Ant1_Route1 in the
+    Seville world and the bag's drive through the pillar room, where the known answer holds (perfect memory and
+    infomax: no put-back, the nest reached, as in the drive's own run above). robustness.csv sets the two worlds
+    side by side from the rows of each; the figure's lines are those numbers."""
+    import csv
+
+    from bionav.experiments.route_homing.plots import plot_robustness
+
+    world = (f"+experiment.worlds.pillars={{db:bag,path:{drive},image_topic:/camera/image,pose_topic:/odom,"
+             "route_step_m:0.1}")
+    proc = run_bionav("experiment=route_homing", "experiment.protocol=ardin2016", "experiment.routes=[Ant1_Route1]",
+                      "experiment.agents=[perfect_memory,infomax]", world, f"cache_dir={tmp_path / 'cache'}",
+                      f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    run = tmp_path / "run"
+    rows = list(csv.DictReader((run / "route_following.csv").open()))
+    assert [(r["route"], r["agent"], r["axis"], r["level"]) for r in rows] == [
+        ("Ant1_Route1", "perfect_memory", "", ""), ("Ant1_Route1", "infomax", "", ""),
+        ("drive_camera_image", "perfect_memory", "world", "pillars"), ("drive_camera_image", "infomax", "world", "pillars")]
+    for r in rows[2:]:
+        assert r["errors"] == "0" and r["reached_nest"] == "1", r
+    summary = [s for s in csv.DictReader((run / "robustness.csv").open()) if s["axis"] == "world"]
+    assert [(s["level"], s["agent"]) for s in summary] == [("seville2009", "perfect_memory"), ("seville2009", "infomax"),
+                                                           ("pillars", "perfect_memory"), ("pillars", "infomax")]
+    for s, r in zip(summary, rows):
+        assert float(s["errors_median"]) == float(r["errors"]) and float(s["reached_nest"]) == float(r["reached_nest"])
+    lines = plot_robustness(tmp_path / "w.png", summary, axis="world", unit="", agents=["perfect_memory", "infomax"],
+                            categories=["seville2009", "pillars"])
+    for agent, (x, med, nest) in lines.items():
+        mine = [s for s in summary if s["agent"] == agent]
+        assert x.tolist() == [0.0, 1.0] and med.tolist() == [float(s["errors_median"]) for s in mine]
+        assert nest.tolist() == [100.0 * float(s["reached_nest"]) for s in mine]
+    assert (run / "plots" / "robustness_world.png").is_file()
+    m = json.loads((run / "metrics.json").read_text())
+    assert m["sweep"] == {"world": ["seville2009", "pillars"]} and m["n_conditions"] == 2
+
+
+def test_a_bad_second_world_is_one_clear_message(tmp_path):
+    base = ("experiment=route_homing", "experiment.protocol=ardin2016", "experiment.routes=[Ant1_Route1]",
+            "experiment.agents=[perfect_memory]")
+    proc = run_bionav(*base, "+experiment.worlds.x={db:nosuchdb}", f"hydra.run.dir={tmp_path / 'a'}", cwd=tmp_path)
+    assert_fails_cleanly(proc, "experiment.worlds.x.db", "nosuchdb")
+    proc = run_bionav(*base, "+experiment.worlds.x={db:bag,path:" + str(tmp_path / "missing") + "}",
+                      f"hydra.run.dir={tmp_path / 'b'}", cwd=tmp_path)
+    assert_fails_cleanly(proc, "missing")
+    proc = run_bionav("experiment=route_homing", "+experiment.worlds.x={db:bag}", f"hydra.run.dir={tmp_path / 'c'}",
+                      cwd=tmp_path)
+    assert_fails_cleanly(proc, "experiment.protocol=ardin2016")

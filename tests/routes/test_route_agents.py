@@ -145,6 +145,8 @@ def test_algorithms_match_plain_references():
     np.testing.assert_array_equal(mushroom_body_novelty(w_en, act), [0, 0, (act[2] & ~act[0] & ~act[1]).sum()])
     half = mushroom_body_train(np.ones(50), act[:2], depression=0.5)
     np.testing.assert_allclose(half, 0.5 ** act[:2].sum(0))
+    plain = [sum(half[k] for k in range(50) if act[v, k]) for v in range(3)]  # weights not 0/1: the weighted sum
+    np.testing.assert_allclose(mushroom_body_novelty(half, act), plain, rtol=1e-12)
 
 
 # --------------------------------------------------------------------------- each agent on a tiny synthetic route

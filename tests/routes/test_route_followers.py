@@ -358,3 +358,55 @@ def test_per_kc_thresholds_stop_kcs_on_bright_pixels_from_firing_on_every_view()
         share["all"] = bright.mean()
     assert share["shared"] == 1.0
     assert 0.1 < share["all"] < 0.3 and share["per_kc"] < 2 * share["all"], share
+
+
+@pytest.mark.slow
+def test_a_split_ardin2016_run_merges_into_the_unsplit_run(tmp_path):
+    """experiment.block=[i,2] runs every other group of units (route, seed, condition); python -m
+    bionav.experiments.merge joins the two tasks into the files of the unsplit run: the same rows in the same
+    order (CPU times aside), the same per-route table, robustness.csv and metrics; a task given twice is refused."""
+    import csv
+    import json
+
+    from helpers import assert_fails_cleanly, run_bionav
+
+    common = ["experiment=route_homing", "experiment.protocol=ardin2016", "experiment.routes=[Ant2_Route1]",
+              "experiment.agents=[perfect_memory,random_choice]", "+experiment.sweep.heading_noise_deg=[0,20]",
+              "+experiment.sweep.training_stride=[1,4]", f"cache_dir={tmp_path / 'cache'}"]
+    for name, extra in (("whole", []), ("t0", ["experiment.block=[0,2]"]), ("t1", ["experiment.block=[1,2]"])):
+        proc = run_bionav(*common, *extra, f"hydra.run.dir={tmp_path / name}", cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+    t0 = list(csv.DictReader((tmp_path / "t0" / "route_following.csv").open()))
+    assert [r["unit"] for r in t0] == ["0", "1", "4", "5"]  # groups 0 and 2 of 3 (the run, heading noise 20, stride 4)
+    proc = run_bionav(str(tmp_path / "merged"), str(tmp_path / "t1"), str(tmp_path / "t0"),
+                      module="bionav.experiments.merge", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "merged 2 route_homing tasks" in proc.stdout
+
+    def table(run, name, drop=("cpu_s", "views_cpu_s", "cpu_s_per_route")):
+        return [{k: v for k, v in r.items() if k not in drop} for r in csv.DictReader((tmp_path / run / name).open())]
+
+    for name in ("route_following.csv", "errors_per_route.csv", "robustness.csv"):
+        assert table("merged", name) == table("whole", name), name
+    whole = json.loads((tmp_path / "whole" / "metrics.json").read_text())
+    merged = json.loads((tmp_path / "merged" / "metrics.json").read_text())
+    for key in ("errors_per_route_perfect_memory", "errors_by_route_random_choice", "sweep", "n_conditions"):
+        assert merged[key] == whole[key], key
+    assert (tmp_path / "merged" / "plots" / "robustness_training_stride.png").is_file()
+    assert (tmp_path / "merged" / "plots" / "world_routes.png").is_file()
+    proc = run_bionav(str(tmp_path / "again"), str(tmp_path / "t0"), str(tmp_path / "t0"),
+                      module="bionav.experiments.merge", cwd=tmp_path)
+    assert_fails_cleanly(proc, "block")
+
+
+@pytest.mark.parametrize("args, needles", [
+    (["experiment.protocol=ardin2016", "experiment.block=[3,2]"], ("experiment.block", "0 <= i < n")),
+    (["experiment.protocol=ardin2016", "experiment.block=[1,2]"], ("selects no group of units", "at most 1 tasks")),
+    (["experiment.block=[0,2]"], ("experiment.protocol=ardin2016",)),
+])
+def test_a_bad_block_is_one_clear_message(tmp_path, args, needles):
+    from helpers import assert_fails_cleanly, run_bionav
+
+    proc = run_bionav("experiment=route_homing", "experiment.routes=[Ant2_Route1]", "experiment.agents=[random_choice]",
+                      *args, f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path)
+    assert_fails_cleanly(proc, *needles)

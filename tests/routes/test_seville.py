@@ -243,3 +243,26 @@ def test_route_database_views_sit_on_the_route_at_the_recorded_heading(tmp_path,
     k = len(db) // 2
     again = render_mesh_panorama(world, position=(*xy[k], 0.01), heading=float(db.headings[k]), geometry=db.geometry)
     assert np.abs(again[..., 0] - db.images[k]).max() <= 0.5 / 255 + 1e-6  # noise 0: only 8-bit rounding
+
+
+def test_a_scan_rendered_again_at_the_same_pose_reuses_the_render_and_draws_new_noise(tmp_path):
+    """scan_renderer keeps the noiseless panorama of a pose per route: a second agent at the same pose gets the
+    views a fresh render gives with its own noise stream (equal for the same stream, different for another)."""
+    from bionav.config import compose
+    from bionav.evaluation.route_setup import scan_renderer, setup_route, travel_headings
+
+    cfg = compose(["db=seville_route", "db.step_m=0.5"])
+    setup = setup_route(dict(cfg.db), "Ant1_Route1", cache_dir=str(tmp_path))
+    xy, heading = setup.xy[2], float(travel_headings(setup.xy)[2])
+    opts = {"scan_step_deg": 2, "supersample": 4, "scan_half_deg": 60.0, "view_size": [36, 10]}
+    first, offsets = scan_renderer(setup, np.random.default_rng(1), **opts)(xy, heading)
+    assert len(setup.scans) == 1 and first.shape == (61, 10, 36) and len(offsets) == 61
+    again, _ = scan_renderer(setup, np.random.default_rng(1), **opts)(xy, heading)  # from the kept render
+    other, _ = scan_renderer(setup, np.random.default_rng(2), **opts)(xy, heading)
+    assert len(setup.scans) == 1
+    setup.scans.clear()
+    fresh, _ = scan_renderer(setup, np.random.default_rng(1), **opts)(xy, heading)  # rendered anew
+    assert np.array_equal(first, again) and np.array_equal(first, fresh)
+    assert not np.array_equal(first, other)  # the camera noise is the agent's own
+    scan_renderer(setup, np.random.default_rng(1), **opts)(xy + 0.01, heading)
+    assert len(setup.scans) == 2  # another pose, another render

@@ -14,14 +14,13 @@ from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
-import yaml
 from omegaconf import DictConfig, OmegaConf
 
 from bionav.errors import UserError
 from bionav.evaluation.agent import evaluate_agents
 from bionav.evaluation.measures import angular_errors, ideal_home_angles, quality_measures
 from bionav.evaluation.pairs import home_vector_matrix, prepare_images
-from bionav.experiments.common import load_configured_database, make_homing, prepared_cache
+from bionav.experiments.common import db_preset, load_configured_database, make_homing, prepared_cache
 from bionav.experiments.cross_db.config import CrossDbConfig
 from bionav.experiments.cross_db.plots import MEASURES, plot_cross_db
 from bionav.experiments.tasks import block_of
@@ -29,17 +28,6 @@ from bionav.files import write_csv_atomic
 
 #: settings of cfg.db that apply to every member of the family
 SHARED_DB_KEYS = ("image_size", "seed", "noise", "rotate_current", "rotation_seed")
-
-
-def db_preset(name: str) -> dict:
-    """The ``bionav/conf/db/<name>.yaml`` preset from any config folder."""
-    from bionav.config import config_dirs
-
-    for _n, folder in config_dirs():
-        path = folder / "db" / f"{name}.yaml"
-        if path.is_file():
-            return yaml.safe_load(path.read_text()) or {}
-    raise UserError(f"the cross_db family names the database {name!r}, which has no preset (bionav/conf/db/{name}.yaml).")
 
 
 def family_nodes(cfg: DictConfig, family) -> list[dict]:

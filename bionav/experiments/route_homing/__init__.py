@@ -20,6 +20,14 @@ class RouteHoming(Experiment):
         methods = list(node.get("methods") or []) if node is not None and hasattr(node, "get") else []
         return cls.plugin_groups if "homing" in methods else ()
 
+    @staticmethod
+    def merge(task_dirs, out) -> dict[str, Any]:
+        """Join the tasks (``experiment.block=[i,n]``) of one split ``ardin2016`` run into ``out``
+        (``python -m bionav.experiments.merge``)."""
+        from bionav.experiments.route_homing.merge import merge
+
+        return merge(task_dirs, out)
+
     def run(self, ctx) -> dict[str, Any]:
         if self.config.protocol == "ardin2016":
             from bionav.experiments.route_homing.ardin2016 import run

@@ -6,6 +6,7 @@ with zone. Checked by the runner before the run (:func:`bionav.experiments.setti
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
@@ -17,6 +18,8 @@ ROUTE_PROTOCOLS = ("bionav", "ardin2016")
 #: ``experiment.sweep`` axes (``ardin2016``): the experiment key each varies (``camera_height_m`` is ``db.camera_height_m``)
 SWEEP_AXES = ("position_jitter_m", "heading_noise_deg", "start_offset_m", "training_stride", "camera_height_m",
               "routes_learned_together")
+#: labels of ``experiment.worlds``
+_WORLD_LABEL = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 
 @dataclass
@@ -75,6 +78,11 @@ class RouteHomingConfig:
     sweep : ``ardin2016``: robustness axes ``{axis: [levels]}`` (axes :data:`SWEEP_AXES`); each level
         is run with every other setting as given, and ``robustness.csv`` and ``plots/robustness_<axis>.png``
         summarise them (docs/worlds.md).
+    worlds : ``ardin2016``: second worlds ``{label: {db: preset, <db key>: value, routes: [...]}}``, each a
+        condition of the sweep's ``world`` axis (:mod:`bionav.experiments.route_homing.worlds`): a robot's drive
+        (``db: bag``) or a mesh world with routes (``db: seville_route``, ``path``, ``routes_path``, ``routes``).
+    block : ``ardin2016``: ``[i, n]``: this run is task i of n, every n-th group of units (one route, seed and
+        condition) from the i-th; ``python -m bionav.experiments.merge OUT TASK_DIR...`` joins the tasks.
     """
 
     name: str = "route_homing"
@@ -113,6 +121,8 @@ class RouteHomingConfig:
     route_weight: float = bounded(0.5, ge=0.0, le=1.0)
     follower_window: int = bounded(5, ge=1, le=10_000)
     sweep: dict[str, Any] = field(default_factory=dict)
+    worlds: dict[str, Any] = field(default_factory=dict)
+    block: Optional[list[int]] = bounded(None, length=(2, 2), item=Range(ge=0, le=10**6))
 
     def validate(self) -> None:
         """``offsets_m`` includes 0, the route itself; ``sweep`` names known axes with lists of levels in range.
@@ -131,6 +141,30 @@ class RouteHomingConfig:
                                 f"+experiment.sweep.{axis}=[...].")
             for level in levels:
                 sweep_level(self, axis, level)
+        if self.block is not None and self.protocol != "ardin2016":
+            raise UserError("experiment.block splits the published test (experiment.protocol=ardin2016) into tasks; "
+                            "add experiment.protocol=ardin2016 or drop experiment.block.")
+        if self.worlds:
+            if self.protocol != "ardin2016":
+                raise UserError("experiment.worlds runs the published test in second worlds: add "
+                                "experiment.protocol=ardin2016.")
+            check_worlds(self.worlds)
+
+
+def check_worlds(worlds: dict) -> None:
+    """``experiment.worlds``: labels that are plain names, each world a mapping (called by :meth:`RouteHomingConfig.validate`)."""
+    for label, entry in worlds.items():
+        if not isinstance(label, str) or not _WORLD_LABEL.match(label):
+            raise UserError(f"experiment.worlds: bad label {label!r}; use letters, digits, '_', '-' or '.', e.g. "
+                            "+experiment.worlds.pillars={db:bag,path:DRIVE,image_topic:/camera/image,pose_topic:/odom}.")
+        if not isinstance(entry, dict):
+            raise UserError(f"experiment.worlds.{label} must be a mapping of db keys (and routes), e.g. "
+                            f"+experiment.worlds.{label}={{db:bag,path:DRIVE,image_topic:/camera/image,pose_topic:/odom}}.")
+        routes = entry.get("routes")
+        if routes is not None and (not isinstance(routes, (list, tuple)) or not routes
+                                   or not all(isinstance(r, str) for r in routes)):
+            raise UserError(f"experiment.worlds.{label}.routes must be a non-empty list of route names, e.g. "
+                            "routes:[Ant1_Route1,Ant2_Route1].")
 
 
 def sweep_level(exp: "RouteHomingConfig", axis: str, level: Any) -> Any:

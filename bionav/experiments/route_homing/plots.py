@@ -120,37 +120,47 @@ def plot_errors_per_route(path, table: list[dict], agents: list[str], *, title: 
     return drawn
 
 
-def plot_robustness(path, summary: list[dict], *, axis: str, unit: str,
-                    agents: list[str]) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+def plot_robustness(path, summary: list[dict], *, axis: str, unit: str, agents: list[str],
+                    categories: list[str] | None = None) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Errors per route (median with interquartile band) and nest arrivals against one robustness axis, per agent.
 
     ``summary`` holds rows of ``robustness.csv`` for this axis (``agent``, ``level``,
     ``errors_median``, ``errors_q25``, ``errors_q75``, ``reached_nest``). Returns, per agent drawn,
     the levels, medians and nest arrivals (%) read back from the figure's lines (what the tests
-    compare with the CSV).
+    compare with the CSV). With ``categories`` (the ``world`` axis: labels) the levels are those names, drawn at
+    x = 0, 1, ... in that order (the levels returned are these positions).
     """
     plt = pyplot()
     fig, (ax_e, ax_n) = plt.subplots(1, 2, figsize=(9.5, 3.6))
     drawn = {}
+
+    def x_of(r):
+        return float(categories.index(str(r["level"]))) if categories else float(r["level"])
+
+    style = "o:" if categories else "o-"  # worlds are not a scale: dotted joins
+
     for a in agents:
-        mine = sorted((r for r in summary if r["agent"] == a), key=lambda r: float(r["level"]))
+        mine = sorted((r for r in summary if r["agent"] == a), key=x_of)
         if not mine:
             continue
-        x = np.array([float(r["level"]) for r in mine])
+        x = np.array([x_of(r) for r in mine])
         med = np.array([float(r["errors_median"]) for r in mine])
-        line, = ax_e.plot(x, med, "o-", ms=4, label=a.replace("_", " "))
+        line, = ax_e.plot(x, med, style, ms=4, label=a.replace("_", " "))
         ax_e.fill_between(x, [float(r["errors_q25"]) for r in mine], [float(r["errors_q75"]) for r in mine],
                           color=line.get_color(), alpha=0.15, lw=0)
-        nest, = ax_n.plot(x, [100.0 * float(r["reached_nest"]) for r in mine], "o-", ms=4, color=line.get_color())
+        nest, = ax_n.plot(x, [100.0 * float(r["reached_nest"]) for r in mine], style, ms=4, color=line.get_color())
         drawn[a] = (np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float),
                     np.asarray(nest.get_ydata(), float))
     ax_e.set_xlabel(f"{axis} ({unit})" if unit else axis)
     ax_n.set_xlabel(f"{axis} ({unit})" if unit else axis)
+    if categories:
+        for ax in (ax_e, ax_n):
+            ax.set_xticks(range(len(categories)), categories, fontsize=8)
     ax_e.set_ylabel("errors per route: median (IQR)")
     ax_n.set_ylabel("routes reaching the nest (%)")
     ax_n.set_ylim(-3, 103)
     ax_e.set_ylim(bottom=-0.3)
     ax_e.legend(fontsize=7, ncol=2)
-    fig.suptitle(f"Route following against {axis} (Seville routes, protocol of Ardin et al. 2016)", fontsize=9)
+    fig.suptitle(f"Route following against {axis} (protocol of Ardin et al. 2016)", fontsize=9)
     save_figure(fig, path, dpi=110)
     return drawn

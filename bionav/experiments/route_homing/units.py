@@ -55,7 +55,7 @@ class Unit:
         ``homing``: ``(homing node, signature node)`` (:func:`frozen`; the signature ``null`` for
         methods without one).
     axis, level :
-        The condition (``""`` and None for the run as configured).
+        The condition (``""`` and None for the run as configured; axis ``world``: the world's label).
     keep_path : bool
         Its path is drawn in ``plots/world_routes.png`` (the first seed of the run as configured).
     """
@@ -70,7 +70,7 @@ class Unit:
     kind: str
     homing: Any = None
     axis: str = ""
-    level: float | None = None
+    level: float | str | None = None
     keep_path: bool = False
 
 
