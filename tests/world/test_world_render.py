@@ -172,8 +172,24 @@ def test_result_does_not_depend_on_the_number_of_threads():
     s.add_light(PointLight((0.0, 0.0, 2.5), 3.0))
     geo = PanoramaGeometry.square_pixels(120, 30)
     one = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=1)
-    two = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=2)
-    np.testing.assert_array_equal(one, two)
+    for threads in (2, 3, None):  # 8, 12 and 4 x cores blocks of columns (uneven at 3: 120 / 12 ... / 8)
+        many = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=threads)
+        np.testing.assert_array_equal(one, many)
+    # a grid narrower than the blocks (columns < 4 x threads) and one column
+    narrow = PanoramaGeometry.square_pixels(5, 30)
+    np.testing.assert_array_equal(render_panorama(s, position=(0.5, 0.5, 0.6), geometry=narrow, threads=1),
+                                  render_panorama(s, position=(0.5, 0.5, 0.6), geometry=narrow, threads=4))
+
+
+def test_stable_argsort_is_numpys_stable_order():
+    from bionav.world.intersect import _stable_argsort
+
+    rng = np.random.default_rng(3)
+    for n in (0, 1, 2, 3, 7, 8, 9, 64, 257):
+        for keys in (rng.random(n), rng.integers(0, 4, n).astype(float)):  # distinct keys, many ties
+            if n > 3:
+                keys[rng.integers(0, n, 2)] = np.nan  # NaN last, as numpy
+            np.testing.assert_array_equal(_stable_argsort(keys), np.argsort(keys, kind="stable"))
 
 
 @pytest.mark.slow
