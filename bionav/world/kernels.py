@@ -98,10 +98,17 @@ def _bilinear(tex, base, size, uu, vv):
     y0 = math.floor(y)
     fx = x - x0
     fy = y - y0
-    ix0 = int(x0) % size
-    iy0 = int(y0) % size
-    ix1 = (ix0 + 1) % size
-    iy1 = (iy0 + 1) % size
+    if size & (size - 1) == 0:  # a power of two (every mip level): the same wrap as % without a division
+        m = size - 1
+        ix0 = int(x0) & m
+        iy0 = int(y0) & m
+        ix1 = (ix0 + 1) & m
+        iy1 = (iy0 + 1) & m
+    else:
+        ix0 = int(x0) % size
+        iy0 = int(y0) % size
+        ix1 = (ix0 + 1) % size
+        iy1 = (iy0 + 1) % size
     a = tex[base + iy0 * size + ix0]
     b = tex[base + iy0 * size + ix1]
     c = tex[base + iy1 * size + ix0]

@@ -216,10 +216,40 @@ def test_binned_shadow_rays_equal_brute_force():
                 d = v / np.linalg.norm(v)
             else:
                 d, tmax = lp[1:4], INF
-            binned = _occluded(k, *p, *d, tmax, cs.light_params, cs.shadow_grids, cs.shadow_starts,
-                                 cs.shadow_items, cs.prim_kind, cs.prim_idx, cs.spheres, cs.boxes, cs.frusta,
-                                 cs.ellipsoids)
+            binned = _occluded(k, *p, *d, tmax, cs.light_params, *cs.shadow_bins(), cs.prim_kind, cs.prim_idx,
+                               cs.spheres, cs.boxes, cs.frusta, cs.ellipsoids)
             brute = trace_depth_reference(p, d[None], *casters_only)[0] < tmax
             assert binned == brute
             n_blocked += brute
     assert n_blocked > 20
+
+
+def test_preparing_compiles_the_one_signature_of_every_render_and_builds_no_shadow_bins():
+    from bionav.world.kernels import render_kernel
+    from bionav.world.render import prepare_renderer
+
+    rng = np.random.default_rng(8)
+    s = _random_scene(rng)
+    s.add_light(PointLight((0.0, 0.0, 2.5), 3.0))
+    cs = s.compiled()
+    before = set(render_kernel.signatures)
+    prepare_renderer(cs)
+    assert cs.shadow_grids is None  # the one-ray render casts no shadow ray: no bins built (nor compiled)
+    prepared = set(render_kernel.signatures)
+    assert len(prepared - before) <= 1
+    img = render_panorama(cs, position=(0.5, 0.5, 0.6), geometry=PanoramaGeometry.square_pixels(40, 10))
+    assert set(render_kernel.signatures) == prepared  # the real render compiled nothing more
+    assert cs.shadow_grids is not None and np.isfinite(img).all()
+
+
+def test_the_world_digest_leaves_out_the_derived_shadow_bins():
+    rng = np.random.default_rng(9)
+    s = _random_scene(rng)
+    s.add_light(PointLight((0.0, 0.0, 2.5), 3.0))
+    cs = s.compiled()
+    lazy = cs.digest()
+    cs.shadow_bins()
+    assert cs.digest() == lazy  # the same key before and after the bins are built
+    other = _random_scene(np.random.default_rng(9))
+    other.add_light(PointLight((0.0, 0.0, 2.4), 3.0))
+    assert other.compiled().digest() != lazy  # a light moved: another world
