@@ -59,7 +59,7 @@ def _examples():
 
     from bionav.evaluation import agent
     from bionav.homing import sift_kernels
-    from bionav.homing.warping import distance, kernels, vkernels
+    from bionav.homing.warping import distance, kernels, pair, vkernels
     from bionav.robot import coverage
     from bionav.world import intersect, mesh_kernels
     from bionav.world import kernels as world
@@ -109,6 +109,16 @@ def _examples():
                                    (z(n_planes, 9, w, dtype=np.int16), z(n_planes, 9, 2 * w + 4, dtype=np.int16),
                                     z(n_planes, w, dtype=np.int32), z(n_planes, 2 * w + 4, dtype=np.int32), step, 227,
                                     z(n_planes, w, step, n, dtype=u8), z(w + 4, w, dtype=u16)))
+    # the whole quantised pair in one compiled call (issue 42): the kernels above and the selection, argmin, fine search
+    stack, table = z(n_planes, 9, w, dtype=f32), z(2, n_planes, w, step, n, dtype=u8)
+    flat = z(table.size + vkernels.TABLE_PAD, dtype=u8)
+    ex["minwarp_pair_u8"] = (pair.minwarp_pair_u8,
+                             ((stack, stack, stack, stack), (f32(1), f32(1)), step, 227, z(4, dtype=i64), z(4, dtype=i64),
+                              2, windows(), True, False, True, 1, 1,
+                              (z(n_planes, 9, w, dtype=np.int16), z(n_planes, w, dtype=np.int32),
+                               z(n_planes, 9, 2 * w + 4, dtype=np.int16), z(n_planes, 2 * w + 4, dtype=np.int32),
+                               z(w + 4, w, dtype=u16), table, flat, table, flat,
+                               z(vkernels.search_scratch_size(n), dtype=u8))))
     ex["warping1d_scores"] = (warping1d._warp1d_scores, (z(w), z(4 * w + 1), z(3), z(3), z(3)))
     # SIFT matching: descriptors float32, keys int64
     xa, da, na = z(16), z(16, 128, dtype=f32), z(16, dtype=i64)

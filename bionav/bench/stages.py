@@ -2,7 +2,7 @@
 
 For one pair of the bench's pillar-room views at ``--size`` (default 288 x 50, ``--steps`` 96 x 96)
 each stage of :func:`bionav.homing.warping.minwarping` is timed alone (CPU time, minimum over
-``--repeat`` rounds of ``--batch`` calls) and set against its floor: the byte-lane operations the
+``--repeat`` rounds of ``--batch`` calls; the stages and the whole home vectors interleaved round by round) and set against its floor: the byte-lane operations the
 stage's arithmetic needs, counted from the kernels (a 16-bit operation counts 2 byte lanes, a
 32-bit one 4), over ``2 vector instructions per cycle x 64 byte lanes x clock`` (two 512-bit
 instructions per cycle; the clock is measured, :func:`clock_ghz`). Counted per pair (``K`` planes,
@@ -64,17 +64,6 @@ def clock_ghz() -> float:
     return n * 3.0 / max(best2 - best1, 1e-9) / 1e9
 
 
-def _min_ms(fn, repeat: int, batch: int) -> float:
-    fn()
-    best = float("inf")
-    for _ in range(repeat):
-        c0 = time.process_time()
-        for _ in range(batch):
-            fn()
-        best = min(best, (time.process_time() - c0) / batch)
-    return 1e3 * best
-
-
 def _pair(args):
     from bionav.bench.pairs import POSES
     from bionav.plugins.homing.warping import MinWarping
@@ -93,6 +82,7 @@ def _pair(args):
 
 def stage_rows(args) -> list[dict]:
     """One row per stage and per whole home vector (see the module docstring)."""
+    from bionav.bench.calibration import _interleaved_min_ms
     from bionav.homing.warping import search as S
     from bionav.homing.warping.distance import _quantise, diagonal_distances
     from bionav.homing.warping.kernels import compass_measure, fill_window_minima, minwarp_scores_runs, swap_roles
@@ -134,19 +124,21 @@ def stage_rows(args) -> list[dict]:
     ]
     ghz = args.clock_ghz or clock_ghz()
     per_ms = LANES * PER_CYCLE * ghz * 1e6  # byte-lane operations per millisecond at the floor
-    rows, floors = [], {}
-    for name, ops, fn in stages:
-        ms = _min_ms(fn, args.repeat, args.batch or 6)
-        floors[name] = ops / per_ms
-        rows.append({"stage": name, "byte_lane_ops": int(ops), "floor_ms": round(ops / per_ms, 6),
-                     "cpu_ms": round(ms, 6), "fraction_of_floor": round(ops / per_ms / ms, 4)})
     names = [x[0] for x in stages]
     wholes = {"single": names[:2] + names[2:3] + names[4:5],
               "compass": names[:4] + names[5:6],
               "double_fine": names[:3] + names[4:5] * 2 + names[6:8]}
-    for variant, parts in wholes.items():
-        m = methods[variant]
-        ms = _min_ms(lambda: m.home_vector(s, c), args.repeat, args.batch or 6)
+    # stages and whole home vectors interleaved round by round (calibration's rule: a burst of other work
+    # spoils a round of every stage, not all rounds of one)
+    work = {name: (fn, args.batch or 6) for name, _, fn in stages}
+    work.update({f"home vector, {v}": (lambda m=methods[v]: m.home_vector(s, c), args.batch or 6) for v in wholes})
+    times = list(_interleaved_min_ms(work, args.repeat).values())
+    rows, floors = [], {}
+    for (name, ops, _), ms in zip(stages, times):
+        floors[name] = ops / per_ms
+        rows.append({"stage": name, "byte_lane_ops": int(ops), "floor_ms": round(ops / per_ms, 6),
+                     "cpu_ms": round(ms, 6), "fraction_of_floor": round(ops / per_ms / ms, 4)})
+    for (variant, parts), ms in zip(wholes.items(), times[len(stages):]):
         floor = sum(floors[p] for p in parts)
         rows.append({"stage": f"home vector, {variant}", "byte_lane_ops": None, "floor_ms": round(floor, 6),
                      "cpu_ms": round(ms, 6), "fraction_of_floor": round(floor / ms, 4)})

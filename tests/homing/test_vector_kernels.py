@@ -77,3 +77,65 @@ def test_vector_distances_equal_the_previous_kernel(width, n_alpha, rows):
     acc = np.empty((width + 4, width), np.uint16)
     diagonal_distances_u8(sq, cq2, sn, cn2, step, q, got, acc)
     np.testing.assert_array_equal(got, expected)
+
+
+@pytest.mark.parametrize("width,rows", [(64, 5), (96, 49), (130, 17)])
+def test_vector_distances_exact_at_the_largest_sums(width, rows):
+    """Values at +-the image quantum (|a - b| up to twice it, sums up to 65,535): the kernel's
+    ``2 sum max(a, b) - sum a - sum b`` wraps in 16 bits and must still equal ``sum |a - b|``."""
+    rng = np.random.default_rng(width + rows)
+    k, q = 2, distance_quantum(width)[0]
+    top = _image_quantum(rows)
+    sq = (top * rng.choice([-1, 1], size=(k, rows, width))).astype(np.int16)
+    c = (top * rng.choice([-1, 1], size=(k, rows, width))).astype(np.int16)
+    c[0] = -sq[0]  # a diagonal whose every term is 2 * top: the largest sum the quantum allows
+    cq2 = np.zeros((k, rows, 2 * width + 4), np.int16)
+    cq2[:, :, :2 * width] = np.concatenate([c, c], axis=2)
+    cq2[:, :, 2 * width:] = c[:, :, :4]
+    sn = np.abs(sq.astype(np.int32)).sum(axis=1)
+    cn2 = np.abs(cq2.astype(np.int32)).sum(axis=1)
+    expected = np.empty((k, width, 1, width), np.uint8)
+    _diagonal_distances_q(sq, cq2, sn, cn2, 1, q, expected)
+    got = np.empty_like(expected)
+    diagonal_distances_u8(sq, cq2, sn, cn2, 1, q, got, np.empty((width + 4, width), np.uint16))
+    np.testing.assert_array_equal(got, expected)
+    assert (expected[0, 0] == q).all()  # the opposite columns: NSAD 1 on diagonal 0
+
+
+#: (width, height, n_alpha, n_psi): the default, steps 2 and 1 (96 is no multiple of 40), an odd step (130 / 65)
+PAIR_SIZES = ((288, 50, 96, 96), (64, 12, 32, 16), (96, 20, 40, 30), (130, 17, 65, 26))
+VARIANTS = {"single": {}, "compass": {"compass_fraction": 0.3}, "fine": {"fine_search": True},
+            "double_fine": {"double_search": True, "fine_search": True},
+            "compass_double_fine": {"compass_fraction": 0.25, "double_search": True, "fine_search": True}}
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+@pytest.mark.parametrize("width,height,n_alpha,n_psi", PAIR_SIZES)
+def test_compiled_pair_equals_the_kernel_by_kernel_path(width, height, n_alpha, n_psi, symmetric):
+    """minwarping's one compiled call per pair (``pair.minwarp_pair_u8``) against the same kernels called
+    one by one from Python (``search._minwarping_steps``): the same hypothesis, score and count, exactly."""
+    from bionav.geometry import PanoramaGeometry
+    from bionav.homing.warping import minwarping, scale_plane_stack
+    from bionav.homing.warping import search as S
+
+    rng = np.random.default_rng(width + height)
+    geometry = PanoramaGeometry.square_pixels(width, height)
+    scales = default_scales() if symmetric else np.array([0.5, 0.75, 1.0, 1.4, 2.0])  # asymmetric: recomputed
+    for trial in range(2):
+        base = rng.random((height, width)).astype(np.float32)
+        other = np.roll(base, 5 * trial + 3, axis=1) + 0.3 * rng.random((height, width)).astype(np.float32)
+        snap, cur = (scale_plane_stack(img, geometry=geometry, scales=scales) for img in (base, other))
+        scl, tau, sym = S._scale_setup(snap["scales"], None)
+        assert sym == symmetric
+        windows = minwarp_windows(minwarp_template(width, scl, tau), max_level=S.WINDOW_LEVEL)
+        for name, opts in VARIANTS.items():
+            got = minwarping(snap, cur, n_alpha=n_alpha, n_psi=n_psi, **opts)
+            p_all = S._column_grid(n_psi, width)
+            double = opts.get("double_search", False)
+            grid = (S._column_grid(n_alpha, width), p_all, S._layout_step(width, n_alpha, p_all, double),
+                    n_alpha, n_psi)
+            want = S._minwarping_steps(snap, cur, grid, windows, opts.get("compass_fraction"),
+                                       opts.get("fine_search", False), double, sym, True)
+            assert (got.alpha, got.psi, got.score, got.home_angle) == (want.alpha, want.psi, want.score,
+                                                                      want.home_angle), (name, trial)
+            assert got.extras == want.extras

@@ -237,6 +237,12 @@ def _absmax(stack, key):
     return float(np.abs(np.asarray(stack[key])).max(initial=0.0))
 
 
+def _quantisation_scale(snapshot, current, n_rows: int):
+    """The common scale of both stacks' 16-bit images (largest |value| to :func:`_image_quantum`)."""
+    top = max(_absmax(snapshot, "snap"), _absmax(current, "cur"))
+    return np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
+
+
 def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised: bool = False):
     """Fast column distances in the layout the search kernels read.
 
@@ -277,8 +283,7 @@ def diagonal_distances(snapshot, current, *, step: int = 1, out=None, quantised:
     elif out.shape != shape or out.dtype != dtype or not out.flags.c_contiguous:
         raise ValueError(f"out must be a C-contiguous {np.dtype(dtype).name} array of shape {shape}")
     if quantised:
-        top = max(_absmax(snapshot, "snap"), _absmax(current, "cur"))
-        scale = np.float32(_image_quantum(n_rows) / top if top > 0 else 0.0)
+        scale = _quantisation_scale(snapshot, current, n_rows)
         # per-thread scratch arrays: fresh ones would be new pages (page faults) on every call
         sq = _scratch("sq", (n_planes, n_rows, width), np.int16)
         sn = _scratch("sn", (n_planes, width), np.int32)

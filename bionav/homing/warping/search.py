@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bionav.geometry import wrap_angle
-from bionav.homing.warping.distance import diagonal_distances, distance_quantum
+from bionav.homing.warping.distance import _scratch, diagonal_distances, distance_quantum
 from bionav.homing.warping.kernels import (
     compass_measure,
     fill_window_minima,
@@ -37,6 +37,7 @@ from bionav.homing.warping.kernels import (
     warp2d_scores,
     warp2d_scores_at,
 )
+from bionav.homing.warping.pair import minwarp_pair_u8, n_selected, pair_inputs
 from bionav.homing.warping.scaleplanes import check_scales
 from bionav.homing.warping.templates import minwarp_template, minwarp_windows, warp2d_template
 from bionav.homing.warping.vkernels import TABLE_PAD, minwarp_search_u8, padded_lanes, search_scratch_size
@@ -204,12 +205,10 @@ def _scale_setup(scales, thresholds):
 
 
 def _select_psi(dist, p_cols, compass_fraction):
-    if compass_fraction is None or compass_fraction >= 1.0:
+    n_sel = n_selected(p_cols.size, compass_fraction)
+    if n_sel == p_cols.size:
         return p_cols
-    if not (0.0 < compass_fraction <= 1.0):
-        raise ValueError(f"compass_fraction must lie in (0, 1], got {compass_fraction}")
     measure = compass_measure(dist, p_cols)
-    n_sel = max(1, int(np.ceil(compass_fraction * p_cols.size)))
     keep = np.sort(np.argsort(measure, kind="stable")[:n_sel])
     return p_cols[keep]
 
@@ -371,10 +370,30 @@ def minwarping(
     a_cols = _column_grid(n_alpha, width)
     p_all = _column_grid(n_psi, width)
     step = _layout_step(width, n_alpha, p_all, double_search)
-    n_a_eff = width // step
     if windows is None:
         tmpl = minwarp_template(width, scales, tau) if template is None else template
         windows = minwarp_windows(tmpl, max_level=WINDOW_LEVEL)
+    grid = (a_cols, p_all, step, n_alpha, n_psi)
+    if quantised and width >= 32 and distance_quantum(width)[1] == np.uint16:
+        # the whole pair in one compiled call (the same kernels, order and ties as the steps below)
+        ra, rp = _fine_radii(width, n_alpha, n_psi)
+        best_a, best_p, best, n_p = minwarp_pair_u8(
+            *pair_inputs(snapshot, current, step, double_search and not symmetric),
+            a_cols, p_all, n_selected(p_all.size, compass_fraction), windows, double_search, symmetric,
+            fine_search, ra, rp, _pair_buffers(snapshot, current, step, windows, double_search))
+        best /= distance_quantum(width)[0]
+        return _result(int(best_a), int(best_p), np.nan, best, width, n_psi_searched=int(n_p))
+    return _minwarping_steps(snapshot, current, grid, windows, compass_fraction, fine_search,
+                             double_search, symmetric, quantised)
+
+
+def _minwarping_steps(snapshot, current, grid, windows, compass_fraction, fine_search, double_search, symmetric,
+                      quantised):
+    """:func:`minwarping` kernel by kernel from Python (float distances, and quantised ones the
+    compiled pair does not take); ``grid`` is ``(a_cols, p_all, step, n_alpha, n_psi)``."""
+    a_cols, p_all, step, n_alpha, n_psi = grid
+    width = int(np.shape(snapshot["snap"])[-1])
+    n_a_eff = width // step
     levels = _window_minima(snapshot, current, step, windows, quantised)
     p_cols = _select_psi(levels[0], p_all, compass_fraction)
     scores = _search(levels, n_a_eff, p_cols, windows, quantised)
@@ -403,11 +422,40 @@ def minwarping(
     return _result(best_a, best_p, np.nan, best, width, n_psi_searched=int(p_cols.size))
 
 
+def _fine_radii(width, n_alpha, n_psi):
+    """Half widths in columns of the fine search's block (within one grid step)."""
+    return max(1, int(np.ceil(width / n_alpha)) - 1), max(1, int(np.ceil(width / n_psi)) - 1)
+
+
+def _pair_buffers(snapshot, current, step, windows, double_search):
+    """The per-thread work arrays of :func:`minwarp_pair_u8` (those of the Python path, shared),
+    kept per shape: one lookup per pair instead of ten."""
+    n_planes, n_rows, width = np.shape(snapshot["snap"])
+    key = (n_planes, n_rows, width, step, int(windows[2].max(initial=0)) + 1, bool(double_search))
+    kept = _WORKSPACE.__dict__.setdefault("pair", {})
+    bufs = kept.get(key)
+    if bufs is None:
+        if len(kept) >= 8:
+            kept.clear()
+        bufs = kept[key] = _pair_buffers_new(*key)
+    return bufs
+
+
+def _pair_buffers_new(n_planes, n_rows, width, step, n_levels, double_search):
+    shape = (n_levels, n_planes, width, step, width // step)
+    levels = _table("levels", shape, np.dtype(np.uint8))
+    levels2 = _table("levels2", shape, np.dtype(np.uint8)) if double_search else levels
+    return (_scratch("sq", (n_planes, n_rows, width), np.int16), _scratch("sn", (n_planes, width), np.int32),
+            _scratch("cq2", (n_planes, n_rows, 2 * width + 4), np.int16),
+            _scratch("cn2", (n_planes, 2 * width + 4), np.int32), _scratch("acc", (width + 4, width), np.uint16),
+            levels, _padded(levels), levels2, _padded(levels2),
+            _buffer("scratch", (search_scratch_size(width // step),), np.dtype(np.uint8)))
+
+
 def _fine_minwarp(levels, levels2, windows, best_a, best_p, best, width, n_alpha, n_psi):
     """:func:`_fine` for min-warping: the block of hypotheses as runs of
     directions per rotation (:func:`minwarp_scores_runs`), same order and ties."""
-    ra = max(1, int(np.ceil(width / n_alpha)) - 1)
-    rp = max(1, int(np.ceil(width / n_psi)) - 1)
+    ra, rp = _fine_radii(width, n_alpha, n_psi)
     pc = (best_p + np.arange(-rp, rp + 1, dtype=np.int64)) % width
     a_first = np.full(pc.size, (best_a - ra) % width, dtype=np.int64)
     vals = minwarp_scores_runs(levels, a_first, 2 * ra + 1, pc, *windows)

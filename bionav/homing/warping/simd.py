@@ -151,6 +151,33 @@ def add_widened_u8(typingctx, acc, v):
 
 
 @intrinsic
+def add_max_i16(typingctx, acc, a, b):
+    """``acc + max(a, b)`` lane-wise on ``I16x32``, signed maximum (``vpmaxsw`` + ``vpaddw``, wrapping)."""
+    def codegen(context, builder, sig, args):
+        return builder.add(args[0], builder.select(builder.icmp_signed(">", args[1], args[2]), args[1], args[2]))
+
+    return I16x32(I16x32, I16x32, I16x32), codegen
+
+
+@intrinsic
+def add_i16(typingctx, a, b):
+    """``a + b`` lane-wise on ``I16x32`` (``vpaddw``, wrapping)."""
+    def codegen(context, builder, sig, args):
+        return builder.add(args[0], args[1])
+
+    return I16x32(I16x32, I16x32), codegen
+
+
+@intrinsic
+def sub_i16(typingctx, a, b):
+    """``a - b`` lane-wise on ``I16x32`` (``vpsubw``, wrapping)."""
+    def codegen(context, builder, sig, args):
+        return builder.sub(args[0], args[1])
+
+    return I16x32(I16x32, I16x32), codegen
+
+
+@intrinsic
 def add_absdiff_i16(typingctx, acc, a, b):
     """``acc + |a - b|`` lane-wise on ``I16x32`` (``vpsubw`` + ``vpabsw`` + ``vpaddw``, wrapping)."""
     def codegen(context, builder, sig, args):
