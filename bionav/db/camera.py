@@ -44,6 +44,7 @@ from bionav.db.config import CameraConfig, PoseErrorConfig
 from bionav.db.unfold import unfold_panorama
 from bionav.geometry import PanoramaGeometry
 from bionav.world.catadioptric import MirrorProjection, RawFrameLayout, raw_frame_layout, render_raw_frame
+from bionav.world.render import thread_count, map_in_threads
 from bionav.world.scene import Scene
 
 #: Bump whenever a change to the camera pipeline changes pixels (part of the cache key).
@@ -421,18 +422,34 @@ def camera_images(world, positions: np.ndarray, geometry: PanoramaGeometry, *, c
     # the world as it was at each capture (the capture light, outdoors or through windows; the supervisor)
     scene_at = world.capture_scenes(positions, seed=session_seed(int(pose_error.seed), int(seed)))
     light_level = float(getattr(world, "light_level", 1.0))
-    for k in it:
+    n_threads = thread_count(threads)
+    if scene_at is None and n_threads > 1:
+        world.scene.compiled().shadow_bins()  # built once before the threads share the scene
+
+    def capture(k: int) -> tuple[np.ndarray, np.ndarray]:
+        """View ``k``'s raw frame (8 bits) and its unfolded panorama; every view on its own (own noise stream)."""
         i, j = positions[k]
         x, y, z = world.cell_position(i, j)
         scene = world.scene if scene_at is None else scene_at(k)
         radiance = render_raw_frame(scene, position=(x + offsets[k, 0], y + offsets[k, 1], z),
-                                    heading=float(dheads[k]), layout=setup.layout, threads=threads)
+                                    heading=float(dheads[k]), layout=setup.layout, threads=1)
         if not isinstance(scene, Scene):  # a compiled session scene renders without the scene's exposure
             radiance *= float(world.scene.exposure)
         if light_level != 1.0:  # a dim scene (the night hall): the automatic exposure has to make up for it
             radiance *= light_level
         raw = raw_frame_from_radiance(radiance, setup, rng=noise_rng(seed, (i, j)))
-        out[k] = unfold_frame(raw, setup, geometry, tilt=tilts[k])
-        if raws is not None:
-            raws[k] = raw
+        return raw, unfold_frame(raw, setup, geometry, tilt=tilts[k])
+
+    # whole views on the threads (render and camera model), not the columns of one view: the camera model's
+    # NumPy work, a quarter of a view's time, then runs beside another view's render instead of alone
+    views = map_in_threads(capture, range(n), threads=n_threads) if n_threads > 1 else map(capture, range(n))
+    try:
+        for k in it:
+            raw, out[k] = next(views)
+            if raws is not None:
+                raws[k] = raw
+    finally:
+        close = getattr(views, "close", None)
+        if close is not None:  # the views handed out and not started are cancelled
+            close()
     return out, raws, {"offsets_m": offsets, "heading_errors": dheads, "tilts": tilts}

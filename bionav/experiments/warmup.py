@@ -1,14 +1,17 @@
 """Compiling a run's homing kernels in a second process while the first one renders (the first run's wait).
 
 From empty caches the default ``python -m bionav`` spends most of its time in
-numba compiling: the renderer's kernel (needed first), then the SIFT matcher's
-row kernel and the return agent's kernel (needed only after the rendering).
-numba compiles in one thread, so :func:`start_warmup` starts
-``python -m bionav.experiments.warmup`` beside the run: it homes with the run's
-method on a tiny synthetic 3 x 3 grid, which compiles the same kernels for the
-same argument types into numba's on-disk cache, while the run compiles the
-renderer and renders. When the run reaches its home vectors it loads them from
-the cache. The results do not depend on it (the same compiled code either way).
+numba compiling: the renderer's kernel (needed first), its shadow bins (needed
+when the render starts), then the SIFT matcher's row kernel and the return
+agent's kernel (needed only after the rendering). numba compiles in one
+thread, so :func:`start_warmup` starts ``python -m bionav.experiments.warmup``
+beside the run: for a run of a synthetic database it first builds the shadow
+bins of a one-light scene (the renderer's second kernel), then it homes with
+the run's method on a tiny synthetic 3 x 3 grid, which compiles the same
+kernels for the same argument types into numba's on-disk cache, while the run
+compiles the render kernel and renders. When the run reaches them it loads
+them from the cache. The results do not depend on it (the same compiled code
+either way).
 
 A marker file beside numba's cache of the agent kernel records a finished
 warm-up per method and code version, so later runs start no process; a run
@@ -81,7 +84,9 @@ def start_warmup(cfg: Any, *, used_groups: tuple[str, ...]) -> subprocess.Popen 
         if marker is None or marker.exists():
             return None
         plain = json.dumps(OmegaConf.to_container(node, resolve=True))
-        return subprocess.Popen([sys.executable, "-m", "bionav.experiments.warmup", plain, str(marker)],
+        db = cfg.get("db")
+        renders = "render" if db is not None and db.get("source") == "synthetic" else "no-render"
+        return subprocess.Popen([sys.executable, "-m", "bionav.experiments.warmup", plain, str(marker), renders],
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                 env={**os.environ, "BIONAV_NO_WARMUP": "1"})
     except Exception:  # a warm-up is an optimisation: never a reason for a run to fail
@@ -131,8 +136,22 @@ def warm(node: dict) -> None:
     evaluate_agents(db, hv, step_length=0.5, success_radius=1.0)
 
 
+def warm_shadow_bins() -> None:
+    """Build the shadow bins of one point light over two casters (compiles :func:`build_shadow_bins`), unless cached."""
+    from bionav.files import numba_cached
+    from bionav.world.shadow_bins import build_shadow_bins
+
+    if numba_cached(build_shadow_bins):
+        return
+    lights = np.zeros((1, 6))  # one point light (kind 0) at the origin, group 0
+    spheres = np.array([[1.0, 0.0, 0.0, 0.5], [0.0, 2.0, 0.0, 0.5]])
+    build_shadow_bins(lights, spheres, np.arange(2, dtype=np.int64))
+
+
 def main(argv: list[str]) -> int:
     node, marker = json.loads(argv[0]), Path(argv[1])
+    if argv[2:] == ["render"]:
+        warm_shadow_bins()
     warm(node)
     marker.parent.mkdir(parents=True, exist_ok=True)
     marker.write_text("compiled\n")

@@ -83,7 +83,7 @@ def _hit_box(ox, oy, oz, dx, dy, dz, B, i):
     return t, face, lx + t * ldx, ly + t * ldy, lz + t * ldz, ldx, ldy, ldz
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _hit_frustum(ox, oy, oz, dx, dy, dz, F, i):
     """Nearest hit with frustum ``F[i]``; returns (t, face) with face 0 side, 1 bottom, 2 top."""
     cx, cy, z0, z1, r0, r1 = F[i, 0], F[i, 1], F[i, 2], F[i, 3], F[i, 4], F[i, 5]
@@ -133,7 +133,7 @@ def _hit_frustum(ox, oy, oz, dx, dy, dz, F, i):
     return best, face
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _hit_ellipsoid(ox, oy, oz, dx, dy, dz, E, i):
     """Nearest hit with ellipsoid ``E[i]``; returns t (INF if missed)."""
     px = (ox - E[i, 0]) / E[i, 3]
@@ -169,7 +169,7 @@ def _hit_prim(ox, oy, oz, dx, dy, dz, kind, i, boxes, frusta, ells):
     return _hit_ellipsoid(ox, oy, oz, dx, dy, dz, ells, i), 0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _trace(ox, oy, oz, dx, dy, dz, el, cands, j, n_cands, el_lo, el_hi, rho_min, prim_kind, prim_idx,
            boxes, frusta, ells):
     """Nearest primitive along a ray among the column's candidates.
@@ -272,6 +272,42 @@ def _prim_bounds(ox, oy, oz, kind, i, boxes, frusta, ells):
 
 
 @njit(cache=True)
+def _stable_argsort(keys):
+    """Indices that sort ``keys`` (1-D float64) ascending, equal keys in input order, NaN last.
+
+    The same order as ``np.argsort(keys, kind="stable")``: a bottom-up merge sort written out,
+    because numba's own sort cost 2-4 s of compilation on a first run, for a few hundred keys.
+    """
+    n = keys.shape[0]
+    a = np.arange(n)
+    b = np.empty(n, np.int64)
+    width = 1
+    while width < n:
+        for lo in range(0, n, 2 * width):
+            mid = min(lo + width, n)
+            hi = min(lo + 2 * width, n)
+            i = lo
+            j = mid
+            for k in range(lo, hi):
+                if i < mid and j < hi:
+                    x = keys[a[i]]
+                    y = keys[a[j]]
+                    # take the right run's key only when strictly smaller (stable); NaN sorts last
+                    right = y < x or (x != x and y == y)
+                else:
+                    right = i >= mid
+                if right:
+                    b[k] = a[j]
+                    j += 1
+                else:
+                    b[k] = a[i]
+                    i += 1
+        a, b = b, a
+        width *= 2
+    return a
+
+
+@njit(cache=True)
 def _candidates(ox, oy, oz, az, margin, prim_kind, prim_idx, boxes, frusta, ells):
     """Per-column candidate primitives (sorted near to far) and per-primitive elevation bands.
 
@@ -297,7 +333,7 @@ def _candidates(ox, oy, oz, az, margin, prim_kind, prim_idx, boxes, frusta, ells
         el_lo[p] = elo - margin
         el_hi[p] = ehi + margin
         rho_min[p] = rm
-    order = np.argsort(rho_min, kind="mergesort")
+    order = _stable_argsort(rho_min)
     cands = np.empty((W, n), np.int64)
     counts = np.zeros(W, np.int64)
     two_pi = 2.0 * math.pi

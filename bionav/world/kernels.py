@@ -20,7 +20,7 @@ from bionav.world.intersect import INF, _candidates, _hit_box, _trace
 from bionav.world.shadow_bins import _occluded
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _surface(kind, idx, face, t, ox, oy, oz, dx, dy, dz, boxes, frusta, ells):
     """Normal (world frame, facing the ray), surface coordinates (u, v) in metres and face extents."""
     hx = ox + t * dx
@@ -90,7 +90,7 @@ def _material(kind, idx, face, box_mats, frustum_mats, ell_mats):
     return ell_mats[idx]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _bilinear(tex, base, size, uu, vv):
     x = uu * size - 0.5
     y = vv * size - 0.5
@@ -98,10 +98,17 @@ def _bilinear(tex, base, size, uu, vv):
     y0 = math.floor(y)
     fx = x - x0
     fy = y - y0
-    ix0 = int(x0) % size
-    iy0 = int(y0) % size
-    ix1 = (ix0 + 1) % size
-    iy1 = (iy0 + 1) % size
+    if size & (size - 1) == 0:  # a power of two (every mip level): the same wrap as % without a division
+        m = size - 1
+        ix0 = int(x0) & m
+        iy0 = int(y0) & m
+        ix1 = (ix0 + 1) & m
+        iy1 = (iy0 + 1) & m
+    else:
+        ix0 = int(x0) % size
+        iy0 = int(y0) % size
+        ix1 = (ix0 + 1) % size
+        iy1 = (iy0 + 1) % size
     a = tex[base + iy0 * size + ix0]
     b = tex[base + iy0 * size + ix1]
     c = tex[base + iy1 * size + ix0]
@@ -109,7 +116,7 @@ def _bilinear(tex, base, size, uu, vv):
     return (a * (1 - fx) + b * fx) * (1 - fy) + (c * (1 - fx) + d * fx) * fy
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _sample_texture(tex, tex_id, size, uu, vv, lod):
     """Trilinear sample of texture ``tex_id`` at normalised (uu, vv) and level of detail ``lod``."""
     n_levels = 0
@@ -186,7 +193,7 @@ def _light_at(k, light_params, hx, hy, hz, nx, ny, nz):
     return lx, ly, lz, tmax, fac
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True)
 def render_kernel(ox, oy, oz, az, el, pix_angle,
                   boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
                   prim_kind, prim_idx, spheres, shadow_grids, shadow_starts, shadow_items,
@@ -197,16 +204,39 @@ def render_kernel(ox, oy, oz, az, el, pix_angle,
 
     Writes ``out`` (H, W, C) radiance, ``depth`` (H, W) hit distance in metres
     (inf for misses) and ``sky_mask`` (H, W) True where nothing was hit.
+
+    Serial and GIL-free: every ray is independent, so callers split the columns over threads
+    (:func:`bionav.world.render.render_ray_grid`) with identical results. It was a
+    ``parallel=True`` kernel, whose compilation was most of a first run's wait (numba's parallel
+    passes about doubled it).
+    """
+    C = out.shape[2]
+    cands, counts, el_lo, el_hi, rho_min = _candidates(ox, oy, oz, az, 2.0 * pix_angle, prim_kind, prim_idx,
+                                                       boxes, frusta, ells)
+    _render_rows(ox, oy, oz, az, el, pix_angle, boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
+                 prim_kind, prim_idx, spheres, shadow_grids, shadow_starts, shadow_items,
+                 mat_tex, mat_fit, mat_scale, mat_albedo, mat_emission, tex, tex_size,
+                 light_params, light_power, amb_up, amb_down, shadows,
+                 cands, counts, el_lo, el_hi, rho_min, np.empty(C), np.empty(C), out, depth, sky_mask)
+
+
+@njit(cache=True, _nrt=False)
+def _render_rows(ox, oy, oz, az, el, pix_angle, boxes, box_mats, frusta, frustum_mats, ells, ell_mats,
+                 prim_kind, prim_idx, spheres, shadow_grids, shadow_starts, shadow_items,
+                 mat_tex, mat_fit, mat_scale, mat_albedo, mat_emission, tex, tex_size,
+                 light_params, light_power, amb_up, amb_down, shadows,
+                 cands, counts, el_lo, el_hi, rho_min, E, Eg, out, depth, sky_mask):
+    """The rays of :func:`render_kernel`, given its candidate lists and two scratch vectors ``E``, ``Eg`` (C,).
+
+    Compiled without numba's reference counting (``_nrt=False``, as are the per-ray helpers it
+    calls: they allocate nothing): with it, every call of a helper counted its array arguments up
+    and down with atomic instructions, half the render's time in a serial kernel.
     """
     H = el.shape[0]
     W = az.shape[0]
     C = out.shape[2]
     nl = light_params.shape[0]
-    cands, counts, el_lo, el_hi, rho_min = _candidates(ox, oy, oz, az, 2.0 * pix_angle, prim_kind, prim_idx,
-                                                       boxes, frusta, ells)
-    for r in prange(H):  # rows are independent: the result does not depend on the number of threads
-        E = np.empty(C)
-        Eg = np.empty(C)
+    for r in range(H):
         ce = math.cos(el[r])
         se = math.sin(el[r])
         for j in range(W):

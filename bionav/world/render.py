@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Sequence
+import collections
+import itertools
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from typing import Callable, Iterable, Iterator, Sequence, TypeVar
 
 import numba
 import numpy as np
@@ -14,11 +18,68 @@ from bionav.world.scene import CompiledScene, Scene
 #: Bump whenever a change to the renderer or a world builder changes pixels (invalidates caches).
 RENDERER_VERSION = 2
 
+A = TypeVar("A")
+T = TypeVar("T")
+
+#: shadow bins of no light, for renders without shadow rays (the kernel's argument types)
+_NO_SHADOW_BINS = (np.zeros((0, 6)), np.zeros((0, 1), np.int64), np.zeros((0, 1), np.int64))
+
+
+def thread_count(threads: int | None) -> int:
+    """Render threads: ``threads`` capped to numba's thread count (``NUMBA_NUM_THREADS``, all cores by default; None: that many)."""
+    cap = numba.config.NUMBA_NUM_THREADS
+    return cap if threads is None else max(1, min(int(threads), cap))
+
+
+_POOL: ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
+
+
+def map_in_threads(fn: Callable[[A], T], items: Iterable[A], *, threads: int) -> Iterator[T]:
+    """``map(fn, items)`` on ``threads`` threads of one shared pool: results in order, as they are taken.
+
+    For work that releases the GIL (the render kernel, most of NumPy). At most ``2 * threads``
+    items are handed out ahead of the one taken, and those not started are cancelled when the
+    caller stops taking (an error, Ctrl-C), so nothing renders on after it. ``fn`` must not itself
+    wait for this pool (a render inside runs with ``threads=1``).
+    """
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None or _POOL._max_workers < threads:
+            _POOL = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="bionav-render")
+        pool = _POOL
+    items = iter(items)
+    pending = collections.deque(pool.submit(fn, x) for x in itertools.islice(items, 2 * threads))
+    try:
+        while pending:
+            done = pending.popleft()
+            for x in itertools.islice(items, 1):
+                pending.append(pool.submit(fn, x))
+            yield done.result()
+    finally:
+        for future in pending:
+            future.cancel()
+
+
+def _in_column_blocks(render_columns: Callable[[int, int], T], width: int, threads: int) -> list[T]:
+    """``render_columns(j0, j1)`` over blocks of the ``width`` columns, on ``threads`` threads, in column order.
+
+    Rays are independent, so the blocks give the same values as one call over all columns. With
+    more than one thread the columns are cut into ``4 * threads`` blocks (a block of sky costs less
+    than one of walls) taken by the threads of one shared pool as they come free; the render kernel
+    releases the GIL.
+    """
+    n_blocks = 1 if threads <= 1 else min(width, 4 * threads)
+    if n_blocks <= 1:
+        return [render_columns(0, width)]
+    edges = np.linspace(0, width, n_blocks + 1).round().astype(int)
+    return list(map_in_threads(lambda edge: render_columns(*edge), zip(edges[:-1].tolist(), edges[1:].tolist()),
+                               threads=threads))
+
 
 def _run_threads(threads: int | None, kernel, *args) -> None:
-    """Run a parallel kernel on ``threads`` threads (None = numba's default); the result does not depend on it."""
-    n = numba.config.NUMBA_NUM_THREADS if threads is None else max(1, min(int(threads),
-                                                                          numba.config.NUMBA_NUM_THREADS))
+    """Run a ``parallel=True`` kernel on ``threads`` threads (None = numba's default); the result does not depend on it."""
+    n = thread_count(threads)
     prev = numba.get_num_threads()
     numba.set_num_threads(n)
     try:
@@ -94,10 +155,10 @@ def render_panorama(scene: Scene | CompiledScene, *, position: Sequence[float], 
     clip : bool
         Clip the result to ``[0, 1]``.
     threads : int or None
-        Threads for the row-parallel kernel (``None``: numba's default, all
-        cores). One thread by default: on a shared machine the thread pool
-        costs more than it gains for small images. Results are identical for
-        any number of threads.
+        Threads rendering blocks of columns (``None``: numba's thread count,
+        all cores unless ``NUMBA_NUM_THREADS`` says otherwise). One thread by
+        default: on a shared machine the threads cost more than they gain for
+        small images. Results are identical for any number of threads.
 
     Returns
     -------
@@ -161,15 +222,23 @@ def render_ray_grid(scene: Scene | CompiledScene, *, position: Sequence[float], 
     el = np.ascontiguousarray(elevations, dtype=np.float64)
     ox, oy, oz = (float(v) for v in position)
     C = cs.mat_albedo.shape[1]
-    out = np.empty((el.size, az.size, C), np.float64)
-    depth = np.empty((el.size, az.size))
-    sky_mask = np.zeros((el.size, az.size), np.bool_)
-    _run_threads(threads, render_kernel, ox, oy, oz, az, el, float(pixel_angle),
-                  cs.boxes, cs.box_mats, cs.frusta, cs.frustum_mats, cs.ellipsoids, cs.ellipsoid_mats,
-                  cs.prim_kind, cs.prim_idx, cs.spheres, cs.shadow_grids, cs.shadow_starts, cs.shadow_items,
-                  cs.mat_tex, cs.mat_fit, cs.mat_scale, cs.mat_albedo, cs.mat_emission, cs.tex_data,
-                  cs.tex_size, cs.light_params, cs.light_power, cs.ambient_up, cs.ambient_down, bool(shadows),
-                  out, depth, sky_mask)
+    grids, starts, items = cs.shadow_bins() if shadows else _NO_SHADOW_BINS
+
+    def columns(j0: int, j1: int):
+        block_out = np.empty((el.size, j1 - j0, C), np.float64)
+        block_depth = np.empty((el.size, j1 - j0))
+        block_sky = np.zeros((el.size, j1 - j0), np.bool_)
+        render_kernel(ox, oy, oz, az[j0:j1], el, float(pixel_angle),
+                      cs.boxes, cs.box_mats, cs.frusta, cs.frustum_mats, cs.ellipsoids, cs.ellipsoid_mats,
+                      cs.prim_kind, cs.prim_idx, cs.spheres, grids, starts, items,
+                      cs.mat_tex, cs.mat_fit, cs.mat_scale, cs.mat_albedo, cs.mat_emission, cs.tex_data,
+                      cs.tex_size, cs.light_params, cs.light_power, cs.ambient_up, cs.ambient_down, bool(shadows),
+                      block_out, block_depth, block_sky)
+        return block_out, block_sky
+
+    blocks = _in_column_blocks(columns, az.size, thread_count(threads))
+    out = blocks[0][0] if len(blocks) == 1 else np.concatenate([b[0] for b in blocks], axis=1)
+    sky_mask = blocks[0][1] if len(blocks) == 1 else np.concatenate([b[1] for b in blocks], axis=1)
     if sky is not None and sky_mask.any():
         rr, jj = np.nonzero(sky_mask)
         ce = np.cos(el[rr])
@@ -191,9 +260,10 @@ def prepare_renderer(scene: Scene | CompiledScene) -> None:
 
     One ray is rendered: the same argument types as every view of the scene, so the views that follow
     run at their own speed and a progress bar's rate (and ETA) is the render's, not the compiler's.
+    It casts no shadow ray, so the scene's shadow bins are not built yet (nor compiled).
     """
     render_ray_grid(scene, position=(0.0, 0.0, 0.0), azimuths=np.zeros(1), elevations=np.zeros(1),
-                    pixel_angle=1e-3)
+                    pixel_angle=1e-3, shadows=False)
 
 
 def render_depth(scene: Scene | CompiledScene, *, position: Sequence[float], heading: float = 0.0,

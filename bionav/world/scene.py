@@ -94,24 +94,36 @@ class CompiledScene:
     prim_idx: np.ndarray = None  # (n,) index within its kind
     spheres: np.ndarray = None  # (n, 4) bounding sphere cx cy cz radius
     casters: np.ndarray = None  # (k,) unified indices of shadow-casting primitives
+    # derived from the lights, spheres and casters when first needed (:meth:`shadow_bins`)
     shadow_grids: np.ndarray = None  # (L, 6) per-light bin grid
     shadow_starts: np.ndarray = None  # (L, n_bins + 1) CSR offsets
     shadow_items: np.ndarray = None  # (L, total) caster indices
 
     def __post_init__(self) -> None:
-        from bionav.world.shadow_bins import build_shadow_bins
-
         if self.prim_kind is None:
             self.prim_kind, self.prim_idx, self.spheres, self.casters = bounding_spheres(
                 self.boxes, self.frusta, self.ellipsoids)
+
+    def shadow_bins(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(shadow_grids, shadow_starts, shadow_items)``, built on first use (:func:`~bionav.world.shadow_bins.build_shadow_bins`).
+
+        Built lazily: a world's cache key (:meth:`digest`) and a render from the cache need no
+        shadow bins, and a first run compiles the render kernel before them (their compilation
+        can then happen in another process, :mod:`bionav.experiments.warmup`).
+        """
         if self.shadow_grids is None:
+            from bionav.world.shadow_bins import build_shadow_bins
+
             self.shadow_grids, self.shadow_starts, self.shadow_items = build_shadow_bins(
                 self.light_params, self.spheres, self.casters)
+        return self.shadow_grids, self.shadow_starts, self.shadow_items
 
     def digest(self) -> str:
-        """SHA-256 of every array (identifies the world for caches)."""
+        """SHA-256 of every array but the shadow bins (derived from the others): identifies the world for caches."""
         h = hashlib.sha256()
         for name in self.__dataclass_fields__:
+            if name.startswith("shadow_"):
+                continue
             v = getattr(self, name)
             a = np.ascontiguousarray(np.asarray(v))
             h.update(name.encode())

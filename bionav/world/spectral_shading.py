@@ -71,7 +71,7 @@ def trace_surfaces(scene: Scene | CompiledScene, origin, directions, *, light: i
     ox, oy, oz = (float(v) for v in origin)
     _run_threads(threads, surface_kernel, ox, oy, oz, az, d, AZIMUTH_BINS, cs.boxes, cs.box_mats, cs.frusta,
                  cs.frustum_mats, cs.ellipsoids, cs.ellipsoid_mats, cs.prim_kind, cs.prim_idx, cs.spheres,
-                 cs.shadow_grids, cs.shadow_starts, cs.shadow_items, cs.light_params, int(light), out["depth"],
+                 *cs.shadow_bins(), cs.light_params, int(light), out["depth"],
                  out["point"], out["normal"], out["material"], out["lit"])
     return out
 

@@ -57,3 +57,43 @@ def test_a_third_party_method_is_called_only_by_the_run(tmp_path):
                       f"hydra.run.dir={tmp_path / 'run'}", cwd=tmp_path, env=env)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert log.read_text().count("pair") == 9 * 8
+
+
+def test_the_warmup_compiles_the_shadow_bins_a_rendering_run_then_loads(tmp_path):
+    """For a synthetic database the warm-up builds a one-light scene's shadow bins first: the run's own
+    scene (other lights, casters) then loads the compiled code from numba's cache instead of compiling."""
+    import subprocess
+    import sys
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    warm = subprocess.run([sys.executable, "-c", "from bionav.experiments.warmup import warm_shadow_bins; "
+                           "warm_shadow_bins()"], env=env, capture_output=True, text=True, timeout=600)
+    assert warm.returncode == 0, warm.stderr[-2000:]
+    check = ("from bionav.db.standins import get_spec\n"
+             "from bionav.world.shadow_bins import build_shadow_bins\n"
+             "cs = get_spec('sim_original').builder(0).scene.compiled()\n"
+             "assert cs.shadow_grids is None  # lazily built\n"
+             "grids, starts, items = cs.shadow_bins()\n"
+             "s = build_shadow_bins.stats\n"
+             "print(sum(s.cache_hits.values()), sum(s.cache_misses.values()), len(cs.light_params), items.shape[0])\n")
+    run = subprocess.run([sys.executable, "-c", check], env=env, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    hits, misses, n_lights, rows = map(int, run.stdout.split())
+    assert (hits, misses) == (1, 0)
+    assert n_lights > 1 and rows == n_lights  # a scene unlike the warm-up's, still the same compiled code
+
+
+def test_the_warmup_learns_whether_the_run_renders(monkeypatch, tmp_path):
+    from omegaconf import OmegaConf
+
+    from bionav.experiments import warmup
+
+    started = []
+    monkeypatch.delenv("BIONAV_NO_WARMUP", raising=False)
+    monkeypatch.setattr(warmup.subprocess, "Popen", lambda argv, **kw: started.append(argv))
+    monkeypatch.setattr(warmup, "_marker", lambda method: tmp_path / "no-marker-yet")
+    cfg = OmegaConf.create({"homing": {"name": "sift"}, "db": {"source": "synthetic", "name": "sim_original"}})
+    warmup.start_warmup(cfg, used_groups=("homing",))
+    cfg.db.source = "folder"
+    warmup.start_warmup(cfg, used_groups=("homing",))
+    assert [argv[-1] for argv in started] == ["render", "no-render"]

@@ -172,8 +172,24 @@ def test_result_does_not_depend_on_the_number_of_threads():
     s.add_light(PointLight((0.0, 0.0, 2.5), 3.0))
     geo = PanoramaGeometry.square_pixels(120, 30)
     one = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=1)
-    two = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=2)
-    np.testing.assert_array_equal(one, two)
+    for threads in (2, 3, None):  # 8, 12 and 4 x cores blocks of columns (uneven at 3: 120 / 12 ... / 8)
+        many = render_panorama(s, position=(0.5, 0.5, 0.6), geometry=geo, threads=threads)
+        np.testing.assert_array_equal(one, many)
+    # a grid narrower than the blocks (columns < 4 x threads) and one column
+    narrow = PanoramaGeometry.square_pixels(5, 30)
+    np.testing.assert_array_equal(render_panorama(s, position=(0.5, 0.5, 0.6), geometry=narrow, threads=1),
+                                  render_panorama(s, position=(0.5, 0.5, 0.6), geometry=narrow, threads=4))
+
+
+def test_stable_argsort_is_numpys_stable_order():
+    from bionav.world.intersect import _stable_argsort
+
+    rng = np.random.default_rng(3)
+    for n in (0, 1, 2, 3, 7, 8, 9, 64, 257):
+        for keys in (rng.random(n), rng.integers(0, 4, n).astype(float)):  # distinct keys, many ties
+            if n > 3:
+                keys[rng.integers(0, n, 2)] = np.nan  # NaN last, as numpy
+            np.testing.assert_array_equal(_stable_argsort(keys), np.argsort(keys, kind="stable"))
 
 
 @pytest.mark.slow
@@ -200,10 +216,40 @@ def test_binned_shadow_rays_equal_brute_force():
                 d = v / np.linalg.norm(v)
             else:
                 d, tmax = lp[1:4], INF
-            binned = _occluded(k, *p, *d, tmax, cs.light_params, cs.shadow_grids, cs.shadow_starts,
-                                 cs.shadow_items, cs.prim_kind, cs.prim_idx, cs.spheres, cs.boxes, cs.frusta,
-                                 cs.ellipsoids)
+            binned = _occluded(k, *p, *d, tmax, cs.light_params, *cs.shadow_bins(), cs.prim_kind, cs.prim_idx,
+                               cs.spheres, cs.boxes, cs.frusta, cs.ellipsoids)
             brute = trace_depth_reference(p, d[None], *casters_only)[0] < tmax
             assert binned == brute
             n_blocked += brute
     assert n_blocked > 20
+
+
+def test_preparing_compiles_the_one_signature_of_every_render_and_builds_no_shadow_bins():
+    from bionav.world.kernels import render_kernel
+    from bionav.world.render import prepare_renderer
+
+    rng = np.random.default_rng(8)
+    s = _random_scene(rng)
+    s.add_light(PointLight((0.0, 0.0, 2.5), 3.0))
+    cs = s.compiled()
+    before = set(render_kernel.signatures)
+    prepare_renderer(cs)
+    assert cs.shadow_grids is None  # the one-ray render casts no shadow ray: no bins built (nor compiled)
+    prepared = set(render_kernel.signatures)
+    assert len(prepared - before) <= 1
+    img = render_panorama(cs, position=(0.5, 0.5, 0.6), geometry=PanoramaGeometry.square_pixels(40, 10))
+    assert set(render_kernel.signatures) == prepared  # the real render compiled nothing more
+    assert cs.shadow_grids is not None and np.isfinite(img).all()
+
+
+def test_the_world_digest_leaves_out_the_derived_shadow_bins():
+    rng = np.random.default_rng(9)
+    s = _random_scene(rng)
+    s.add_light(PointLight((0.0, 0.0, 2.5), 3.0))
+    cs = s.compiled()
+    lazy = cs.digest()
+    cs.shadow_bins()
+    assert cs.digest() == lazy  # the same key before and after the bins are built
+    other = _random_scene(np.random.default_rng(9))
+    other.add_light(PointLight((0.0, 0.0, 2.4), 3.0))
+    assert other.compiled().digest() != lazy  # a light moved: another world
