@@ -285,7 +285,7 @@ def _prepare_renderer(spec, world) -> None:
 
     if not renderer_compiled():
         log.info("rendering %s (%d views) for the first time: compiling the renderer first (numba, once per "
-                 "installation and cached; about half a minute on 2 idle cores) ...", spec.name, spec.n_images)
+                 "installation and cached; about 15 s on 2 idle cores) ...", spec.name, spec.n_images)
     prepare_renderer(world.scene)
 
 
