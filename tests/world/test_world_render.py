@@ -253,3 +253,27 @@ def test_the_world_digest_leaves_out_the_derived_shadow_bins():
     other = _random_scene(np.random.default_rng(9))
     other.add_light(PointLight((0.0, 0.0, 2.4), 3.0))
     assert other.compiled().digest() != lazy  # a light moved: another world
+
+
+def test_map_in_threads_keeps_the_order_and_stops_when_the_caller_stops():
+    import threading
+    import time
+
+    from bionav.world.render import map_in_threads
+
+    ran = []
+    lock = threading.Lock()
+
+    def square(x):
+        time.sleep(0.005 * (x % 3))  # finishing out of order
+        with lock:
+            ran.append(x)
+        return x * x
+
+    assert list(map_in_threads(square, range(20), threads=2)) == [x * x for x in range(20)]
+    ran.clear()
+    taken = map_in_threads(square, range(100), threads=2)
+    assert [next(taken) for _ in range(3)] == [0, 1, 4]
+    taken.close()  # the caller stops (an error, Ctrl-C): what was not started is cancelled
+    time.sleep(0.2)
+    assert len(ran) <= 3 + 2 * 2  # the three taken and at most 2 x threads handed out ahead
